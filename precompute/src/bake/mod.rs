@@ -1,0 +1,159 @@
+//! The offline bake (thesis Figure 4.2): per-vertex SH transfer with shadowing and
+//! interreflections.
+//!
+//! One pass traces `samples` cosine-distributed rays per vertex. A ray that escapes adds the SH
+//! basis in its direction to the vertex's direct (shadowed) transfer; a ray that hits the front
+//! of a triangle records the hit's barycentric weights. Those weights form a sparse
+//! interreflection operator `W` (vertex × vertex), so each Neumann-series bounce
+//! `T_b = diag(ρ) W T_{b-1}` reuses every hit without tracing again.
+
+mod bounce;
+mod transfer;
+mod visibility;
+
+pub use bounce::InterreflectionOperator;
+pub use transfer::TransferVectors;
+
+use crate::bvh::SceneBvh;
+use crate::scene::SceneMesh;
+use crate::sh;
+use indicatif::ProgressBar;
+use std::time::Instant;
+
+/// Settings of a bake; a scene file's `[bake]` table gives the defaults.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BakeSettings {
+    /// SH order (bands `0..order`).
+    pub order: usize,
+    /// Hemisphere samples (rays) per vertex.
+    pub samples: u32,
+    /// Indirect bounces of the Neumann series (0 = shadowed direct lighting only).
+    pub bounces: u32,
+    /// Seed of the per-vertex sample rotations.
+    pub seed: u64,
+}
+
+impl Default for BakeSettings {
+    fn default() -> Self {
+        Self {
+            order: 5,
+            samples: 1024,
+            bounces: 3,
+            seed: 0,
+        }
+    }
+}
+
+/// Most rays per vertex a bake accepts.
+pub const MAX_SAMPLES: u32 = 1 << 20;
+/// Most bounces a bake accepts.
+pub const MAX_BOUNCES: u32 = 256;
+
+impl BakeSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        sh::check_order(self.order).map_err(|e| e.to_string())?;
+        if self.samples == 0 || self.samples > MAX_SAMPLES {
+            return Err(format!(
+                "samples must be between 1 and {MAX_SAMPLES}, got {}",
+                self.samples
+            ));
+        }
+        if self.bounces > MAX_BOUNCES {
+            return Err(format!(
+                "bounces must be at most {MAX_BOUNCES}, got {}",
+                self.bounces
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Direct and interreflected transfer of every vertex.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Transfer {
+    pub settings: BakeSettings,
+    pub direct: TransferVectors,
+    pub indirect: TransferVectors,
+}
+
+impl Transfer {
+    /// Direct plus indirect.
+    pub fn full(&self) -> TransferVectors {
+        self.direct.sum(&self.indirect)
+    }
+}
+
+/// Timings and counts of one bake.
+#[derive(Debug, Clone, Default)]
+pub struct BakeStats {
+    pub vertices: usize,
+    pub rays: u64,
+    pub direct_seconds: f64,
+    /// Time of each bounce.
+    pub bounce_seconds: Vec<f64>,
+    pub total_seconds: f64,
+    /// Non-zero entries of the interreflection operator.
+    pub operator_entries: usize,
+}
+
+impl BakeStats {
+    /// Rays traced per second of the direct pass (the only pass that traces).
+    pub fn rays_per_second(&self) -> f64 {
+        self.rays as f64 / self.direct_seconds.max(1e-9)
+    }
+}
+
+/// Where the ray-epsilon scale of a scene comes from: a fraction of its bounding-box diagonal.
+pub const RAY_OFFSET_FRACTION: f32 = 1e-5;
+
+/// Bakes the transfer of every vertex of `geometry`. `progress` counts vertices of the
+/// tracing pass (pass `ProgressBar::hidden()` for none).
+pub fn bake(
+    geometry: &SceneMesh,
+    bvh: &SceneBvh,
+    settings: &BakeSettings,
+    progress: &ProgressBar,
+) -> Result<(Transfer, BakeStats), String> {
+    settings.validate()?;
+    let start = Instant::now();
+    let vertex_count = geometry.mesh.vertex_count();
+    progress.set_length(vertex_count as u64);
+
+    let traced = visibility::trace_vertices(geometry, bvh, settings, progress);
+    let direct_seconds = start.elapsed().as_secs_f64();
+
+    let mut stats = BakeStats {
+        vertices: vertex_count,
+        rays: vertex_count as u64 * settings.samples as u64,
+        direct_seconds,
+        operator_entries: traced.operator.entries(),
+        ..Default::default()
+    };
+    let direct = traced.direct_transfer(&geometry.albedo, settings.order);
+    let mut indirect = TransferVectors::zeros(settings.order, vertex_count);
+    let mut previous = direct.clone();
+    for bounce in 0..settings.bounces {
+        progress.set_message(format!("bounce {}/{}", bounce + 1, settings.bounces));
+        let bounce_start = Instant::now();
+        let next = traced.operator.apply(&previous, &geometry.albedo);
+        for (acc, x) in indirect.as_mut_slice().iter_mut().zip(next.as_slice()) {
+            *acc += x;
+        }
+        previous = next;
+        stats.bounce_seconds.push(bounce_start.elapsed().as_secs_f64());
+    }
+    stats.total_seconds = start.elapsed().as_secs_f64();
+    progress.finish_and_clear();
+    Ok((
+        Transfer {
+            settings: *settings,
+            direct,
+            indirect,
+        },
+        stats,
+    ))
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,167 @@
+//! Furnace tests and properties of the bake.
+
+use super::*;
+use crate::color::Rgb;
+use crate::mesh::{TriangleMesh, box_mesh, sphere_mesh};
+use crate::sh::ShCoeffs;
+use glam::Vec3;
+
+/// SH coefficients of a uniform environment of radiance `value`.
+pub(crate) fn uniform_light(order: usize, value: Rgb) -> ShCoeffs<Rgb> {
+    let mut l = ShCoeffs::zeros(order);
+    l.as_mut_slice()[0] = value * (4.0 * std::f32::consts::PI).sqrt();
+    l
+}
+
+fn scene_of(mesh: &TriangleMesh, albedo: Rgb) -> SceneMesh {
+    let mut s = SceneMesh::default();
+    s.push_object("test".into(), mesh, albedo);
+    s
+}
+
+fn run(geometry: &SceneMesh, settings: BakeSettings) -> (Transfer, BakeStats) {
+    let bvh = SceneBvh::build(&geometry.mesh);
+    bake(geometry, &bvh, &settings, &ProgressBar::hidden()).unwrap()
+}
+
+/// An open box (five inward-facing walls, no lid): a concave mesh where every vertex is
+/// partly occluded.
+fn open_box() -> TriangleMesh {
+    let outer = box_mesh(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 1.0, 1.0), [8, 4, 8]);
+    let mut mesh = TriangleMesh::default();
+    for t in 0..outer.triangle_count() {
+        let [a, b, c] = outer.corners(t);
+        // Drop the top face, flip the others to face inwards.
+        if a.y == 1.0 && b.y == 1.0 && c.y == 1.0 {
+            continue;
+        }
+        let base = mesh.positions.len() as u32;
+        let n = -outer.normals[outer.triangles[t][0] as usize];
+        mesh.positions.extend([a, c, b]);
+        mesh.normals.extend([n; 3]);
+        mesh.triangles.push([base, base + 1, base + 2]);
+    }
+    mesh
+}
+
+#[test]
+fn furnace_unoccluded_vertices_reflect_their_albedo() {
+    let albedo = Rgb::new(0.8, 0.5, 0.2);
+    let geometry = scene_of(&sphere_mesh(Vec3::ZERO, 1.0, 2), albedo);
+    let settings = BakeSettings {
+        order: 3,
+        samples: 64,
+        bounces: 2,
+        seed: 1,
+    };
+    let (transfer, _) = run(&geometry, settings);
+    let light = uniform_light(3, Rgb::ONE);
+    for v in 0..geometry.mesh.vertex_count() {
+        let l = transfer.full().radiance(v, &light);
+        assert!((l - albedo).abs().max_element() < 0.01 * albedo.max_element(), "vertex {v}: {l}");
+        // A convex mesh has no interreflection.
+        assert_eq!(transfer.indirect.radiance(v, &light), Rgb::ZERO);
+    }
+}
+
+fn white_furnace_deficits(geometry: &SceneMesh, bounce_counts: &[u32], samples: u32) -> Vec<Vec<f32>> {
+    let light = uniform_light(1, Rgb::ONE);
+    bounce_counts
+        .iter()
+        .map(|&bounces| {
+            let (transfer, _) = run(
+                geometry,
+                BakeSettings {
+                    order: 1,
+                    samples,
+                    bounces,
+                    seed: 3,
+                },
+            );
+            let full = transfer.full();
+            (0..geometry.mesh.vertex_count())
+                .map(|v| 1.0 - full.radiance(v, &light).x)
+                .collect()
+        })
+        .collect()
+}
+
+fn mean(v: &[f32]) -> f32 {
+    v.iter().sum::<f32>() / v.len() as f32
+}
+
+#[test]
+fn white_furnace_open_box_converges_to_one() {
+    let geometry = scene_of(&open_box(), Rgb::ONE);
+    let counts = [0, 1, 2, 4, 8, 16];
+    let deficits = white_furnace_deficits(&geometry, &counts, 256);
+    let means: Vec<f32> = deficits.iter().map(|d| mean(d)).collect();
+    for w in means.windows(2) {
+        assert!(w[1] < w[0], "deficit must shrink with every bounce: {means:?}");
+    }
+    // Every vertex's deficit shrinks too (no bounce subtracts light).
+    for pair in deficits.windows(2) {
+        for (a, b) in pair[0].iter().zip(&pair[1]) {
+            assert!(b <= &(a + 1e-5));
+        }
+    }
+    // Occluded vertices really were dark without interreflection.
+    assert!(means[0] > 0.3, "{means:?}");
+    assert!(*means.last().unwrap() < 0.02, "{means:?}");
+}
+
+#[test]
+fn same_result_whatever_the_thread_count() {
+    let geometry = scene_of(&open_box(), Rgb::splat(0.7));
+    let settings = BakeSettings {
+        order: 4,
+        samples: 128,
+        bounces: 2,
+        seed: 9,
+    };
+    let in_pool = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| run(&geometry, settings).0)
+    };
+    assert_eq!(in_pool(1), in_pool(3));
+}
+
+#[test]
+fn occlusion_only_and_hit_recording_paths_agree() {
+    // bounces = 0 traces occlusion rays only; its direct transfer must equal the direct part
+    // of a bake that records hits.
+    let geometry = scene_of(&open_box(), Rgb::splat(0.6));
+    let settings = BakeSettings {
+        order: 3,
+        samples: 64,
+        bounces: 0,
+        seed: 5,
+    };
+    let (a, _) = run(&geometry, settings);
+    let (b, _) = run(&geometry, BakeSettings { bounces: 1, ..settings });
+    for (x, y) in a.direct.as_slice().iter().zip(b.direct.as_slice()) {
+        assert!((x - y).abs() < 1e-6);
+    }
+    assert!(a.indirect.as_slice().iter().all(|x| *x == 0.0));
+}
+
+#[test]
+fn rejects_bad_settings() {
+    let geometry = scene_of(&sphere_mesh(Vec3::ZERO, 1.0, 0), Rgb::ONE);
+    let bvh = SceneBvh::build(&geometry.mesh);
+    for settings in [
+        BakeSettings {
+            samples: 0,
+            ..Default::default()
+        },
+        BakeSettings {
+            order: crate::sh::MAX_ORDER + 1,
+            ..Default::default()
+        },
+    ] {
+        assert!(bake(&geometry, &bvh, &settings, &ProgressBar::hidden()).is_err());
+    }
+}

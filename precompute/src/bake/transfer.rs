@@ -1,0 +1,124 @@
+//! Per-vertex transfer vectors: what a bake produces.
+
+use crate::color::Rgb;
+use crate::sh::{ShCoeffs, num_coeffs};
+
+/// For each vertex and colour channel, `order²` SH coefficients `t_c` such that the vertex's
+/// outgoing radiance under lighting `l_c` is `dot(t_c, l_c)`. Albedo and cosine are inside.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransferVectors {
+    order: usize,
+    vertex_count: usize,
+    /// `data[(vertex * 3 + channel) * order² + k]`.
+    data: Vec<f32>,
+}
+
+impl TransferVectors {
+    pub fn zeros(order: usize, vertex_count: usize) -> Self {
+        Self {
+            order,
+            vertex_count,
+            data: vec![0.0; vertex_count * 3 * num_coeffs(order)],
+        }
+    }
+
+    /// Wraps raw data laid out as `[vertex][channel][coefficient]`.
+    pub fn from_raw(order: usize, vertex_count: usize, data: Vec<f32>) -> Option<Self> {
+        (data.len() == vertex_count * 3 * num_coeffs(order)).then_some(Self {
+            order,
+            vertex_count,
+            data,
+        })
+    }
+
+    pub fn order(&self) -> usize {
+        self.order
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.vertex_count
+    }
+
+    /// Floats per vertex (`3 · order²`).
+    pub fn stride(&self) -> usize {
+        3 * num_coeffs(self.order)
+    }
+
+    pub fn as_slice(&self) -> &[f32] {
+        &self.data
+    }
+
+    pub fn as_mut_slice(&mut self) -> &mut [f32] {
+        &mut self.data
+    }
+
+    /// The transfer vector of `vertex` for `channel` (0 = R, 1 = G, 2 = B).
+    pub fn vector(&self, vertex: usize, channel: usize) -> &[f32] {
+        let n = num_coeffs(self.order);
+        let start = (vertex * 3 + channel) * n;
+        &self.data[start..start + n]
+    }
+
+    /// Outgoing radiance of `vertex` under `light` (`dot(t_c, l_c)` per channel). Bands the
+    /// two do not share contribute nothing.
+    pub fn radiance(&self, vertex: usize, light: &ShCoeffs<Rgb>) -> Rgb {
+        let n = num_coeffs(self.order.min(light.order()));
+        let l = &light.as_slice()[..n];
+        let mut out = [0.0f32; 3];
+        for (c, value) in out.iter_mut().enumerate() {
+            let t = &self.vector(vertex, c)[..n];
+            *value = t.iter().zip(l).map(|(t, l)| t * l[c]).sum();
+        }
+        Rgb::from(out)
+    }
+
+    /// Element-wise sum (direct + indirect = full transfer).
+    pub fn sum(&self, other: &TransferVectors) -> TransferVectors {
+        assert_eq!((self.order, self.vertex_count), (other.order, other.vertex_count));
+        TransferVectors {
+            order: self.order,
+            vertex_count: self.vertex_count,
+            data: self.data.iter().zip(&other.data).map(|(a, b)| a + b).collect(),
+        }
+    }
+
+    /// The same transfer truncated to `order` bands (fewer coefficients per vertex).
+    pub fn truncated(&self, order: usize) -> TransferVectors {
+        let order = order.min(self.order);
+        let (n_old, n_new) = (num_coeffs(self.order), num_coeffs(order));
+        let mut data = Vec::with_capacity(self.vertex_count * 3 * n_new);
+        for chunk in self.data.chunks_exact(n_old) {
+            data.extend_from_slice(&chunk[..n_new]);
+        }
+        TransferVectors {
+            order,
+            vertex_count: self.vertex_count,
+            data,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn radiance_is_a_per_channel_dot_product() {
+        let order = 2;
+        let data: Vec<f32> = (0..2 * 3 * 4).map(|i| i as f32).collect();
+        let t = TransferVectors::from_raw(order, 2, data).unwrap();
+        let light = ShCoeffs::from_vec(vec![
+            Rgb::new(1.0, 0.0, 0.0),
+            Rgb::new(0.0, 1.0, 0.0),
+            Rgb::new(0.0, 0.0, 1.0),
+            Rgb::ZERO,
+        ])
+        .unwrap();
+        // Vertex 1: R vector = 12..16, G = 16..20, B = 20..24.
+        assert_eq!(t.radiance(1, &light), Rgb::new(12.0, 17.0, 22.0));
+        let cut = t.truncated(1);
+        assert_eq!(cut.vector(1, 2), &[20.0]);
+        assert_eq!(t.sum(&t).vector(0, 0), &[0.0, 2.0, 4.0, 6.0]);
+        assert!(TransferVectors::from_raw(2, 3, vec![0.0; 5]).is_none());
+    }
+}

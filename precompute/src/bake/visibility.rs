@@ -1,0 +1,202 @@
+//! The tracing pass of the bake: every (vertex, sample) ray is cast exactly once.
+
+use super::{BakeSettings, InterreflectionOperator, RAY_OFFSET_FRACTION, TransferVectors};
+use crate::bvh::SceneBvh;
+use crate::color::Rgb;
+use crate::sampling::{Frame, cosine_hemisphere, cranley_patterson, hammersley, hash_to_unit2, mix64};
+use crate::scene::SceneMesh;
+use crate::sh::{ShBasis, num_coeffs};
+use glam::{Vec2, Vec3};
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+
+/// What the tracing pass found.
+pub(super) struct TracedVertices {
+    order: usize,
+    /// Per vertex, `(1/N) Σ_{escaping rays} Y_k(ω)`: the scalar direct transfer before albedo.
+    visibility: Vec<f32>,
+    /// Where the other rays landed, as interpolation weights over vertices.
+    pub operator: InterreflectionOperator,
+}
+
+impl TracedVertices {
+    /// `T_direct,c(v) = ρ_c(v) · visibility(v)`.
+    pub fn direct_transfer(&self, albedo: &[Rgb], order: usize) -> TransferVectors {
+        debug_assert_eq!(order, self.order);
+        let n = num_coeffs(order);
+        let mut out = TransferVectors::zeros(order, albedo.len());
+        let stride = out.stride();
+        out.as_mut_slice()
+            .par_chunks_mut(stride)
+            .zip(self.visibility.par_chunks(n))
+            .zip(albedo.par_iter())
+            .for_each(|((dst, vis), rho)| {
+                for c in 0..3 {
+                    for (d, y) in dst[c * n..(c + 1) * n].iter_mut().zip(vis) {
+                        *d = rho[c] * y;
+                    }
+                }
+            });
+        out
+    }
+}
+
+/// The base sample set: cosine-weighted Hammersley points, sorted along a Morton curve of the
+/// unit square so consecutive rays of a vertex are spatially coherent.
+fn base_samples(count: u32) -> Vec<Vec2> {
+    let mut points: Vec<Vec2> = (0..count).map(|i| hammersley(i, count)).collect();
+    let morton = |p: &Vec2| {
+        let spread = |x: f32| {
+            let mut v = ((x.clamp(0.0, 1.0) * 65535.0) as u64) & 0xffff;
+            v = (v | (v << 8)) & 0x00ff_00ff;
+            v = (v | (v << 4)) & 0x0f0f_0f0f;
+            v = (v | (v << 2)) & 0x3333_3333;
+            (v | (v << 1)) & 0x5555_5555
+        };
+        spread(p.x) | (spread(p.y) << 1)
+    };
+    points.sort_by_key(morton);
+    points
+}
+
+/// Per-thread buffers reused across vertices.
+struct Scratch {
+    basis: Vec<f32>,
+    hits: Vec<(u32, f32)>,
+}
+
+/// Results for a contiguous run of vertices, in vertex order.
+struct Chunk {
+    visibility: Vec<f32>,
+    row_lengths: Vec<usize>,
+    columns: Vec<u32>,
+    weights: Vec<f32>,
+}
+
+const CHUNK: usize = 32;
+
+pub(super) fn trace_vertices(
+    geometry: &SceneMesh,
+    bvh: &SceneBvh,
+    settings: &BakeSettings,
+    progress: &ProgressBar,
+) -> TracedVertices {
+    let mesh = &geometry.mesh;
+    let order = settings.order;
+    let n = num_coeffs(order);
+    let basis = ShBasis::<f32>::new(order).expect("validated settings");
+    let samples = base_samples(settings.samples);
+    let inv_samples = 1.0 / settings.samples as f32;
+    let offset = RAY_OFFSET_FRACTION * geometry.diagonal();
+    let front_normals: Vec<Vec3> = (0..mesh.triangle_count()).map(|t| mesh.front_normal(t)).collect();
+    let record_hits = settings.bounces > 0;
+    let vertex_count = mesh.vertex_count();
+
+    let chunks: Vec<Chunk> = (0..vertex_count.div_ceil(CHUNK))
+        .into_par_iter()
+        .map_init(
+            || Scratch {
+                basis: vec![0.0; n],
+                hits: Vec::with_capacity(3 * samples.len()),
+            },
+            |scratch, chunk_index| {
+                let vertices = chunk_index * CHUNK..((chunk_index + 1) * CHUNK).min(vertex_count);
+                let mut chunk = Chunk {
+                    visibility: vec![0.0; vertices.len() * n],
+                    row_lengths: Vec::with_capacity(vertices.len()),
+                    columns: Vec::new(),
+                    weights: Vec::new(),
+                };
+                for (local, v) in vertices.clone().enumerate() {
+                    let normal = mesh.normals[v];
+                    let frame = Frame::from_normal(normal);
+                    let origin = mesh.positions[v] + normal * offset;
+                    let rotation = hash_to_unit2(mix64(settings.seed ^ mix64(v as u64)));
+                    let visibility = &mut chunk.visibility[local * n..(local + 1) * n];
+                    scratch.hits.clear();
+                    for u in &samples {
+                        let direction = frame.to_world(cosine_hemisphere(cranley_patterson(*u, rotation)));
+                        let vertex = v as u32;
+                        if record_hits {
+                            match bvh.intersect_from_vertex(vertex, origin, direction, 0.0) {
+                                None => accumulate_basis(&basis, direction, &mut scratch.basis, visibility),
+                                Some(hit) => {
+                                    // Back faces reflect nothing: the ray is only blocked.
+                                    if direction.dot(front_normals[hit.triangle as usize]) < 0.0 {
+                                        let corners = mesh.triangles[hit.triangle as usize];
+                                        for (i, w) in corners.iter().zip(hit.barycentrics()) {
+                                            scratch.hits.push((*i, w * inv_samples));
+                                        }
+                                    }
+                                }
+                            }
+                        } else if !bvh.occluded_from_vertex(vertex, origin, direction, 0.0) {
+                            accumulate_basis(&basis, direction, &mut scratch.basis, visibility);
+                        }
+                    }
+                    for y in visibility.iter_mut() {
+                        *y *= inv_samples;
+                    }
+                    // Merge the hits into one sparse row of the interreflection operator.
+                    scratch.hits.sort_unstable_by_key(|(i, _)| *i);
+                    let row_start = chunk.columns.len();
+                    for &(i, w) in &scratch.hits {
+                        let last = chunk.columns.len().wrapping_sub(1);
+                        if chunk.columns.len() > row_start && chunk.columns[last] == i {
+                            chunk.weights[last] += w;
+                        } else {
+                            chunk.columns.push(i);
+                            chunk.weights.push(w);
+                        }
+                    }
+                    chunk.row_lengths.push(chunk.columns.len() - row_start);
+                }
+                progress.inc(vertices.len() as u64);
+                chunk
+            },
+        )
+        .collect();
+
+    let mut visibility = Vec::with_capacity(vertex_count * n);
+    let mut row_lengths = Vec::with_capacity(vertex_count);
+    let total: usize = chunks.iter().map(|c| c.columns.len()).sum();
+    let mut columns = Vec::with_capacity(total);
+    let mut weights = Vec::with_capacity(total);
+    for chunk in chunks {
+        visibility.extend_from_slice(&chunk.visibility);
+        row_lengths.extend_from_slice(&chunk.row_lengths);
+        columns.extend_from_slice(&chunk.columns);
+        weights.extend_from_slice(&chunk.weights);
+    }
+    TracedVertices {
+        order,
+        visibility,
+        operator: InterreflectionOperator::from_rows(&row_lengths, columns, weights),
+    }
+}
+
+#[inline]
+fn accumulate_basis(basis: &ShBasis<f32>, direction: Vec3, scratch: &mut [f32], sum: &mut [f32]) {
+    basis.eval(direction, scratch);
+    for (s, y) in sum.iter_mut().zip(scratch.iter()) {
+        *s += y;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base_samples_are_a_permutation_of_hammersley() {
+        let mut a: Vec<(f32, f32)> = base_samples(256).iter().map(|p| (p.x, p.y)).collect();
+        let mut b: Vec<(f32, f32)> = (0..256).map(|i| hammersley(i, 256)).map(|p| (p.x, p.y)).collect();
+        a.sort_by(|x, y| x.partial_cmp(y).unwrap());
+        b.sort_by(|x, y| x.partial_cmp(y).unwrap());
+        assert_eq!(a, b);
+        // Coherent: consecutive points are close on average.
+        let s = base_samples(1024);
+        let mean_step: f32 = s.windows(2).map(|w| w[0].distance(w[1])).sum::<f32>() / 1023.0;
+        assert!(mean_step < 0.1, "{mean_step}");
+    }
+}

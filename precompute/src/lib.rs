@@ -1,0 +1,17 @@
+//! The offline half of hprt: everything computed on the CPU before a frame is drawn.
+//!
+//! Data flows one way: a [`scene`] (meshes, camera, environment) is loaded, a [`bvh`] is built
+//! over it, the [`bake`] computes per-vertex spherical-harmonic transfer ([`sh`]) and stores it
+//! in a [`bakefile`]. The [`reference`] path tracer renders the same scene as ground truth.
+
+pub mod color;
+pub mod mesh;
+pub mod quadrature;
+pub mod sampling;
+pub mod sh;
+
+pub use color::{Rgb, luminance};
+pub mod bake;
+pub mod bvh;
+pub mod camera;
+pub mod scene;

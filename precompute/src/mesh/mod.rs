@@ -1,0 +1,201 @@
+//! Triangle meshes and their loaders (OBJ, PLY, Bézier patches), with the clean-up every
+//! mesh gets before it is baked: validation, removal of zero-area triangles, optional welding
+//! of coincident vertices and smooth vertex normals.
+
+mod bpt;
+mod cleanup;
+mod obj;
+mod ply;
+mod shapes;
+
+pub use bpt::{BezierPatch, read_bpt, tessellate_patches};
+pub use cleanup::{CleanupReport, MeshCleanup};
+pub use shapes::{box_mesh, icosahedron, sphere_mesh, subdivide};
+
+use glam::Vec3;
+use std::path::{Path, PathBuf};
+
+/// An indexed triangle mesh with one unit normal per vertex.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TriangleMesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriangleMesh {
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Corner positions of triangle `t`.
+    #[inline]
+    pub fn corners(&self, t: usize) -> [Vec3; 3] {
+        let [a, b, c] = self.triangles[t];
+        [
+            self.positions[a as usize],
+            self.positions[b as usize],
+            self.positions[c as usize],
+        ]
+    }
+
+    /// Unit geometric normal of triangle `t`, flipped to the side its vertex normals point to
+    /// (the "front" side; back faces reflect nothing but still occlude).
+    pub fn front_normal(&self, t: usize) -> Vec3 {
+        let [a, b, c] = self.corners(t);
+        let n = (b - a).cross(c - a).normalize_or_zero();
+        let shading: Vec3 = self.triangles[t].iter().map(|&i| self.normals[i as usize]).sum();
+        if n.dot(shading) < 0.0 { -n } else { n }
+    }
+
+    /// Axis-aligned bounds `(min, max)`; `None` for an empty mesh.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let first = *self.positions.first()?;
+        Some(
+            self.positions
+                .iter()
+                .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))),
+        )
+    }
+
+    /// Appends `other`, offsetting its indices.
+    pub fn append(&mut self, other: &TriangleMesh) {
+        let base = self.positions.len() as u32;
+        self.positions.extend_from_slice(&other.positions);
+        self.normals.extend_from_slice(&other.normals);
+        self.triangles
+            .extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
+    }
+}
+
+/// A mesh as read from a file: positions, triangles and, if the file has them, normals.
+#[derive(Debug, Clone, Default)]
+pub struct RawMesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Option<Vec<Vec3>>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Why a mesh could not be loaded. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: line {line}: {message}", path.display())]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error("{}: {message}", path.display())]
+    Invalid { path: PathBuf, message: String },
+    #[error("{}: the mesh has no triangles{detail}", path.display())]
+    Empty { path: PathBuf, detail: String },
+    #[error(
+        "{}: unsupported mesh format (expected .obj, .ply, .bpt, optionally gzipped as .gz)",
+        path.display()
+    )]
+    UnsupportedFormat { path: PathBuf },
+}
+
+/// Reads a file, transparently decompressing `.gz`.
+fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gz")) {
+        use std::io::Read;
+        let mut out = Vec::new();
+        flate2::read::MultiGzDecoder::new(&bytes[..])
+            .read_to_end(&mut out)
+            .map_err(|e| MeshError::Invalid {
+                path: path.to_owned(),
+                message: format!("corrupt or truncated gzip data: {e}"),
+            })?;
+        Ok(out)
+    } else {
+        Ok(bytes)
+    }
+}
+
+/// The mesh format, from the file name (ignoring a trailing `.gz`).
+fn format_of(path: &Path) -> Option<&'static str> {
+    let name = path.file_name()?.to_str()?.to_ascii_lowercase();
+    let name = name.strip_suffix(".gz").unwrap_or(&name);
+    ["obj", "ply", "bpt"]
+        .into_iter()
+        .find(|ext| name.ends_with(&format!(".{ext}")))
+}
+
+/// Options for loading a mesh file.
+#[derive(Debug, Clone, Copy)]
+pub struct LoadOptions {
+    /// Tessellation of each Bézier patch (`segments × segments` quads).
+    pub patch_segments: u32,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        Self { patch_segments: 16 }
+    }
+}
+
+/// Reads a mesh file (OBJ, PLY ASCII or binary, BPT; any of them gzipped) without clean-up.
+pub fn read_mesh(path: &Path, options: &LoadOptions) -> Result<RawMesh, MeshError> {
+    let format = format_of(path).ok_or_else(|| MeshError::UnsupportedFormat {
+        path: path.to_owned(),
+    })?;
+    let bytes = read_bytes(path)?;
+    match format {
+        "obj" => obj::parse_obj(path, &bytes),
+        "ply" => ply::parse_ply(path, &bytes),
+        _ => {
+            let patches = bpt::read_bpt(path, &bytes)?;
+            Ok(bpt::tessellate_patches(&patches, options.patch_segments))
+        }
+    }
+}
+
+/// Reads and cleans a mesh file: validation, zero-area triangles dropped (counted in the
+/// report), coincident vertices welded where the file has no normals, smooth normals.
+pub fn load_mesh(
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<(TriangleMesh, CleanupReport), MeshError> {
+    let raw = read_mesh(path, options)?;
+    MeshCleanup::default().run(path, raw)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn recognises_formats_by_name() {
+        assert_eq!(format_of(Path::new("a/b.PLY.gz")), Some("ply"));
+        assert_eq!(format_of(Path::new("teapot.bpt")), Some("bpt"));
+        assert_eq!(format_of(Path::new("x.obj")), Some("obj"));
+        assert_eq!(format_of(Path::new("x.stl")), None);
+    }
+
+    #[test]
+    fn append_offsets_indices() {
+        let tri = TriangleMesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            normals: vec![Vec3::Z; 3],
+            triangles: vec![[0, 1, 2]],
+        };
+        let mut m = tri.clone();
+        m.append(&tri);
+        assert_eq!(m.triangles, vec![[0, 1, 2], [3, 4, 5]]);
+        assert_eq!(m.bounds(), Some((Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0))));
+    }
+}

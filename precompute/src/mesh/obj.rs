@@ -1,0 +1,146 @@
+//! Wavefront OBJ through `tobj`, with the offending line located for error messages.
+
+use super::{MeshError, RawMesh};
+use glam::Vec3;
+use std::path::Path;
+
+pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let mut reader = std::io::BufReader::new(bytes);
+    // Materials are irrelevant: albedo comes from the scene file.
+    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| {
+        Ok((Vec::new(), Default::default()))
+    })
+    .map_err(|e| {
+        let text = String::from_utf8_lossy(bytes);
+        match first_bad_line(&text) {
+            Some((line, message)) => MeshError::Syntax {
+                path: path.to_owned(),
+                line,
+                message,
+            },
+            None => MeshError::Invalid {
+                path: path.to_owned(),
+                message: format!("malformed OBJ: {e}"),
+            },
+        }
+    })?;
+
+    let mut mesh = RawMesh::default();
+    let all_have_normals = models
+        .iter()
+        .all(|m| m.mesh.normals.len() == m.mesh.positions.len());
+    let mut normals = Vec::new();
+    for model in &models {
+        let m = &model.mesh;
+        let base = mesh.positions.len() as u32;
+        mesh.positions
+            .extend(m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        if all_have_normals {
+            normals.extend(m.normals.chunks_exact(3).map(|n| Vec3::new(n[0], n[1], n[2])));
+        }
+        mesh.triangles.extend(
+            m.indices
+                .chunks_exact(3)
+                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+        );
+    }
+    if all_have_normals && !mesh.positions.is_empty() {
+        mesh.normals = Some(normals);
+    }
+    Ok(mesh)
+}
+
+/// The first line that does not parse as OBJ geometry, with a description (tobj reports the
+/// kind of error but not where it is).
+fn first_bad_line(text: &str) -> Option<(usize, String)> {
+    let (mut positions, mut texcoords, mut normals) = (0i64, 0i64, 0i64);
+    for (number, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("");
+        let mut tokens = line.split_whitespace();
+        let Some(keyword) = tokens.next() else {
+            continue;
+        };
+        let args: Vec<&str> = tokens.collect();
+        let floats_ok = |min: usize| {
+            args.len() >= min && args.iter().all(|a| a.parse::<f32>().is_ok())
+        };
+        let problem = match keyword {
+            "v" => {
+                positions += 1;
+                (!floats_ok(3)).then(|| format!("vertex needs 3 numbers, got {:?}", args))
+            }
+            "vt" => {
+                texcoords += 1;
+                (!floats_ok(1)).then(|| format!("bad texture coordinate {:?}", args))
+            }
+            "vn" => {
+                normals += 1;
+                (!floats_ok(3)).then(|| format!("normal needs 3 numbers, got {:?}", args))
+            }
+            "f" => check_face(&args, [positions, texcoords, normals]),
+            _ => None,
+        };
+        if let Some(message) = problem {
+            return Some((number + 1, message));
+        }
+    }
+    None
+}
+
+/// A face needs three or more `v[/vt][/vn]` references, each within the elements so far.
+fn check_face(args: &[&str], counts: [i64; 3]) -> Option<String> {
+    if args.len() < 3 {
+        return Some(format!("face needs at least 3 vertices, got {}", args.len()));
+    }
+    for arg in args {
+        for (slot, part) in arg.split('/').enumerate().take(3) {
+            if part.is_empty() && slot > 0 {
+                continue;
+            }
+            let Ok(index) = part.parse::<i64>() else {
+                return Some(format!("face vertex {arg:?} is not an index"));
+            };
+            let count = counts[slot];
+            if index == 0 || index > count || index < -count {
+                return Some(format!(
+                    "face refers to element {index} of {count} defined so far ({arg:?})"
+                ));
+            }
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_quads_as_triangles_with_normals() {
+        let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n";
+        let mesh = parse_obj(Path::new("q.obj"), obj.as_bytes()).unwrap();
+        assert_eq!(mesh.triangles.len(), 2);
+        assert_eq!(mesh.normals.as_ref().map(|n| n.len()), Some(mesh.positions.len()));
+    }
+
+    #[test]
+    fn reports_the_line_of_a_malformed_vertex() {
+        let obj = "# test\nv 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n";
+        let err = parse_obj(Path::new("bad.obj"), obj.as_bytes()).unwrap_err();
+        let text = err.to_string();
+        assert!(text.contains("bad.obj") && text.contains("line 3"), "{text}");
+    }
+
+    #[test]
+    fn reports_out_of_range_face_indices() {
+        let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
+        let err = parse_obj(Path::new("idx.obj"), obj.as_bytes()).unwrap_err();
+        let text = err.to_string();
+        assert!(text.contains("line 4"), "{text}");
+    }
+}

@@ -1,0 +1,1 @@
+//! The per-frame half of hprt.
