@@ -1,1 +1,46 @@
-fn main() {}
+//! `hprt`: hybrid precomputed radiance transfer + shadow-mapped lights for static diffuse
+//! scenes under distant HDR environment lighting.
+
+mod commands;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "hprt", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Bake per-vertex SH transfer (shadowed direct + interreflected) for a scene.
+    Bake(commands::bake::BakeArgs),
+    /// Benchmarks anyone can rerun (bake throughput, ...).
+    #[command(subcommand)]
+    Bench(commands::bench::BenchCommand),
+}
+
+fn main() {
+    env_logger::Builder::new()
+        .parse_filters("warn,wgpu_core=error,wgpu_hal=error,naga=error")
+        .parse_env("HPRT_LOG")
+        .format(|buf, record| {
+            use std::io::Write;
+            let level = match record.level() {
+                log::Level::Warn => "warning".to_owned(),
+                level => level.as_str().to_lowercase(),
+            };
+            writeln!(buf, "{level}: {}", record.args())
+        })
+        .init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Bake(args) => commands::bake::run(args),
+        Command::Bench(cmd) => commands::bench::run(cmd),
+    };
+    if let Err(error) = result {
+        eprintln!("error: {error:#}");
+        std::process::exit(1);
+    }
+}

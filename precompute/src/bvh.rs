@@ -201,7 +201,13 @@ impl SceneBvh {
     }
 
     /// Whether anything blocks a ray leaving a vertex, ignoring the vertex's own triangles.
-    pub fn occluded_from_vertex(&self, vertex: u32, origin: Vec3, direction: Vec3, tmin: f32) -> bool {
+    pub fn occluded_from_vertex(
+        &self,
+        vertex: u32,
+        origin: Vec3,
+        direction: Vec3,
+        tmin: f32,
+    ) -> bool {
         let ray = Self::ray(origin, direction, tmin, f32::INFINITY);
         !self.bvh.ray_traverse_miss(ray, |r, slot| {
             if self.corners[slot].contains(&vertex) {
@@ -220,7 +226,7 @@ mod tests {
 
     #[test]
     fn finds_the_closest_box_face_with_barycentrics() {
-        let mesh = box_mesh(Vec3::splat(-1.0), Vec3::ONE, [3, 3, 3]);
+        let mesh = box_mesh(Vec3::splat(-1.0), Vec3::ONE, [3, 3, 3], [false; 6]);
         let bvh = SceneBvh::build(&mesh);
         let origin = Vec3::new(0.2, 0.3, 5.0);
         let hit = bvh.intersect(origin, -Vec3::Z, 0.0, f32::INFINITY).unwrap();
@@ -236,12 +242,20 @@ mod tests {
         assert!(bvh.intersect(origin, Vec3::Z, 0.0, f32::INFINITY).is_none());
         assert!(bvh.intersect(origin, -Vec3::Z, 0.0, 3.9).is_none());
         // Axis-aligned directions with negative zeros (regression: obvhs octant handling).
-        assert!(bvh.intersect(Vec3::new(0.0, 5.0, 0.0), Vec3::new(-0.0, -1.0, -0.0), 0.0, f32::INFINITY).is_some());
+        assert!(
+            bvh.intersect(
+                Vec3::new(0.0, 5.0, 0.0),
+                Vec3::new(-0.0, -1.0, -0.0),
+                0.0,
+                f32::INFINITY
+            )
+            .is_some()
+        );
     }
 
     #[test]
     fn vertex_rays_ignore_the_vertex_own_triangles() {
-        let mesh = box_mesh(Vec3::splat(-1.0), Vec3::ONE, [2, 2, 2]);
+        let mesh = box_mesh(Vec3::splat(-1.0), Vec3::ONE, [2, 2, 2], [false; 6]);
         let bvh = SceneBvh::build(&mesh);
         // From just below a top-face vertex, a ray upwards first crosses the vertex's own
         // triangles; rays from the vertex must not see them.

@@ -43,7 +43,10 @@ impl Camera {
     /// Checks the camera can form an image; the message says what is wrong.
     pub fn validate(&self) -> Result<(), String> {
         if self.width == 0 || self.height == 0 {
-            return Err(format!("image size {}x{} is empty", self.width, self.height));
+            return Err(format!(
+                "image size {}x{} is empty",
+                self.width, self.height
+            ));
         }
         if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 179.0) {
             return Err(format!("fov_y_deg {} is outside (0, 179)", self.fov_y_deg));

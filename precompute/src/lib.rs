@@ -12,6 +12,7 @@ pub mod sh;
 
 pub use color::{Rgb, luminance};
 pub mod bake;
+pub mod bakefile;
 pub mod bvh;
 pub mod camera;
 pub mod scene;

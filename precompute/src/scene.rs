@@ -4,7 +4,9 @@
 use crate::bake::BakeSettings;
 use crate::camera::Camera;
 use crate::color::Rgb;
-use crate::mesh::{self, LoadOptions, MeshCleanup, MeshError, TriangleMesh, box_mesh};
+use crate::mesh::{
+    self, LoadOptions, MeshCleanup, MeshError, TriangleMesh, annulus_mesh, box_mesh,
+};
 use glam::{Mat3, Mat4, Quat, Vec3};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -12,20 +14,20 @@ use std::path::{Path, PathBuf};
 /// Why a scene could not be loaded. Every variant names the scene file.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {cause}", path.display())]
     Io {
         path: PathBuf,
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     #[error("{}: {message}", path.display())]
     Parse { path: PathBuf, message: String },
     #[error("{}: {message}", path.display())]
     Invalid { path: PathBuf, message: String },
-    #[error("{}: object {object}: {source}", scene.display())]
+    #[error("{}: object \"{object}\": {cause}", scene.display())]
     Mesh {
         scene: PathBuf,
         object: String,
-        source: MeshError,
+        cause: MeshError,
     },
 }
 
@@ -68,6 +70,11 @@ pub struct ObjectSpec {
     pub transform: Transform,
     /// Quads per Bézier patch side (BPT meshes).
     pub patch_segments: Option<u32>,
+    /// Bézier patches to leave out (BPT meshes, 0-based).
+    #[serde(default)]
+    pub skip_patches: Vec<usize>,
+    /// A flat ring (or disc, with `inner_radius = 0`) in the object's XZ plane, facing +Y.
+    pub annulus: Option<AnnulusSpec>,
     /// Weld coincident vertices (default: when the file has no normals).
     pub weld: Option<bool>,
 }
@@ -80,10 +87,31 @@ pub struct BoxSpec {
     /// Quads along x, y and z.
     #[serde(default = "default_box_segments")]
     pub segments: [u32; 3],
+    /// Faces to leave out, named "+x", "-x", "+y", "-y", "+z", "-z" (faces that touch
+    /// something else and are never seen).
+    #[serde(default)]
+    pub skip_faces: Vec<String>,
 }
 
 fn default_box_segments() -> [u32; 3] {
     [1, 1, 1]
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnnulusSpec {
+    #[serde(default)]
+    pub center: [f32; 3],
+    #[serde(default)]
+    pub inner_radius: f32,
+    pub outer_radius: f32,
+    /// Quads across the ring and around it.
+    #[serde(default = "default_annulus_segments")]
+    pub segments: [u32; 2],
+}
+
+fn default_annulus_segments() -> [u32; 2] {
+    [1, 64]
 }
 
 /// Object-to-world placement: scale, then rotations about X, Y and Z (degrees), then translate.
@@ -126,7 +154,8 @@ impl Transform {
             Scale::PerAxis(s) => Vec3::from(s),
         };
         let [rx, ry, rz] = self.rotate_deg.map(f32::to_radians);
-        let rotation = Quat::from_rotation_z(rz) * Quat::from_rotation_y(ry) * Quat::from_rotation_x(rx);
+        let rotation =
+            Quat::from_rotation_z(rz) * Quat::from_rotation_y(ry) * Quat::from_rotation_x(rx);
         Mat4::from_scale_rotation_translation(scale, rotation, Vec3::from(self.translate))
     }
 }
@@ -155,7 +184,13 @@ impl SceneMesh {
         hasher.update(b"hprt scene mesh v1");
         hasher.update(&(self.mesh.positions.len() as u64).to_le_bytes());
         hasher.update(&(self.mesh.triangles.len() as u64).to_le_bytes());
-        for v in self.mesh.positions.iter().chain(&self.mesh.normals).chain(&self.albedo) {
+        for v in self
+            .mesh
+            .positions
+            .iter()
+            .chain(&self.mesh.normals)
+            .chain(&self.albedo)
+        {
             for c in v.to_array() {
                 hasher.update(&c.to_le_bytes());
             }
@@ -208,9 +243,9 @@ pub struct Scene {
 impl Scene {
     /// Loads a scene file and every mesh it names.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        let text = std::fs::read_to_string(path).map_err(|cause| SceneError::Io {
             path: path.to_owned(),
-            source,
+            cause,
         })?;
         let file: SceneFile = toml::from_str(&text).map_err(|e| SceneError::Parse {
             path: path.to_owned(),
@@ -229,7 +264,9 @@ impl Scene {
         file.camera
             .validate()
             .map_err(|m| invalid(format!("camera: {m}")))?;
-        file.bake.validate().map_err(|m| invalid(format!("bake: {m}")))?;
+        file.bake
+            .validate()
+            .map_err(|m| invalid(format!("bake: {m}")))?;
         if file.objects.is_empty() {
             return Err(invalid("the scene has no [[object]]".into()));
         }
@@ -238,7 +275,7 @@ impl Scene {
             let name = object
                 .name
                 .clone()
-                .unwrap_or_else(|| format!("object {index}"));
+                .unwrap_or_else(|| format!("#{}", index + 1));
             let albedo = Rgb::from(object.albedo);
             if !object.albedo.iter().all(|a| (0.0..1.0).contains(a)) {
                 return Err(invalid(format!(
@@ -247,10 +284,10 @@ impl Scene {
                 )));
             }
             let local = load_object_mesh(dir, object).map_err(|e| match e {
-                ObjectError::Mesh(source) => SceneError::Mesh {
+                ObjectError::Mesh(cause) => SceneError::Mesh {
                     scene: path.to_owned(),
                     object: name.clone(),
-                    source,
+                    cause,
                 },
                 ObjectError::Spec(m) => invalid(format!("{name}: {m}")),
             })?;
@@ -277,16 +314,20 @@ impl Scene {
     }
 }
 
+/// Face names of `skip_faces`, in the order of `box_mesh`'s `skip` flags.
+const BOX_FACES: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
+
 enum ObjectError {
     Mesh(MeshError),
     Spec(String),
 }
 
 fn load_object_mesh(dir: &Path, object: &ObjectSpec) -> Result<TriangleMesh, ObjectError> {
-    match (&object.mesh, &object.box_shape) {
-        (Some(file), None) => {
+    match (&object.mesh, &object.box_shape, &object.annulus) {
+        (Some(file), None, None) => {
             let options = LoadOptions {
-                patch_segments: object.patch_segments.unwrap_or(LoadOptions::default().patch_segments),
+                patch_segments: object.patch_segments,
+                skip_patches: object.skip_patches.clone(),
             };
             let path = dir.join(file);
             let raw = mesh::read_mesh(&path, &options).map_err(ObjectError::Mesh)?;
@@ -297,26 +338,60 @@ fn load_object_mesh(dir: &Path, object: &ObjectSpec) -> Result<TriangleMesh, Obj
             let (mesh, _report) = cleanup.run(&path, raw).map_err(ObjectError::Mesh)?;
             Ok(mesh)
         }
-        (None, Some(b)) => {
-            let (min, max) = (Vec3::from(b.min), Vec3::from(b.max));
-            if !(min.is_finite() && max.is_finite() && min.cmplt(max).all()) {
-                return Err(ObjectError::Spec(format!(
-                    "box min {:?} must be below max {:?} on every axis",
-                    b.min, b.max
-                )));
-            }
-            if b.segments.iter().any(|&s| s == 0 || s > 4096) {
-                return Err(ObjectError::Spec(format!(
-                    "box segments {:?} must be between 1 and 4096",
-                    b.segments
-                )));
-            }
-            Ok(box_mesh(min, max, b.segments))
-        }
+        (None, Some(b), None) => box_object(b),
+        (None, None, Some(a)) => annulus_object(a),
         _ => Err(ObjectError::Spec(
-            "give exactly one of `mesh = \"file\"` or `box = { min, max }`".into(),
+            "give exactly one of `mesh = \"file\"`, `box = { min, max }` or `annulus = { outer_radius }`"
+                .into(),
         )),
     }
+}
+
+fn box_object(b: &BoxSpec) -> Result<TriangleMesh, ObjectError> {
+    let (min, max) = (Vec3::from(b.min), Vec3::from(b.max));
+    if !(min.is_finite() && max.is_finite() && min.cmplt(max).all()) {
+        return Err(ObjectError::Spec(format!(
+            "box min {:?} must be below max {:?} on every axis",
+            b.min, b.max
+        )));
+    }
+    if b.segments.iter().any(|&s| s == 0 || s > 4096) {
+        return Err(ObjectError::Spec(format!(
+            "box segments {:?} must be between 1 and 4096",
+            b.segments
+        )));
+    }
+    let mut skip = [false; 6];
+    for face in &b.skip_faces {
+        let index = BOX_FACES.iter().position(|f| f == face).ok_or_else(|| {
+            ObjectError::Spec(format!(
+                "unknown box face {face:?} in skip_faces (use {BOX_FACES:?})"
+            ))
+        })?;
+        skip[index] = true;
+    }
+    Ok(box_mesh(min, max, b.segments, skip))
+}
+
+fn annulus_object(a: &AnnulusSpec) -> Result<TriangleMesh, ObjectError> {
+    if !(a.inner_radius >= 0.0 && a.outer_radius > a.inner_radius && a.outer_radius.is_finite()) {
+        return Err(ObjectError::Spec(format!(
+            "annulus radii {} .. {} must satisfy 0 <= inner < outer",
+            a.inner_radius, a.outer_radius
+        )));
+    }
+    if a.segments[0] == 0 || a.segments[1] < 3 || a.segments.iter().any(|&s| s > 4096) {
+        return Err(ObjectError::Spec(format!(
+            "annulus segments {:?} must be at least [1, 3] and at most 4096",
+            a.segments
+        )));
+    }
+    Ok(annulus_mesh(
+        Vec3::from(a.center),
+        a.inner_radius,
+        a.outer_radius,
+        a.segments,
+    ))
 }
 
 /// Applies an affine transform to positions and (inverse-transpose) normals. `None` if the
@@ -336,7 +411,11 @@ pub fn transform_mesh(mesh: &TriangleMesh, m: &Mat4) -> Option<TriangleMesh> {
         }
     }
     Some(TriangleMesh {
-        positions: mesh.positions.iter().map(|p| m.transform_point3(*p)).collect(),
+        positions: mesh
+            .positions
+            .iter()
+            .map(|p| m.transform_point3(*p))
+            .collect(),
         normals: mesh
             .normals
             .iter()
@@ -371,45 +450,68 @@ mod tests {
         assert!((lo - Vec3::new(-1.0, 2.0, -2.0)).length() < 1e-5, "{lo}");
         assert!((hi - Vec3::new(1.0, 4.0, 2.0)).length() < 1e-5, "{hi}");
         assert_eq!(scene.geometry.objects[0].name, "slab");
-        assert!(scene.geometry.albedo.iter().all(|a| *a == Rgb::new(0.5, 0.4, 0.3)));
+        assert!(
+            scene
+                .geometry
+                .albedo
+                .iter()
+                .all(|a| *a == Rgb::new(0.5, 0.4, 0.3))
+        );
         assert_eq!(scene.bake, BakeSettings::default());
     }
 
     #[test]
     fn errors_name_the_file_and_the_problem() {
         let dir = tempfile::tempdir().unwrap();
-        let bad_albedo = format!("{CAMERA}[[object]]\nbox = {{ min = [0,0,0], max = [1,1,1] }}\nalbedo = [1.2, 0, 0]\n");
-        let err = Scene::load(&write_scene(dir.path(), &bad_albedo)).unwrap_err().to_string();
+        let bad_albedo = format!(
+            "{CAMERA}[[object]]\nbox = {{ min = [0,0,0], max = [1,1,1] }}\nalbedo = [1.2, 0, 0]\n"
+        );
+        let err = Scene::load(&write_scene(dir.path(), &bad_albedo))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("s.toml") && err.contains("albedo"), "{err}");
 
-        let missing_mesh = format!("{CAMERA}[[object]]\nmesh = \"nope.ply\"\nalbedo = [0.5, 0.5, 0.5]\n");
-        let err = Scene::load(&write_scene(dir.path(), &missing_mesh)).unwrap_err().to_string();
+        let missing_mesh =
+            format!("{CAMERA}[[object]]\nmesh = \"nope.ply\"\nalbedo = [0.5, 0.5, 0.5]\n");
+        let err = Scene::load(&write_scene(dir.path(), &missing_mesh))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("nope.ply"), "{err}");
 
-        let typo = format!("{CAMERA}[[object]]\nbox = {{ min = [0,0,0], max = [1,1,1] }}\nalbedo = [0.5, 0.5, 0.5]\ncolour = 1\n");
-        let err = Scene::load(&write_scene(dir.path(), &typo)).unwrap_err().to_string();
+        let typo = format!(
+            "{CAMERA}[[object]]\nbox = {{ min = [0,0,0], max = [1,1,1] }}\nalbedo = [0.5, 0.5, 0.5]\ncolour = 1\n"
+        );
+        let err = Scene::load(&write_scene(dir.path(), &typo))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("colour") && err.contains("line"), "{err}");
 
-        let err = Scene::load(&dir.path().join("absent.toml")).unwrap_err().to_string();
+        let err = Scene::load(&dir.path().join("absent.toml"))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("absent.toml"), "{err}");
     }
 
     #[test]
     fn mirroring_transforms_keep_triangles_outward() {
-        let cube = box_mesh(Vec3::splat(-1.0), Vec3::ONE, [1, 1, 1]);
+        let cube = box_mesh(Vec3::splat(-1.0), Vec3::ONE, [1, 1, 1], [false; 6]);
         let mirrored = transform_mesh(&cube, &Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0))).unwrap();
         for t in 0..mirrored.triangle_count() {
             let [a, b, c] = mirrored.corners(t);
             let n = (b - a).cross(c - a);
             assert!(n.dot(a + b + c) > 0.0);
-            assert!(n.normalize().dot(mirrored.normals[mirrored.triangles[t][0] as usize]) > 0.99);
+            assert!(
+                n.normalize()
+                    .dot(mirrored.normals[mirrored.triangles[t][0] as usize])
+                    > 0.99
+            );
         }
         assert!(transform_mesh(&cube, &Mat4::from_scale(Vec3::new(0.0, 1.0, 1.0))).is_none());
     }
 
     #[test]
     fn content_hash_changes_with_albedo() {
-        let cube = box_mesh(Vec3::splat(-1.0), Vec3::ONE, [1, 1, 1]);
+        let cube = box_mesh(Vec3::splat(-1.0), Vec3::ONE, [1, 1, 1], [false; 6]);
         let mut a = SceneMesh::default();
         a.push_object("a".into(), &cube, Rgb::splat(0.5));
         let mut b = SceneMesh::default();

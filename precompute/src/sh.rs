@@ -1,6 +1,6 @@
 //! Real orthonormal spherical harmonics: the one implementation every part of hprt uses.
 //!
-//! Conventions (see `docs/conventions.md`):
+//! Conventions (see `CONVENTIONS.md`):
 //! * index `k = l(l+1) + m`; "order n" means bands `l = 0..n-1`, i.e. `n²` coefficients;
 //! * the polar axis is world **+Y** and the azimuth runs from +Z toward +X, i.e. the textbook
 //!   z-up formulas are evaluated at `(x, y, z) = (w.z, w.x, w.y)`. Band 1 is then simply
@@ -69,13 +69,16 @@ impl<F: Float> ShBasis<F> {
                 }
             })
             .collect();
-        let first_off_diagonal = (0..order).map(|m| cast(((2 * m + 3) as f64).sqrt())).collect();
+        let first_off_diagonal = (0..order)
+            .map(|m| cast(((2 * m + 3) as f64).sqrt()))
+            .collect();
         let mut three_term = vec![(F::zero(), F::zero()); num_coeffs(order)];
         for l in 2..order {
             for m in 0..l - 1 {
                 let (lf, mf) = (l as f64, m as f64);
                 let a = ((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf)).sqrt();
-                let b = (((lf - 1.0) * (lf - 1.0) - mf * mf) / (4.0 * (lf - 1.0) * (lf - 1.0) - 1.0))
+                let b = (((lf - 1.0) * (lf - 1.0) - mf * mf)
+                    / (4.0 * (lf - 1.0) * (lf - 1.0) - 1.0))
                     .sqrt();
                 three_term[index(l, m as isize)] = (cast(a), cast(b));
             }
@@ -370,7 +373,12 @@ mod tests {
     fn f32_evaluation_matches_f64() {
         let b32 = ShBasis::<f32>::new(MAX_ORDER).unwrap();
         let b64 = ShBasis::<f64>::new(MAX_ORDER).unwrap();
-        for w in [DVec3::new(0.1, 0.99, 0.05), DVec3::new(-0.7, -0.2, 0.6), DVec3::Y, -DVec3::Y] {
+        for w in [
+            DVec3::new(0.1, 0.99, 0.05),
+            DVec3::new(-0.7, -0.2, 0.6),
+            DVec3::Y,
+            -DVec3::Y,
+        ] {
             let w = w.normalize();
             let y64 = eval64(&b64, w);
             let y32 = b32.eval_vec(w.as_vec3());
@@ -398,7 +406,9 @@ mod tests {
         let mut state = seed;
         let coeffs = (0..num_coeffs(order))
             .map(|_| {
-                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
             })
             .collect();
@@ -411,12 +421,24 @@ mod tests {
         let c = random_coeffs(order, 7);
         let basis = ShBasis::<f64>::new(order).unwrap();
         let f = |w: DVec3| -> f64 {
-            eval64(&basis, w).iter().zip(c.as_slice()).map(|(y, c)| y * *c as f64).sum()
+            eval64(&basis, w)
+                .iter()
+                .zip(c.as_slice())
+                .map(|(y, c)| y * *c as f64)
+                .sum()
         };
         let rotation = glam::DQuat::from_euler(glam::EulerRot::ZXY, 0.4, 1.1, -2.3);
         let rotated = project(order, |w| f(rotation.inverse() * w));
-        for (l, (e0, e1)) in c.band_energies().iter().zip(rotated.band_energies()).enumerate() {
-            assert!((e0 - e1).abs() < 1e-4 * (1.0 + e0), "band {l}: {e0} vs {e1}");
+        for (l, (e0, e1)) in c
+            .band_energies()
+            .iter()
+            .zip(rotated.band_energies())
+            .enumerate()
+        {
+            assert!(
+                (e0 - e1).abs() < 1e-4 * (1.0 + e0),
+                "band {l}: {e0} vs {e1}"
+            );
         }
         // The rotation really mixed coefficients within bands.
         assert!((rotated.as_slice()[5] - c.as_slice()[5]).abs() > 1e-3);
@@ -429,7 +451,11 @@ mod tests {
         let basis = ShBasis::<f64>::new(order).unwrap();
         let angle = 0.7f64;
         let f = |w: DVec3| -> f64 {
-            eval64(&basis, w).iter().zip(c.as_slice()).map(|(y, c)| y * *c as f64).sum()
+            eval64(&basis, w)
+                .iter()
+                .zip(c.as_slice())
+                .map(|(y, c)| y * *c as f64)
+                .sum()
         };
         let r_inv = glam::DQuat::from_rotation_y(-angle);
         let expected = project(order, |w| f(r_inv * w));
@@ -456,7 +482,11 @@ mod tests {
         let a = clamped_cosine_bands(order);
         for l in 0..order {
             let expected = (4.0 * std::f64::consts::PI / (2 * l + 1) as f64).sqrt() * zonal[l];
-            assert!((a[l] as f64 - expected).abs() < 1e-4, "A_{l}: {} vs {expected}", a[l]);
+            assert!(
+                (a[l] as f64 - expected).abs() < 1e-4,
+                "A_{l}: {} vs {expected}",
+                a[l]
+            );
         }
     }
 

@@ -4,40 +4,85 @@ use super::TransferVectors;
 use crate::color::Rgb;
 use rayon::prelude::*;
 
-/// Sparse vertex-to-vertex operator `W` (compressed rows): `W[v][j]` is the fraction of vertex
-/// `v`'s cosine-distributed rays that land on the front of a triangle, weighted by the
-/// barycentric weight of `j` at the landing point. One bounce is `T' = diag(ρ) W T`.
+/// Sparse vertex-to-vertex operator `W`: `W[v][j]` is the fraction of vertex `v`'s
+/// cosine-distributed rays that land on the front of a triangle, weighted by the barycentric
+/// weight of `j` at the landing point. One bounce is `T' = diag(ρ) W T`.
+///
+/// Stored as consecutive blocks of compressed rows, exactly as the tracing pass produced
+/// them, so the (large) operator is never copied.
 #[derive(Debug, Clone, Default)]
 pub struct InterreflectionOperator {
-    row_starts: Vec<usize>,
-    columns: Vec<u32>,
-    weights: Vec<f32>,
+    blocks: Vec<OperatorBlock>,
+}
+
+/// Compressed rows of `rows` consecutive vertices.
+#[derive(Debug, Clone, Default)]
+pub struct OperatorBlock {
+    /// `row_starts[r]..row_starts[r + 1]` indexes `columns`/`weights` of the block's row `r`.
+    pub row_starts: Vec<u32>,
+    pub columns: Vec<u32>,
+    pub weights: Vec<f32>,
+}
+
+impl OperatorBlock {
+    pub fn new() -> Self {
+        Self {
+            row_starts: vec![0],
+            ..Default::default()
+        }
+    }
+
+    pub fn rows(&self) -> usize {
+        self.row_starts.len() - 1
+    }
+
+    /// Appends a row given as `(column, weight)` pairs sorted by column; equal columns merge.
+    pub fn push_sorted_row(&mut self, entries: &[(u32, f32)]) {
+        let row_start = self.columns.len();
+        for &(j, w) in entries {
+            let last = self.columns.len().wrapping_sub(1);
+            if self.columns.len() > row_start && self.columns[last] == j {
+                self.weights[last] += w;
+            } else {
+                self.columns.push(j);
+                self.weights.push(w);
+            }
+        }
+        self.row_starts.push(self.columns.len() as u32);
+    }
+
+    /// Releases the growth slack of the entry vectors.
+    pub fn shrink_to_fit(&mut self) {
+        self.columns.shrink_to_fit();
+        self.weights.shrink_to_fit();
+    }
+
+    fn row(&self, r: usize) -> (&[u32], &[f32]) {
+        let range = self.row_starts[r] as usize..self.row_starts[r + 1] as usize;
+        (&self.columns[range.clone()], &self.weights[range])
+    }
 }
 
 impl InterreflectionOperator {
-    pub fn from_rows(row_lengths: &[usize], columns: Vec<u32>, weights: Vec<f32>) -> Self {
-        let mut row_starts = Vec::with_capacity(row_lengths.len() + 1);
-        row_starts.push(0);
-        for len in row_lengths {
-            row_starts.push(row_starts.last().copied().unwrap_or(0) + len);
-        }
-        assert_eq!(row_starts.last().copied(), Some(columns.len()));
-        assert_eq!(columns.len(), weights.len());
-        Self {
-            row_starts,
-            columns,
-            weights,
-        }
+    /// Blocks covering consecutive vertex ranges, in order.
+    pub fn from_blocks(blocks: Vec<OperatorBlock>) -> Self {
+        Self { blocks }
     }
 
     /// Number of stored (vertex, vertex) weights.
     pub fn entries(&self) -> usize {
-        self.columns.len()
+        self.blocks.iter().map(|b| b.columns.len()).sum()
     }
 
     /// Sum of row `v`: the fraction of `v`'s (cosine-weighted) hemisphere that sees front faces.
-    pub fn row_sum(&self, v: usize) -> f32 {
-        self.weights[self.row_starts[v]..self.row_starts[v + 1]].iter().sum()
+    pub fn row_sum(&self, mut v: usize) -> f32 {
+        for block in &self.blocks {
+            if v < block.rows() {
+                return block.row(v).1.iter().sum();
+            }
+            v -= block.rows();
+        }
+        panic!("row out of range");
     }
 
     /// One bounce: `out_c(v) = ρ_c(v) Σ_j W[v][j] t_c(j)`.
@@ -46,20 +91,31 @@ impl InterreflectionOperator {
         let per_channel = stride / 3;
         let input = transfer.as_slice();
         let mut out = TransferVectors::zeros(transfer.order(), transfer.vertex_count());
-        out.as_mut_slice()
-            .par_chunks_mut(stride)
-            .enumerate()
-            .for_each(|(v, row_out)| {
-                let range = self.row_starts[v]..self.row_starts[v + 1];
-                for (&j, &w) in self.columns[range.clone()].iter().zip(&self.weights[range]) {
-                    let src = &input[j as usize * stride..(j as usize + 1) * stride];
-                    for (o, s) in row_out.iter_mut().zip(src) {
-                        *o += w * s;
+        // Split the output into the blocks' vertex ranges.
+        let mut rest = out.as_mut_slice();
+        let mut work = Vec::with_capacity(self.blocks.len());
+        let mut first_vertex = 0;
+        for block in &self.blocks {
+            let (head, tail) = rest.split_at_mut(block.rows() * stride);
+            work.push((block, first_vertex, head));
+            first_vertex += block.rows();
+            rest = tail;
+        }
+        work.into_par_iter()
+            .for_each(|(block, first_vertex, out_rows)| {
+                for (r, row_out) in out_rows.chunks_exact_mut(stride).enumerate() {
+                    let (columns, weights) = block.row(r);
+                    for (&j, &w) in columns.iter().zip(weights) {
+                        let src = &input[j as usize * stride..(j as usize + 1) * stride];
+                        for (o, s) in row_out.iter_mut().zip(src) {
+                            *o += w * s;
+                        }
                     }
-                }
-                for c in 0..3 {
-                    for o in &mut row_out[c * per_channel..(c + 1) * per_channel] {
-                        *o *= albedo[v][c];
+                    let rho = albedo[first_vertex + r];
+                    for c in 0..3 {
+                        for o in &mut row_out[c * per_channel..(c + 1) * per_channel] {
+                            *o *= rho[c];
+                        }
                     }
                 }
             });
@@ -73,13 +129,18 @@ mod tests {
 
     #[test]
     fn applies_weights_then_albedo() {
-        // Vertex 0 sees vertex 1 with weight 0.5; vertex 1 sees nothing.
-        let op = InterreflectionOperator::from_rows(&[1, 0], vec![1], vec![0.5]);
+        // Vertex 0 sees vertex 1 with weight 0.5 (given as two hits); vertex 1 sees nothing.
+        let mut first = OperatorBlock::new();
+        first.push_sorted_row(&[(1, 0.25), (1, 0.25)]);
+        let mut second = OperatorBlock::new();
+        second.push_sorted_row(&[]);
+        let op = InterreflectionOperator::from_blocks(vec![first, second]);
         let t = TransferVectors::from_raw(1, 2, vec![0.0, 0.0, 0.0, 2.0, 4.0, 6.0]).unwrap();
         let albedo = [Rgb::new(0.5, 1.0, 0.25), Rgb::ONE];
         let out = op.apply(&t, &albedo);
         assert_eq!(out.as_slice(), &[0.5, 2.0, 0.75, 0.0, 0.0, 0.0]);
         assert_eq!(op.row_sum(0), 0.5);
+        assert_eq!(op.row_sum(1), 0.0);
         assert_eq!(op.entries(), 1);
     }
 }

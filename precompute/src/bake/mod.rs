@@ -141,7 +141,9 @@ pub fn bake(
             *acc += x;
         }
         previous = next;
-        stats.bounce_seconds.push(bounce_start.elapsed().as_secs_f64());
+        stats
+            .bounce_seconds
+            .push(bounce_start.elapsed().as_secs_f64());
     }
     stats.total_seconds = start.elapsed().as_secs_f64();
     progress.finish_and_clear();

@@ -27,7 +27,12 @@ fn run(geometry: &SceneMesh, settings: BakeSettings) -> (Transfer, BakeStats) {
 /// An open box (five inward-facing walls, no lid): a concave mesh where every vertex is
 /// partly occluded.
 fn open_box() -> TriangleMesh {
-    let outer = box_mesh(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 1.0, 1.0), [8, 4, 8]);
+    let outer = box_mesh(
+        Vec3::new(-1.0, 0.0, -1.0),
+        Vec3::new(1.0, 1.0, 1.0),
+        [8, 4, 8],
+        [false; 6],
+    );
     let mut mesh = TriangleMesh::default();
     for t in 0..outer.triangle_count() {
         let [a, b, c] = outer.corners(t);
@@ -58,13 +63,20 @@ fn furnace_unoccluded_vertices_reflect_their_albedo() {
     let light = uniform_light(3, Rgb::ONE);
     for v in 0..geometry.mesh.vertex_count() {
         let l = transfer.full().radiance(v, &light);
-        assert!((l - albedo).abs().max_element() < 0.01 * albedo.max_element(), "vertex {v}: {l}");
+        assert!(
+            (l - albedo).abs().max_element() < 0.01 * albedo.max_element(),
+            "vertex {v}: {l}"
+        );
         // A convex mesh has no interreflection.
         assert_eq!(transfer.indirect.radiance(v, &light), Rgb::ZERO);
     }
 }
 
-fn white_furnace_deficits(geometry: &SceneMesh, bounce_counts: &[u32], samples: u32) -> Vec<Vec<f32>> {
+fn white_furnace_deficits(
+    geometry: &SceneMesh,
+    bounce_counts: &[u32],
+    samples: u32,
+) -> Vec<Vec<f32>> {
     let light = uniform_light(1, Rgb::ONE);
     bounce_counts
         .iter()
@@ -97,7 +109,10 @@ fn white_furnace_open_box_converges_to_one() {
     let deficits = white_furnace_deficits(&geometry, &counts, 256);
     let means: Vec<f32> = deficits.iter().map(|d| mean(d)).collect();
     for w in means.windows(2) {
-        assert!(w[1] < w[0], "deficit must shrink with every bounce: {means:?}");
+        assert!(
+            w[1] < w[0],
+            "deficit must shrink with every bounce: {means:?}"
+        );
     }
     // Every vertex's deficit shrinks too (no bounce subtracts light).
     for pair in deficits.windows(2) {
@@ -141,7 +156,13 @@ fn occlusion_only_and_hit_recording_paths_agree() {
         seed: 5,
     };
     let (a, _) = run(&geometry, settings);
-    let (b, _) = run(&geometry, BakeSettings { bounces: 1, ..settings });
+    let (b, _) = run(
+        &geometry,
+        BakeSettings {
+            bounces: 1,
+            ..settings
+        },
+    );
     for (x, y) in a.direct.as_slice().iter().zip(b.direct.as_slice()) {
         assert!((x - y).abs() < 1e-6);
     }

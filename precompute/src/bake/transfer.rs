@@ -74,11 +74,19 @@ impl TransferVectors {
 
     /// Element-wise sum (direct + indirect = full transfer).
     pub fn sum(&self, other: &TransferVectors) -> TransferVectors {
-        assert_eq!((self.order, self.vertex_count), (other.order, other.vertex_count));
+        assert_eq!(
+            (self.order, self.vertex_count),
+            (other.order, other.vertex_count)
+        );
         TransferVectors {
             order: self.order,
             vertex_count: self.vertex_count,
-            data: self.data.iter().zip(&other.data).map(|(a, b)| a + b).collect(),
+            data: self
+                .data
+                .iter()
+                .zip(&other.data)
+                .map(|(a, b)| a + b)
+                .collect(),
         }
     }
 

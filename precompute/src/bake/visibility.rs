@@ -1,9 +1,12 @@
 //! The tracing pass of the bake: every (vertex, sample) ray is cast exactly once.
 
+use super::bounce::OperatorBlock;
 use super::{BakeSettings, InterreflectionOperator, RAY_OFFSET_FRACTION, TransferVectors};
 use crate::bvh::SceneBvh;
 use crate::color::Rgb;
-use crate::sampling::{Frame, cosine_hemisphere, cranley_patterson, hammersley, hash_to_unit2, mix64};
+use crate::sampling::{
+    Frame, cosine_hemisphere, cranley_patterson, hammersley, hash_to_unit2, mix64,
+};
 use crate::scene::SceneMesh;
 use crate::sh::{ShBasis, num_coeffs};
 use glam::{Vec2, Vec3};
@@ -68,9 +71,7 @@ struct Scratch {
 /// Results for a contiguous run of vertices, in vertex order.
 struct Chunk {
     visibility: Vec<f32>,
-    row_lengths: Vec<usize>,
-    columns: Vec<u32>,
-    weights: Vec<f32>,
+    operator: OperatorBlock,
 }
 
 const CHUNK: usize = 32;
@@ -88,7 +89,6 @@ pub(super) fn trace_vertices(
     let samples = base_samples(settings.samples);
     let inv_samples = 1.0 / settings.samples as f32;
     let offset = RAY_OFFSET_FRACTION * geometry.diagonal();
-    let front_normals: Vec<Vec3> = (0..mesh.triangle_count()).map(|t| mesh.front_normal(t)).collect();
     let record_hits = settings.bounces > 0;
     let vertex_count = mesh.vertex_count();
 
@@ -103,9 +103,7 @@ pub(super) fn trace_vertices(
                 let vertices = chunk_index * CHUNK..((chunk_index + 1) * CHUNK).min(vertex_count);
                 let mut chunk = Chunk {
                     visibility: vec![0.0; vertices.len() * n],
-                    row_lengths: Vec::with_capacity(vertices.len()),
-                    columns: Vec::new(),
-                    weights: Vec::new(),
+                    operator: OperatorBlock::new(),
                 };
                 for (local, v) in vertices.clone().enumerate() {
                     let normal = mesh.normals[v];
@@ -115,18 +113,23 @@ pub(super) fn trace_vertices(
                     let visibility = &mut chunk.visibility[local * n..(local + 1) * n];
                     scratch.hits.clear();
                     for u in &samples {
-                        let direction = frame.to_world(cosine_hemisphere(cranley_patterson(*u, rotation)));
+                        let direction =
+                            frame.to_world(cosine_hemisphere(cranley_patterson(*u, rotation)));
                         let vertex = v as u32;
                         if record_hits {
                             match bvh.intersect_from_vertex(vertex, origin, direction, 0.0) {
-                                None => accumulate_basis(&basis, direction, &mut scratch.basis, visibility),
+                                None => accumulate_basis(
+                                    &basis,
+                                    direction,
+                                    &mut scratch.basis,
+                                    visibility,
+                                ),
                                 Some(hit) => {
-                                    // Back faces reflect nothing: the ray is only blocked.
-                                    if direction.dot(front_normals[hit.triangle as usize]) < 0.0 {
-                                        let corners = mesh.triangles[hit.triangle as usize];
-                                        for (i, w) in corners.iter().zip(hit.barycentrics()) {
-                                            scratch.hits.push((*i, w * inv_samples));
-                                        }
+                                    // Either side of a triangle shows its front's radiance
+                                    // (CONVENTIONS.md, "Surfaces").
+                                    let corners = mesh.triangles[hit.triangle as usize];
+                                    for (i, w) in corners.iter().zip(hit.barycentrics()) {
+                                        scratch.hits.push((*i, w * inv_samples));
                                     }
                                 }
                             }
@@ -139,18 +142,9 @@ pub(super) fn trace_vertices(
                     }
                     // Merge the hits into one sparse row of the interreflection operator.
                     scratch.hits.sort_unstable_by_key(|(i, _)| *i);
-                    let row_start = chunk.columns.len();
-                    for &(i, w) in &scratch.hits {
-                        let last = chunk.columns.len().wrapping_sub(1);
-                        if chunk.columns.len() > row_start && chunk.columns[last] == i {
-                            chunk.weights[last] += w;
-                        } else {
-                            chunk.columns.push(i);
-                            chunk.weights.push(w);
-                        }
-                    }
-                    chunk.row_lengths.push(chunk.columns.len() - row_start);
+                    chunk.operator.push_sorted_row(&scratch.hits);
                 }
+                chunk.operator.shrink_to_fit();
                 progress.inc(vertices.len() as u64);
                 chunk
             },
@@ -158,20 +152,15 @@ pub(super) fn trace_vertices(
         .collect();
 
     let mut visibility = Vec::with_capacity(vertex_count * n);
-    let mut row_lengths = Vec::with_capacity(vertex_count);
-    let total: usize = chunks.iter().map(|c| c.columns.len()).sum();
-    let mut columns = Vec::with_capacity(total);
-    let mut weights = Vec::with_capacity(total);
+    let mut blocks = Vec::with_capacity(chunks.len());
     for chunk in chunks {
         visibility.extend_from_slice(&chunk.visibility);
-        row_lengths.extend_from_slice(&chunk.row_lengths);
-        columns.extend_from_slice(&chunk.columns);
-        weights.extend_from_slice(&chunk.weights);
+        blocks.push(chunk.operator);
     }
     TracedVertices {
         order,
         visibility,
-        operator: InterreflectionOperator::from_rows(&row_lengths, columns, weights),
+        operator: InterreflectionOperator::from_blocks(blocks),
     }
 }
 
@@ -190,7 +179,10 @@ mod tests {
     #[test]
     fn base_samples_are_a_permutation_of_hammersley() {
         let mut a: Vec<(f32, f32)> = base_samples(256).iter().map(|p| (p.x, p.y)).collect();
-        let mut b: Vec<(f32, f32)> = (0..256).map(|i| hammersley(i, 256)).map(|p| (p.x, p.y)).collect();
+        let mut b: Vec<(f32, f32)> = (0..256)
+            .map(|i| hammersley(i, 256))
+            .map(|p| (p.x, p.y))
+            .collect();
         a.sort_by(|x, y| x.partial_cmp(y).unwrap());
         b.sort_by(|x, y| x.partial_cmp(y).unwrap());
         assert_eq!(a, b);

@@ -56,9 +56,12 @@ pub fn read_bpt(path: &Path, bytes: &[u8]) -> Result<Vec<BezierPatch>, MeshError
     };
 
     let (line, count_text) = next_line("the number of patches")?;
-    let count: usize = count_text
-        .parse()
-        .map_err(|_| syntax(line, format!("expected the number of patches, got {count_text:?}")))?;
+    let count: usize = count_text.parse().map_err(|_| {
+        syntax(
+            line,
+            format!("expected the number of patches, got {count_text:?}"),
+        )
+    })?;
     let mut patches = Vec::with_capacity(count.min(1 << 16));
     for patch in 0..count {
         let (line, degrees) = next_line(&format!("the degrees of patch {patch}"))?;
@@ -66,7 +69,9 @@ pub fn read_bpt(path: &Path, bytes: &[u8]) -> Result<Vec<BezierPatch>, MeshError
         if degrees != ["3", "3"] {
             return Err(syntax(
                 line,
-                format!("patch {patch}: only bicubic patches (\"3 3\") are supported, got {degrees:?}"),
+                format!(
+                    "patch {patch}: only bicubic patches (\"3 3\") are supported, got {degrees:?}"
+                ),
             ));
         }
         let mut control = [Vec3::ZERO; 16];
@@ -81,14 +86,24 @@ pub fn read_bpt(path: &Path, bytes: &[u8]) -> Result<Vec<BezierPatch>, MeshError
                 [x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => {
                     *point = Vec3::new(x, y, z)
                 }
-                [_, _, _] => return Err(syntax(line, format!("non-finite coordinate in {text:?}"))),
-                _ => return Err(syntax(line, format!("expected 3 coordinates, got {text:?}"))),
+                [_, _, _] => {
+                    return Err(syntax(line, format!("non-finite coordinate in {text:?}")));
+                }
+                _ => {
+                    return Err(syntax(
+                        line,
+                        format!("expected 3 coordinates, got {text:?}"),
+                    ));
+                }
             }
         }
         patches.push(BezierPatch { control });
     }
     if let Some((line, extra)) = lines.next() {
-        return Err(syntax(line, format!("unexpected data after {count} patches: {extra:?}")));
+        return Err(syntax(
+            line,
+            format!("unexpected data after {count} patches: {extra:?}"),
+        ));
     }
     Ok(patches)
 }
@@ -107,7 +122,10 @@ pub fn tessellate_patches(patches: &[BezierPatch], segments: u32) -> RawMesh {
             .control
             .iter()
             .fold(Vec3::splat(f32::MIN), |m, p| m.max(*p))
-            - patch.control.iter().fold(Vec3::splat(f32::MAX), |m, p| m.min(*p));
+            - patch
+                .control
+                .iter()
+                .fold(Vec3::splat(f32::MAX), |m, p| m.min(*p));
         let collapse = 1e-5 * size.length();
         for i in 0..=n {
             for j in 0..=n {
@@ -183,7 +201,9 @@ mod tests {
     fn errors_name_the_line() {
         let mut text = flat_patch_text();
         text = text.replacen("2 1 0", "2 x 0", 1);
-        let err = read_bpt(Path::new("bad.bpt"), text.as_bytes()).unwrap_err().to_string();
+        let err = read_bpt(Path::new("bad.bpt"), text.as_bytes())
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("bad.bpt: line 9"), "{err}");
 
         let err = read_bpt(Path::new("short.bpt"), b"2\n3 3\n0 0 0\n")
@@ -191,7 +211,9 @@ mod tests {
             .to_string();
         assert!(err.contains("file ends early"), "{err}");
 
-        let err = read_bpt(Path::new("deg.bpt"), b"1\n2 2\n").unwrap_err().to_string();
+        let err = read_bpt(Path::new("deg.bpt"), b"1\n2 2\n")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("line 2") && err.contains("bicubic"), "{err}");
     }
 }

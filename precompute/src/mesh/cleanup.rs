@@ -166,10 +166,9 @@ fn weld_positions(positions: &[Vec3], tolerance: f32) -> (Vec<u32>, Vec<u32>) {
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     if let Some(candidates) = grid.get(&(cell + IVec3::new(dx, dy, dz))) {
-                        if let Some(&c) = candidates
-                            .iter()
-                            .find(|&&c| positions[kept[c as usize] as usize].distance(*p) <= tolerance)
-                        {
+                        if let Some(&c) = candidates.iter().find(|&&c| {
+                            positions[kept[c as usize] as usize].distance(*p) <= tolerance
+                        }) {
                             found = Some(c);
                             break 'search;
                         }
@@ -310,14 +309,13 @@ mod tests {
     #[test]
     fn smooth_normals_of_a_cube_corner_point_along_the_diagonal() {
         // Three faces of a cube meeting at the origin, facing outwards (-x, -y, -z).
-        let positions = vec![
-            Vec3::ZERO,
-            Vec3::X,
-            Vec3::Y,
-            Vec3::Z,
-        ];
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
         let triangles = vec![[0, 2, 1], [0, 3, 2], [0, 1, 3]];
         let n = smooth_normals(&positions, &triangles);
-        assert!((n[0] - Vec3::splat(-1.0).normalize()).length() < 1e-6, "{:?}", n[0]);
+        assert!(
+            (n[0] - Vec3::splat(-1.0).normalize()).length() < 1e-6,
+            "{:?}",
+            n[0]
+        );
     }
 }

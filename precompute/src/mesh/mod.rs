@@ -10,7 +10,7 @@ mod shapes;
 
 pub use bpt::{BezierPatch, read_bpt, tessellate_patches};
 pub use cleanup::{CleanupReport, MeshCleanup};
-pub use shapes::{box_mesh, icosahedron, sphere_mesh, subdivide};
+pub use shapes::{annulus_mesh, box_mesh, icosahedron, sphere_mesh, subdivide};
 
 use glam::Vec3;
 use std::path::{Path, PathBuf};
@@ -48,7 +48,10 @@ impl TriangleMesh {
     pub fn front_normal(&self, t: usize) -> Vec3 {
         let [a, b, c] = self.corners(t);
         let n = (b - a).cross(c - a).normalize_or_zero();
-        let shading: Vec3 = self.triangles[t].iter().map(|&i| self.normals[i as usize]).sum();
+        let shading: Vec3 = self.triangles[t]
+            .iter()
+            .map(|&i| self.normals[i as usize])
+            .sum();
         if n.dot(shading) < 0.0 { -n } else { n }
     }
 
@@ -83,10 +86,10 @@ pub struct RawMesh {
 /// Why a mesh could not be loaded. Every variant names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {cause}", path.display())]
     Io {
         path: PathBuf,
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     #[error("{}: line {line}: {message}", path.display())]
     Syntax {
@@ -107,11 +110,14 @@ pub enum MeshError {
 
 /// Reads a file, transparently decompressing `.gz`.
 fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
+    let bytes = std::fs::read(path).map_err(|cause| MeshError::Io {
         path: path.to_owned(),
-        source,
+        cause,
     })?;
-    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gz")) {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gz"))
+    {
         use std::io::Read;
         let mut out = Vec::new();
         flate2::read::MultiGzDecoder::new(&bytes[..])
@@ -136,16 +142,13 @@ fn format_of(path: &Path) -> Option<&'static str> {
 }
 
 /// Options for loading a mesh file.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Default)]
 pub struct LoadOptions {
-    /// Tessellation of each Bézier patch (`segments × segments` quads).
-    pub patch_segments: u32,
-}
-
-impl Default for LoadOptions {
-    fn default() -> Self {
-        Self { patch_segments: 16 }
-    }
+    /// Tessellation of each Bézier patch (`segments × segments` quads); 16 when `None`.
+    pub patch_segments: Option<u32>,
+    /// Bézier patches (0-based) to leave out, e.g. the never-seen bottom of a teapot that
+    /// stands on a table.
+    pub skip_patches: Vec<usize>,
 }
 
 /// Reads a mesh file (OBJ, PLY ASCII or binary, BPT; any of them gzipped) without clean-up.
@@ -158,8 +161,25 @@ pub fn read_mesh(path: &Path, options: &LoadOptions) -> Result<RawMesh, MeshErro
         "obj" => obj::parse_obj(path, &bytes),
         "ply" => ply::parse_ply(path, &bytes),
         _ => {
-            let patches = bpt::read_bpt(path, &bytes)?;
-            Ok(bpt::tessellate_patches(&patches, options.patch_segments))
+            let mut patches = bpt::read_bpt(path, &bytes)?;
+            if let Some(&bad) = options.skip_patches.iter().find(|&&p| p >= patches.len()) {
+                return Err(MeshError::Invalid {
+                    path: path.to_owned(),
+                    message: format!(
+                        "cannot skip patch {bad}: the file has {} patches",
+                        patches.len()
+                    ),
+                });
+            }
+            let mut index = 0;
+            patches.retain(|_| {
+                index += 1;
+                !options.skip_patches.contains(&(index - 1))
+            });
+            Ok(bpt::tessellate_patches(
+                &patches,
+                options.patch_segments.unwrap_or(16),
+            ))
         }
     }
 }

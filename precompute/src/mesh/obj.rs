@@ -38,10 +38,17 @@ pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     for model in &models {
         let m = &model.mesh;
         let base = mesh.positions.len() as u32;
-        mesh.positions
-            .extend(m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        mesh.positions.extend(
+            m.positions
+                .chunks_exact(3)
+                .map(|p| Vec3::new(p[0], p[1], p[2])),
+        );
         if all_have_normals {
-            normals.extend(m.normals.chunks_exact(3).map(|n| Vec3::new(n[0], n[1], n[2])));
+            normals.extend(
+                m.normals
+                    .chunks_exact(3)
+                    .map(|n| Vec3::new(n[0], n[1], n[2])),
+            );
         }
         mesh.triangles.extend(
             m.indices
@@ -66,9 +73,8 @@ fn first_bad_line(text: &str) -> Option<(usize, String)> {
             continue;
         };
         let args: Vec<&str> = tokens.collect();
-        let floats_ok = |min: usize| {
-            args.len() >= min && args.iter().all(|a| a.parse::<f32>().is_ok())
-        };
+        let floats_ok =
+            |min: usize| args.len() >= min && args.iter().all(|a| a.parse::<f32>().is_ok());
         let problem = match keyword {
             "v" => {
                 positions += 1;
@@ -95,7 +101,10 @@ fn first_bad_line(text: &str) -> Option<(usize, String)> {
 /// A face needs three or more `v[/vt][/vn]` references, each within the elements so far.
 fn check_face(args: &[&str], counts: [i64; 3]) -> Option<String> {
     if args.len() < 3 {
-        return Some(format!("face needs at least 3 vertices, got {}", args.len()));
+        return Some(format!(
+            "face needs at least 3 vertices, got {}",
+            args.len()
+        ));
     }
     for arg in args {
         for (slot, part) in arg.split('/').enumerate().take(3) {
@@ -125,7 +134,10 @@ mod tests {
         let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n";
         let mesh = parse_obj(Path::new("q.obj"), obj.as_bytes()).unwrap();
         assert_eq!(mesh.triangles.len(), 2);
-        assert_eq!(mesh.normals.as_ref().map(|n| n.len()), Some(mesh.positions.len()));
+        assert_eq!(
+            mesh.normals.as_ref().map(|n| n.len()),
+            Some(mesh.positions.len())
+        );
     }
 
     #[test]
@@ -133,7 +145,10 @@ mod tests {
         let obj = "# test\nv 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n";
         let err = parse_obj(Path::new("bad.obj"), obj.as_bytes()).unwrap_err();
         let text = err.to_string();
-        assert!(text.contains("bad.obj") && text.contains("line 3"), "{text}");
+        assert!(
+            text.contains("bad.obj") && text.contains("line 3"),
+            "{text}"
+        );
     }
 
     #[test]

@@ -95,14 +95,20 @@ impl PropertyAccess for PlyFace {
 
 pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let to_error = |e: ply_rs_bw::parser::ParseError, what: &str| {
-        let text = e.to_string();
+        // ply-rs messages span several indented lines; keep them on one.
+        let text = e
+            .to_string()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
         match e.line() {
             Some(line) => MeshError::Syntax {
                 path: path.to_owned(),
                 line,
                 message: format!(
                     "{what}: {}",
-                    text.strip_prefix(&format!("Line {line}: ")).unwrap_or(&text)
+                    text.strip_prefix(&format!("Line {line}: "))
+                        .unwrap_or(&text)
                 ),
             },
             None => MeshError::Invalid {
@@ -149,7 +155,10 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
         if indices.len() < 3 {
             return Err(MeshError::Invalid {
                 path: path.to_owned(),
-                message: format!("face {f} has {} vertices (at least 3 needed)", indices.len()),
+                message: format!(
+                    "face {f} has {} vertices (at least 3 needed)",
+                    indices.len()
+                ),
             });
         }
         if let Some(&bad) = indices
@@ -195,7 +204,12 @@ mod tests {
     #[test]
     fn reads_binary_little_endian() {
         let mut bytes = HEADER.replace("ascii", "binary_little_endian").into_bytes();
-        for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]] {
+        for p in [
+            [0.0f32, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ] {
             for c in p {
                 bytes.extend_from_slice(&c.to_le_bytes());
             }
@@ -212,14 +226,18 @@ mod tests {
     #[test]
     fn malformed_ascii_names_the_line() {
         let text = format!("{HEADER}0 0 0\n1 0 0\n1 oops 0\n0 1 0\n3 0 1 2\n");
-        let err = parse_ply(Path::new("m.ply"), text.as_bytes()).unwrap_err().to_string();
+        let err = parse_ply(Path::new("m.ply"), text.as_bytes())
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("m.ply") && err.contains("line"), "{err}");
     }
 
     #[test]
     fn out_of_range_face_names_the_face() {
         let text = format!("{HEADER}0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 9\n");
-        let err = parse_ply(Path::new("f.ply"), text.as_bytes()).unwrap_err().to_string();
+        let err = parse_ply(Path::new("f.ply"), text.as_bytes())
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("face 0") && err.contains("vertex 9"), "{err}");
     }
 

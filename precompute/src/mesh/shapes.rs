@@ -5,12 +5,20 @@ use glam::Vec3;
 
 /// An axis-aligned box with outward-facing flat faces, each face a grid of
 /// `segments[a] × segments[b]` quads along its two axes, so per-vertex transfer can resolve
-/// shadows falling on it.
-pub fn box_mesh(min: Vec3, max: Vec3, segments: [u32; 3]) -> TriangleMesh {
+/// shadows falling on it. `skip[f]` leaves out face `f` of +x, -x, +y, -y, +z, -z.
+pub fn box_mesh(min: Vec3, max: Vec3, segments: [u32; 3], skip: [bool; 6]) -> TriangleMesh {
     let mut mesh = TriangleMesh::default();
     let size = max - min;
     // (normal axis, sign): the two in-plane axes are chosen so (u × v) = outward normal.
-    for (axis, sign) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0)] {
+    let faces = [
+        (0, 1.0),
+        (0, -1.0),
+        (1, 1.0),
+        (1, -1.0),
+        (2, 1.0),
+        (2, -1.0),
+    ];
+    for (&(axis, sign), _) in faces.iter().zip(skip).filter(|(_, skipped)| !skipped) {
         let (mut u_axis, mut v_axis) = ((axis + 1) % 3, (axis + 2) % 3);
         if sign < 0.0 {
             std::mem::swap(&mut u_axis, &mut v_axis);
@@ -45,6 +53,36 @@ pub fn box_mesh(min: Vec3, max: Vec3, segments: [u32; 3]) -> TriangleMesh {
     mesh
 }
 
+/// A flat ring in the XZ plane around `center`, facing +Y: `segments[0]` quads across it and
+/// `segments[1]` around it. With `inner = 0` it is a disc.
+pub fn annulus_mesh(center: Vec3, inner: f32, outer: f32, segments: [u32; 2]) -> TriangleMesh {
+    let (nr, na) = (segments[0].max(1) as usize, segments[1].max(3) as usize);
+    let mut mesh = TriangleMesh::default();
+    for i in 0..=nr {
+        let r = inner + (outer - inner) * i as f32 / nr as f32;
+        for j in 0..na {
+            let a = std::f32::consts::TAU * j as f32 / na as f32;
+            mesh.positions
+                .push(center + Vec3::new(r * a.cos(), 0.0, -r * a.sin()));
+            mesh.normals.push(Vec3::Y);
+        }
+    }
+    let at = |i: usize, j: usize| (i * na + j % na) as u32;
+    for i in 0..nr {
+        for j in 0..na {
+            // Angle increases counter-clockwise seen from +Y, so (outward, around) is +Y-facing.
+            let quad = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+            for tri in [[quad[0], quad[1], quad[2]], [quad[0], quad[2], quad[3]]] {
+                let p = tri.map(|k| mesh.positions[k as usize]);
+                if (p[1] - p[0]).cross(p[2] - p[0]).length() > 0.0 {
+                    mesh.triangles.push(tri);
+                }
+            }
+        }
+    }
+    mesh
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -52,13 +90,16 @@ mod tests {
     #[test]
     fn faces_point_outwards_and_enclose_the_volume() {
         let (min, max) = (Vec3::new(-1.0, 0.0, -2.0), Vec3::new(1.0, 0.5, 2.0));
-        let mesh = box_mesh(min, max, [4, 2, 8]);
+        let mesh = box_mesh(min, max, [4, 2, 8], [false; 6]);
         let centre = (min + max) * 0.5;
         let mut volume = 0.0;
         for t in 0..mesh.triangle_count() {
             let [a, b, c] = mesh.corners(t);
             let n = (b - a).cross(c - a);
-            assert!(n.dot((a + b + c) / 3.0 - centre) > 0.0, "triangle {t} faces inwards");
+            assert!(
+                n.dot((a + b + c) / 3.0 - centre) > 0.0,
+                "triangle {t} faces inwards"
+            );
             assert!((n.normalize() - mesh.normals[mesh.triangles[t][0] as usize]).length() < 1e-5);
             volume += a.dot(b.cross(c)) / 6.0;
         }
@@ -70,6 +111,20 @@ mod tests {
             .filter(|t| t.iter().all(|&i| mesh.positions[i as usize].y == max.y))
             .count();
         assert_eq!(top, 2 * 4 * 8);
+    }
+
+    #[test]
+    fn annulus_faces_up_and_covers_the_ring() {
+        let mesh = annulus_mesh(Vec3::new(0.0, 2.0, 0.0), 1.0, 2.0, [2, 64]);
+        let mut area = 0.0;
+        for t in 0..mesh.triangle_count() {
+            let [a, b, c] = mesh.corners(t);
+            let n = (b - a).cross(c - a);
+            assert!(n.y > 0.0 && n.x.abs() < 1e-4 && n.z.abs() < 1e-4);
+            area += n.length() / 2.0;
+        }
+        let exact = std::f32::consts::PI * (4.0 - 1.0);
+        assert!((area - exact).abs() < 0.01 * exact, "{area}");
     }
 }
 
