@@ -16,6 +16,8 @@ struct Cli {
 enum Command {
     /// Bake per-vertex SH transfer (shadowed direct + interreflected) for a scene.
     Bake(commands::bake::BakeArgs),
+    /// Decompose an environment map into an SH polynomial plus directional lights.
+    Decompose(commands::decompose::DecomposeArgs),
     /// Benchmarks anyone can rerun (bake throughput, ...).
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
@@ -38,6 +40,7 @@ fn main() {
     let result = match cli.command {
         Command::Bake(args) => commands::bake::run(args),
         Command::Bench(cmd) => commands::bench::run(cmd),
+        Command::Decompose(args) => commands::decompose::run(args),
     };
     if let Err(error) = result {
         eprintln!("error: {error:#}");

@@ -21,9 +21,9 @@
 //!    end    4  u32 CRC-32 (IEEE, zlib's crc32) of every preceding byte
 //! ```
 
+use crate::atomic_file::AtomicOutput;
 use crate::bake::{BakeSettings, RAY_OFFSET_FRACTION, Transfer, TransferVectors};
 use crate::sh::{self, num_coeffs};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 pub const MAGIC: &[u8; 8] = b"HPRTBAKE";
@@ -203,47 +203,6 @@ pub fn read_for_mesh(path: &Path, mesh_hash: &[u8; 32]) -> Result<Transfer, Bake
     Ok(transfer)
 }
 
-/// An output file opened before a long bake, so an unwritable path fails at once. The data
-/// goes to a temporary file beside the target and is renamed over it only when complete: an
-/// interrupted bake never leaves a partial file at `path`.
-pub struct AtomicOutput {
-    path: PathBuf,
-    temp: tempfile::NamedTempFile,
-}
-
-impl AtomicOutput {
-    pub fn create(path: &Path) -> Result<Self, std::io::Error> {
-        let dir = match path.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d,
-            _ => Path::new("."),
-        };
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .ok_or_else(|| std::io::Error::other("the output path has no file name"))?;
-        let temp = tempfile::Builder::new()
-            .prefix(&format!(".{name}."))
-            .suffix(".partial")
-            .tempfile_in(dir)?;
-        Ok(Self {
-            path: path.to_owned(),
-            temp,
-        })
-    }
-
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
-
-    /// Writes `bytes` and moves the file into place.
-    pub fn commit(mut self, bytes: &[u8]) -> Result<(), std::io::Error> {
-        self.temp.write_all(bytes)?;
-        self.temp.as_file().sync_all()?;
-        self.temp.persist(&self.path).map_err(|e| e.error)?;
-        Ok(())
-    }
-}
-
 /// Writes a bake atomically.
 pub fn write(path: &Path, transfer: &Transfer, mesh_hash: &[u8; 32]) -> Result<(), BakeFileError> {
     let io = |cause| BakeFileError::Io {
@@ -321,11 +280,5 @@ mod tests {
         ));
         let msg = decode(path, &flipped).unwrap_err().to_string();
         assert!(msg.starts_with("d.bake:"), "{msg}");
-    }
-
-    #[test]
-    fn unwritable_destination_fails_before_any_work() {
-        let err = AtomicOutput::create(Path::new("/nonexistent-dir/x.bake"));
-        assert!(err.is_err());
     }
 }

@@ -5,12 +5,15 @@
 //! in a [`bakefile`]. The [`reference`] path tracer renders the same scene as ground truth.
 
 pub mod color;
+pub mod envmap;
+pub mod image_io;
 pub mod mesh;
 pub mod quadrature;
 pub mod sampling;
 pub mod sh;
 
 pub use color::{Rgb, luminance};
+pub mod atomic_file;
 pub mod bake;
 pub mod bakefile;
 pub mod bvh;

@@ -241,10 +241,10 @@ where
 
     /// Multiplies band `l` by `factors[l]` (windowing, convolution with a zonal kernel).
     pub fn scale_bands(&mut self, factors: &[f32]) {
-        for l in 0..self.order {
+        for (l, factor) in factors.iter().enumerate().take(self.order) {
             for m in -(l as isize)..=(l as isize) {
                 let k = index(l, m);
-                self.coeffs[k] = self.coeffs[k] * factors[l];
+                self.coeffs[k] = self.coeffs[k] * *factor;
             }
         }
     }

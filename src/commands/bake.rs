@@ -3,8 +3,9 @@
 use super::{load_scene, progress_bar, with_threads};
 use anyhow::Context;
 use clap::Args;
+use precompute::atomic_file::AtomicOutput;
 use precompute::bake::{self, BakeSettings, BakeStats};
-use precompute::bakefile::{self, AtomicOutput};
+use precompute::bakefile;
 use precompute::bvh::SceneBvh;
 use precompute::scene::Scene;
 use std::path::PathBuf;

@@ -38,7 +38,8 @@ pub fn run(command: BenchCommand) -> anyhow::Result<()> {
     }
 }
 
-fn median(mut xs: Vec<f64>) -> f64 {
+/// Median of a non-empty sample.
+pub fn median(mut xs: Vec<f64>) -> f64 {
     xs.sort_by(f64::total_cmp);
     let n = xs.len();
     if n % 2 == 1 {

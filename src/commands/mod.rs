@@ -2,6 +2,7 @@
 
 pub mod bake;
 pub mod bench;
+pub mod decompose;
 
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};

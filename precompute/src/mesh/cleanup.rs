@@ -165,13 +165,14 @@ fn weld_positions(positions: &[Vec3], tolerance: f32) -> (Vec<u32>, Vec<u32>) {
         'search: for dz in -1..=1 {
             for dy in -1..=1 {
                 for dx in -1..=1 {
-                    if let Some(candidates) = grid.get(&(cell + IVec3::new(dx, dy, dz))) {
-                        if let Some(&c) = candidates.iter().find(|&&c| {
-                            positions[kept[c as usize] as usize].distance(*p) <= tolerance
-                        }) {
-                            found = Some(c);
-                            break 'search;
-                        }
+                    let near =
+                        |&&c: &&u32| positions[kept[c as usize] as usize].distance(*p) <= tolerance;
+                    if let Some(&c) = grid
+                        .get(&(cell + IVec3::new(dx, dy, dz)))
+                        .and_then(|candidates| candidates.iter().find(near))
+                    {
+                        found = Some(c);
+                        break 'search;
                     }
                 }
             }

@@ -1,0 +1,527 @@
+//! Reading HDR environment maps (OpenEXR, Radiance `.hdr`) in any of the supported layouts.
+
+use super::EnvMap;
+use super::cube::{ALL_FACES, CubeFace, horizontal_cross_cell, vertical_cross_cell};
+use crate::color::Rgb;
+use glam::Vec3;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// How the pixels of an input image map to directions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Layout {
+    /// Latitude-longitude, 2:1.
+    Equirect,
+    /// Horizontal cube cross, 4:3.
+    CrossHorizontal,
+    /// Vertical cube cross, 3:4.
+    CrossVertical,
+    /// Six square face files; the path contains `{face}`, replaced by px, nx, py, ny, pz, nz.
+    Faces,
+    /// Debevec's angular "light probe" map, 1:1.
+    Probe,
+}
+
+impl FromStr for Layout {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "equirect" => Ok(Layout::Equirect),
+            "cross-horizontal" => Ok(Layout::CrossHorizontal),
+            "cross-vertical" => Ok(Layout::CrossVertical),
+            "faces" => Ok(Layout::Faces),
+            "probe" => Ok(Layout::Probe),
+            _ => Err(format!(
+                "unknown layout {s:?} (equirect, cross-horizontal, cross-vertical, faces, probe)"
+            )),
+        }
+    }
+}
+
+impl Layout {
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::Equirect => "equirect",
+            Layout::CrossHorizontal => "cross-horizontal",
+            Layout::CrossVertical => "cross-vertical",
+            Layout::Faces => "faces",
+            Layout::Probe => "probe",
+        }
+    }
+
+    /// The layout implied by an image's aspect ratio.
+    pub fn from_aspect(width: usize, height: usize) -> Option<Layout> {
+        match (width, height) {
+            (w, h) if w == 2 * h => Some(Layout::Equirect),
+            (w, h) if 3 * w == 4 * h => Some(Layout::CrossHorizontal),
+            (w, h) if 4 * w == 3 * h => Some(Layout::CrossVertical),
+            (w, h) if w == h => Some(Layout::Probe),
+            _ => None,
+        }
+    }
+}
+
+/// Why a map could not be loaded. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum EnvMapError {
+    #[error("{}: {cause}", path.display())]
+    Io {
+        path: PathBuf,
+        cause: std::io::Error,
+    },
+    #[error(
+        "{}: the EXR uses {compression} compression, which hprt's EXR reader cannot decode; \
+         convert it, e.g. `oiiotool {} --compression zip -o converted.exr` \
+         or `exrmaketiled`/Blender, and load the converted file",
+        path.display(), path.display()
+    )]
+    UnsupportedCompression { path: PathBuf, compression: String },
+    #[error("{}: cannot decode: {message}", path.display())]
+    Decode { path: PathBuf, message: String },
+    #[error("{}: {message}", path.display())]
+    Layout { path: PathBuf, message: String },
+    #[error("{}: unsupported file type (expected .exr or .hdr)", path.display())]
+    UnsupportedFormat { path: PathBuf },
+}
+
+/// A decoded RGB image, row-major from the top row.
+pub(crate) struct RgbImage {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: Vec<Rgb>,
+}
+
+impl RgbImage {
+    fn pixel(&self, x: usize, y: usize) -> Rgb {
+        self.pixels[y * self.width + x]
+    }
+}
+
+/// A loaded map: the equirectangular radiance, how many texels were sanitised, and the layout
+/// it was read as.
+#[derive(Debug, Clone)]
+pub struct LoadedEnvMap {
+    pub map: EnvMap,
+    /// Texels that had a NaN, infinite or negative channel (set to 0).
+    pub sanitized: usize,
+    pub layout: Layout,
+}
+
+/// Loads `path` (for [`Layout::Faces`], a pattern containing `{face}`). The layout is inferred
+/// from the aspect ratio (or the `{face}` pattern) unless given.
+pub fn load(path: &Path, layout: Option<Layout>) -> Result<LoadedEnvMap, EnvMapError> {
+    let is_pattern = path.to_string_lossy().contains("{face}");
+    let layout = match (layout, is_pattern) {
+        (Some(Layout::Faces), _) | (None, true) => Layout::Faces,
+        (Some(other), false) => other,
+        (Some(other), true) => {
+            return Err(EnvMapError::Layout {
+                path: path.to_owned(),
+                message: format!(
+                    "a {{face}} pattern needs the faces layout, not {}",
+                    other.name()
+                ),
+            });
+        }
+        (None, false) => {
+            let image = read_image(path)?;
+            let layout = Layout::from_aspect(image.width, image.height).ok_or_else(|| {
+                EnvMapError::Layout {
+                    path: path.to_owned(),
+                    message: format!(
+                        "cannot infer the layout of a {}x{} image (2:1 equirect, 4:3 or 3:4 \
+                         cross, 1:1 probe); pass --layout",
+                        image.width, image.height
+                    ),
+                }
+            })?;
+            return finish(path, layout, vec![image]);
+        }
+    };
+    let images = if layout == Layout::Faces {
+        let pattern = path.to_string_lossy();
+        ALL_FACES
+            .iter()
+            .map(|f| read_image(Path::new(&pattern.replace("{face}", f.tag()))))
+            .collect::<Result<Vec<_>, _>>()?
+    } else {
+        vec![read_image(path)?]
+    };
+    finish(path, layout, images)
+}
+
+fn finish(
+    path: &Path,
+    layout: Layout,
+    mut images: Vec<RgbImage>,
+) -> Result<LoadedEnvMap, EnvMapError> {
+    let sanitized = images.iter_mut().map(sanitize).sum();
+    if sanitized > 0 {
+        log::warn!(
+            "{}: {sanitized} texel(s) with NaN, infinite or negative radiance set to 0",
+            path.display()
+        );
+    }
+    let map = resample(path, layout, &images)?;
+    Ok(LoadedEnvMap {
+        map,
+        sanitized,
+        layout,
+    })
+}
+
+/// Zeroes non-finite and negative channels; returns how many texels had one.
+fn sanitize(image: &mut RgbImage) -> usize {
+    let mut count = 0;
+    for p in &mut image.pixels {
+        let bad = !p.is_finite() || p.min_element() < 0.0;
+        if bad {
+            count += 1;
+            *p = Rgb::from(
+                p.to_array()
+                    .map(|c| if c.is_finite() && c > 0.0 { c } else { 0.0 }),
+            );
+        }
+    }
+    count
+}
+
+fn read_image(path: &Path) -> Result<RgbImage, EnvMapError> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if !path.exists() {
+        return Err(EnvMapError::Io {
+            path: path.to_owned(),
+            cause: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+        });
+    }
+    match ext.as_str() {
+        "exr" => read_exr(path),
+        "hdr" => read_hdr(path),
+        _ => Err(EnvMapError::UnsupportedFormat {
+            path: path.to_owned(),
+        }),
+    }
+}
+
+fn read_exr(path: &Path) -> Result<RgbImage, EnvMapError> {
+    use exr::prelude::*;
+    let decode = |e: exr::error::Error| EnvMapError::Decode {
+        path: path.to_owned(),
+        message: e.to_string(),
+    };
+    // Check the compression first: the reader cannot decode DWA and would fail obscurely.
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(decode)?;
+    if let Some(header) = meta.headers.first() {
+        let name = match header.compression {
+            Compression::DWAA(_) => Some("DWAA"),
+            Compression::DWAB(_) => Some("DWAB"),
+            _ => None,
+        };
+        if let Some(name) = name {
+            return Err(EnvMapError::UnsupportedCompression {
+                path: path.to_owned(),
+                compression: name.into(),
+            });
+        }
+    }
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| RgbImage {
+            width: resolution.width(),
+            height: resolution.height(),
+            pixels: vec![Rgb::ZERO; resolution.width() * resolution.height()],
+        },
+        |image: &mut RgbImage, position, (r, g, b, _a): (f32, f32, f32, f32)| {
+            let index = position.y() * image.width + position.x();
+            image.pixels[index] = Rgb::new(r, g, b);
+        },
+    )
+    .map_err(decode)?;
+    Ok(image.layer_data.channel_data.pixels)
+}
+
+fn read_hdr(path: &Path) -> Result<RgbImage, EnvMapError> {
+    let decoded = image::ImageReader::open(path)
+        .map_err(|cause| EnvMapError::Io {
+            path: path.to_owned(),
+            cause,
+        })?
+        .with_guessed_format()
+        .map_err(|cause| EnvMapError::Io {
+            path: path.to_owned(),
+            cause,
+        })?
+        .decode()
+        .map_err(|e| EnvMapError::Decode {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?
+        .into_rgb32f();
+    Ok(RgbImage {
+        width: decoded.width() as usize,
+        height: decoded.height() as usize,
+        pixels: decoded.pixels().map(|p| Rgb::from(p.0)).collect(),
+    })
+}
+
+/// Supersampling factor so each output texel averages at least one input pixel.
+const SUPERSAMPLE: usize = 3;
+
+/// Converts the decoded image(s) into the equirectangular map.
+fn resample(path: &Path, layout: Layout, images: &[RgbImage]) -> Result<EnvMap, EnvMapError> {
+    let bad_shape = |message: String| EnvMapError::Layout {
+        path: path.to_owned(),
+        message,
+    };
+    let first = &images[0];
+    match layout {
+        Layout::Equirect => {
+            if first.width != 2 * first.height {
+                return Err(bad_shape(format!(
+                    "an equirect map must be 2:1, this one is {}x{}",
+                    first.width, first.height
+                )));
+            }
+            Ok(EnvMap::new(first.width, first.height, first.pixels.clone()))
+        }
+        Layout::CrossHorizontal | Layout::CrossVertical => {
+            let horizontal = layout == Layout::CrossHorizontal;
+            let (cols, rows) = if horizontal { (4, 3) } else { (3, 4) };
+            let size = first.width / cols;
+            if size == 0 || first.width != cols * size || first.height != rows * size {
+                return Err(bad_shape(format!(
+                    "a {} cross must be {cols}:{rows} with square faces, this one is {}x{}",
+                    layout.name(),
+                    first.width,
+                    first.height
+                )));
+            }
+            let lookup = |w: Vec3| {
+                let (face, x, y) = CubeFace::locate_texel(w, size);
+                let ((col, row), rotated) = if horizontal {
+                    (horizontal_cross_cell(face), false)
+                } else {
+                    vertical_cross_cell(face)
+                };
+                let (x, y) = if rotated {
+                    (size - 1 - x, size - 1 - y)
+                } else {
+                    (x, y)
+                };
+                first.pixel(col * size + x, row * size + y)
+            };
+            Ok(EnvMap::from_fn(4 * size, 2 * size, SUPERSAMPLE, lookup))
+        }
+        Layout::Faces => {
+            let size = first.width;
+            if let Some((face, image)) = ALL_FACES
+                .iter()
+                .zip(images)
+                .find(|(_, im)| im.width != size || im.height != size)
+            {
+                return Err(bad_shape(format!(
+                    "face {} is {}x{}, but all faces must be {size}x{size}",
+                    face.tag(),
+                    image.width,
+                    image.height
+                )));
+            }
+            let lookup = |w: Vec3| {
+                let (face, x, y) = CubeFace::locate_texel(w, size);
+                images[face as usize].pixel(x, y)
+            };
+            Ok(EnvMap::from_fn(4 * size, 2 * size, SUPERSAMPLE, lookup))
+        }
+        Layout::Probe => {
+            if first.width != first.height {
+                return Err(bad_shape(format!(
+                    "a light probe must be square, this one is {}x{}",
+                    first.width, first.height
+                )));
+            }
+            let size = first.width;
+            let lookup = |w: Vec3| {
+                let (u, v) = probe_coordinates(w);
+                let x = (((u + 1.0) * 0.5 * size as f32) as usize).min(size - 1);
+                let y = (((1.0 - v) * 0.5 * size as f32) as usize).min(size - 1);
+                first.pixel(x, y)
+            };
+            Ok(EnvMap::from_fn(2 * size, size, SUPERSAMPLE, lookup))
+        }
+    }
+}
+
+/// Debevec's angular map: the image centre looks toward -Z, the rim toward +Z, and the radius
+/// from the centre is proportional to the angle from -Z. Returns `(u, v)` in the unit disc,
+/// `v` up.
+pub fn probe_coordinates(w: Vec3) -> (f32, f32) {
+    let planar = (w.x * w.x + w.y * w.y).sqrt();
+    if planar < 1e-9 {
+        return if w.z < 0.0 { (0.0, 0.0) } else { (1.0, 0.0) };
+    }
+    let r = (-w.z).clamp(-1.0, 1.0).acos() / std::f32::consts::PI / planar;
+    (w.x * r, w.y * r)
+}
+
+/// Inverse of [`probe_coordinates`] for a point of the unit disc.
+#[cfg(test)]
+fn probe_direction(u: f32, v: f32) -> Vec3 {
+    let r = (u * u + v * v).sqrt();
+    let theta = std::f32::consts::PI * r.min(1.0);
+    let phi = v.atan2(u);
+    Vec3::new(
+        theta.sin() * phi.cos(),
+        theta.sin() * phi.sin(),
+        -theta.cos(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::envmap::cube::FACE_FRAMES;
+
+    /// A smooth test function of direction with distinct values everywhere.
+    fn pattern(w: Vec3) -> Rgb {
+        Rgb::new(1.0 + w.x, 1.0 + w.y * 0.5, 1.0 + w.z * 0.25 + w.x * w.y)
+    }
+
+    fn compare_to_pattern(map: &EnvMap, tolerance: f32) {
+        let mut worst = 0.0f32;
+        for j in 0..map.height() {
+            for i in 0..map.width() {
+                let d = map.texel(i, j) - pattern(map.texel_direction(i, j));
+                worst = worst.max(d.abs().max_element());
+            }
+        }
+        assert!(worst < tolerance, "worst texel error {worst}");
+    }
+
+    fn face_image(face: CubeFace, size: usize) -> Vec<Rgb> {
+        (0..size * size)
+            .map(|k| pattern(face.texel_direction(size, k % size, k / size)))
+            .collect()
+    }
+
+    #[test]
+    fn horizontal_and_vertical_crosses_land_every_face_where_it_belongs() {
+        let size = 32;
+        for horizontal in [true, false] {
+            let (cols, rows) = if horizontal { (4, 3) } else { (3, 4) };
+            let mut pixels = vec![Rgb::ZERO; cols * rows * size * size];
+            for face in ALL_FACES {
+                let ((col, row), rotated) = if horizontal {
+                    (horizontal_cross_cell(face), false)
+                } else {
+                    vertical_cross_cell(face)
+                };
+                let image = face_image(face, size);
+                for y in 0..size {
+                    for x in 0..size {
+                        let (sx, sy) = if rotated {
+                            (size - 1 - x, size - 1 - y)
+                        } else {
+                            (x, y)
+                        };
+                        pixels[(row * size + sy) * cols * size + col * size + sx] =
+                            image[y * size + x];
+                    }
+                }
+            }
+            let image = RgbImage {
+                width: cols * size,
+                height: rows * size,
+                pixels,
+            };
+            let layout = Layout::from_aspect(image.width, image.height).unwrap();
+            assert_eq!(layout == Layout::CrossHorizontal, horizontal);
+            let map = resample(Path::new("cross.exr"), layout, &[image]).unwrap();
+            compare_to_pattern(&map, 0.12);
+        }
+    }
+
+    #[test]
+    fn cross_centre_looks_toward_minus_z() {
+        assert_eq!(FACE_FRAMES[CubeFace::NegZ as usize][0], Vec3::NEG_Z);
+        assert_eq!(horizontal_cross_cell(CubeFace::NegZ), (1, 1));
+    }
+
+    #[test]
+    fn probe_round_trip_and_resampling() {
+        for w in [
+            Vec3::new(0.3, 0.4, -0.8),
+            Vec3::new(-0.5, 0.1, 0.7),
+            Vec3::new(0.0, -1.0, 0.01),
+        ] {
+            let w = w.normalize();
+            let (u, v) = probe_coordinates(w);
+            assert!(u * u + v * v <= 1.0 + 1e-6);
+            assert!((probe_direction(u, v) - w).length() < 1e-4);
+        }
+        let size = 128;
+        let pixels = (0..size * size)
+            .map(|k| {
+                let u = 2.0 * ((k % size) as f32 + 0.5) / size as f32 - 1.0;
+                let v = 1.0 - 2.0 * ((k / size) as f32 + 0.5) / size as f32;
+                pattern(probe_direction(u, v))
+            })
+            .collect();
+        let image = RgbImage {
+            width: size,
+            height: size,
+            pixels,
+        };
+        let map = resample(Path::new("probe.hdr"), Layout::Probe, &[image]).unwrap();
+        // The rim (+Z) is singular in this layout; compare away from it.
+        let mut worst = 0.0f32;
+        for j in 0..map.height() {
+            for i in 0..map.width() {
+                let w = map.texel_direction(i, j);
+                if w.z < 0.8 {
+                    worst = worst.max((map.texel(i, j) - pattern(w)).abs().max_element());
+                }
+            }
+        }
+        assert!(worst < 0.15, "{worst}");
+    }
+
+    #[test]
+    fn sanitize_zeroes_and_counts_bad_texels() {
+        let mut image = RgbImage {
+            width: 2,
+            height: 2,
+            pixels: vec![
+                Rgb::new(1.0, -2.0, 0.5),
+                Rgb::new(f32::NAN, 1.0, 1.0),
+                Rgb::new(f32::INFINITY, 0.0, 0.0),
+                Rgb::ONE,
+            ],
+        };
+        assert_eq!(sanitize(&mut image), 3);
+        assert_eq!(image.pixels[0], Rgb::new(1.0, 0.0, 0.5));
+        assert_eq!(image.pixels[1], Rgb::new(0.0, 1.0, 1.0));
+        assert_eq!(image.pixels[2], Rgb::ZERO);
+        assert_eq!(image.pixels[3], Rgb::ONE);
+    }
+
+    #[test]
+    fn layout_from_aspect_and_names() {
+        assert_eq!(Layout::from_aspect(1024, 512), Some(Layout::Equirect));
+        assert_eq!(Layout::from_aspect(400, 300), Some(Layout::CrossHorizontal));
+        assert_eq!(Layout::from_aspect(300, 400), Some(Layout::CrossVertical));
+        assert_eq!(Layout::from_aspect(256, 256), Some(Layout::Probe));
+        assert_eq!(Layout::from_aspect(300, 200), None);
+        for l in [
+            Layout::Equirect,
+            Layout::Faces,
+            Layout::Probe,
+            Layout::CrossVertical,
+        ] {
+            assert_eq!(l.name().parse::<Layout>(), Ok(l));
+        }
+    }
+}

@@ -1,0 +1,177 @@
+//! Importance sampling of an environment map: a piecewise-constant 2D distribution over the
+//! equirectangular texels, weighted by luminance times solid angle (`sin θ`).
+
+use super::{EnvMap, direction_of_uv, uv_of_direction};
+use crate::color::luminance;
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// Marginal (rows) and conditional (columns per row) distributions.
+#[derive(Debug, Clone)]
+pub struct EnvSampler {
+    width: usize,
+    height: usize,
+    /// `height + 1` entries, from 0 to 1.
+    marginal_cdf: Vec<f32>,
+    /// `height` rows of `width + 1` entries, each from 0 to 1.
+    conditional_cdf: Vec<f32>,
+    /// Probability of each texel (sums to 1).
+    texel_probability: Vec<f32>,
+}
+
+/// Index `k` with `cdf[k] <= x < cdf[k + 1]`, and where `x` falls inside that interval.
+fn invert_cdf(cdf: &[f32], x: f32) -> (usize, f32) {
+    let n = cdf.len() - 1;
+    let k = cdf
+        .partition_point(|&c| c <= x)
+        .saturating_sub(1)
+        .min(n - 1);
+    // Skip empty intervals (possible when x lands exactly on a plateau edge).
+    let width = cdf[k + 1] - cdf[k];
+    let t = if width > 0.0 {
+        ((x - cdf[k]) / width).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    (k, t)
+}
+
+fn normalised_cdf(weights: &[f64]) -> (Vec<f32>, f64) {
+    let total: f64 = weights.iter().sum();
+    let mut cdf = Vec::with_capacity(weights.len() + 1);
+    let mut acc = 0.0f64;
+    cdf.push(0.0);
+    for w in weights {
+        acc += w;
+        cdf.push(if total > 0.0 {
+            (acc / total) as f32
+        } else {
+            0.0
+        });
+    }
+    if let Some(last) = cdf.last_mut() {
+        *last = 1.0;
+    }
+    (cdf, total)
+}
+
+impl EnvSampler {
+    /// `None` for a map with no light at all.
+    pub fn new(map: &EnvMap) -> Option<Self> {
+        let (w, h) = (map.width(), map.height());
+        let mut conditional_cdf = Vec::with_capacity(h * (w + 1));
+        let mut row_weights = Vec::with_capacity(h);
+        let mut texel_weights = Vec::with_capacity(w * h);
+        for j in 0..h {
+            let sin_theta = (PI * (j as f32 + 0.5) / h as f32).sin() as f64;
+            let weights: Vec<f64> = (0..w)
+                .map(|i| luminance(map.texel(i, j)).max(0.0) as f64 * sin_theta)
+                .collect();
+            let (cdf, total) = normalised_cdf(&weights);
+            conditional_cdf.extend(cdf);
+            row_weights.push(total);
+            texel_weights.extend(weights);
+        }
+        let (marginal_cdf, total) = normalised_cdf(&row_weights);
+        if total <= 0.0 {
+            return None;
+        }
+        Some(Self {
+            width: w,
+            height: h,
+            marginal_cdf,
+            conditional_cdf,
+            texel_probability: texel_weights.iter().map(|x| (x / total) as f32).collect(),
+        })
+    }
+
+    /// Solid-angle density of a point at polar angle with sine `sin_theta` inside a texel of
+    /// probability `p`.
+    #[inline]
+    fn density(&self, p: f32, sin_theta: f32) -> f32 {
+        if sin_theta <= 0.0 {
+            return 0.0;
+        }
+        // Uniform in (u, v) over the texel: density p·W·H in uv; dω = 2π² sin θ du dv.
+        p * (self.width * self.height) as f32 / (2.0 * PI * PI * sin_theta)
+    }
+
+    /// A direction (in the map's own frame) drawn with density [`Self::pdf`], and that density.
+    pub fn sample(&self, u: Vec2) -> (Vec3, f32) {
+        let (j, tv) = invert_cdf(&self.marginal_cdf, u.y);
+        let row = &self.conditional_cdf[j * (self.width + 1)..(j + 1) * (self.width + 1)];
+        let (i, tu) = invert_cdf(row, u.x);
+        let uu = (i as f32 + tu) / self.width as f32;
+        // Keep off the poles, where the density is zero (a measure-zero event, but
+        // Hammersley point 0 hits it exactly).
+        let vv = (j as f32 + tv.clamp(1e-4, 1.0 - 1e-4)) / self.height as f32;
+        let w = direction_of_uv(uu, vv);
+        let p = self.texel_probability[j * self.width + i];
+        (w, self.density(p, (PI * vv).sin()))
+    }
+
+    /// Solid-angle density of sampling direction `w` (map frame).
+    pub fn pdf(&self, w: Vec3) -> f32 {
+        let (u, v) = uv_of_direction(w);
+        let i = ((u * self.width as f32) as usize).min(self.width - 1);
+        let j = ((v * self.height as f32) as usize).min(self.height - 1);
+        // From x and z, which keep their precision near the poles (unlike 1 - y²).
+        let sin_theta = (w.x * w.x + w.z * w.z).sqrt();
+        self.density(self.texel_probability[j * self.width + i], sin_theta)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Rgb;
+    use crate::sampling::hammersley;
+
+    fn test_map() -> EnvMap {
+        EnvMap::from_fn(64, 32, 1, |w| {
+            let sun = if w.dot(Vec3::new(0.3, 0.6, -0.74).normalize()) > 0.98 {
+                200.0
+            } else {
+                0.0
+            };
+            Rgb::new(0.5 + w.y.max(0.0), 0.7, 0.2) + Rgb::splat(sun)
+        })
+    }
+
+    #[test]
+    fn estimates_the_map_integral_without_bias() {
+        // E[L(ω)/pdf(ω)] = ∫ L dω.
+        let map = test_map();
+        let sampler = EnvSampler::new(&map).unwrap();
+        let n = 1 << 16;
+        let mut estimate = 0.0f64;
+        for k in 0..n {
+            let (w, pdf) = sampler.sample(hammersley(k, n));
+            assert!(pdf > 0.0);
+            assert!(
+                (pdf - sampler.pdf(w)).abs() < 1e-3 * pdf,
+                "{pdf} vs {}",
+                sampler.pdf(w)
+            );
+            estimate += (luminance(map.radiance(w)) / pdf) as f64;
+        }
+        estimate /= n as f64;
+        let exact = luminance(map.total_power()) as f64;
+        assert!(
+            (estimate - exact).abs() < 5e-3 * exact,
+            "{estimate} vs {exact}"
+        );
+    }
+
+    #[test]
+    fn pdf_integrates_to_one() {
+        let map = test_map();
+        let sampler = EnvSampler::new(&map).unwrap();
+        let total: f32 = (0..map.height())
+            .flat_map(|j| (0..map.width()).map(move |i| (i, j)))
+            .map(|(i, j)| sampler.pdf(map.texel_direction(i, j)) * map.texel_solid_angle(j))
+            .sum();
+        assert!((total - 1.0).abs() < 1e-3, "{total}");
+        assert!(EnvSampler::new(&EnvMap::uniform(8, 4, Rgb::ZERO)).is_none());
+    }
+}

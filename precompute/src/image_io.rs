@@ -1,0 +1,180 @@
+//! Image files: linear OpenEXR for radiance, tone-mapped sRGB PNG for display
+//! (CONVENTIONS.md, "Cameras and images"). Every file is written atomically.
+
+use crate::atomic_file::write_atomic;
+use crate::color::Rgb;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum ImageError {
+    #[error("{}: {message}", path.display())]
+    Write { path: PathBuf, message: String },
+    #[error("{}: {message}", path.display())]
+    Read { path: PathBuf, message: String },
+}
+
+/// A linear RGB image, row-major from the top row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RgbImageF32 {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: Vec<Rgb>,
+}
+
+impl RgbImageF32 {
+    pub fn new(width: usize, height: usize, pixels: Vec<Rgb>) -> Self {
+        assert_eq!(pixels.len(), width * height);
+        Self {
+            width,
+            height,
+            pixels,
+        }
+    }
+
+    pub fn filled(width: usize, height: usize, value: Rgb) -> Self {
+        Self::new(width, height, vec![value; width * height])
+    }
+
+    #[inline]
+    pub fn get(&self, x: usize, y: usize) -> Rgb {
+        self.pixels[y * self.width + x]
+    }
+}
+
+/// `y = 1 - exp(-exposure · c)` per channel (linear, before sRGB encoding).
+#[inline]
+pub fn tonemap(c: Rgb, exposure: f32) -> Rgb {
+    Rgb::ONE - (-exposure * c.max(Rgb::ZERO)).exp()
+}
+
+/// The sRGB transfer function of a linear value in [0, 1].
+#[inline]
+pub fn srgb_encode(x: f32) -> f32 {
+    let x = x.clamp(0.0, 1.0);
+    if x <= 0.0031308 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Tone-mapped, sRGB-encoded 8-bit pixels.
+pub fn to_display_rgb8(image: &RgbImageF32, exposure: f32) -> Vec<u8> {
+    image
+        .pixels
+        .iter()
+        .flat_map(|p| {
+            tonemap(*p, exposure)
+                .to_array()
+                .map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8)
+        })
+        .collect()
+}
+
+/// Writes 8-bit RGB pixels as a PNG.
+pub fn write_png_rgb8(
+    path: &Path,
+    width: usize,
+    height: usize,
+    rgb: &[u8],
+) -> Result<(), ImageError> {
+    let error = |message: String| ImageError::Write {
+        path: path.to_owned(),
+        message,
+    };
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(
+            rgb,
+            width as u32,
+            height as u32,
+            image::ExtendedColorType::Rgb8,
+        )
+        .map_err(|e| error(e.to_string()))?;
+    write_atomic(path, &bytes).map_err(|e| error(e.to_string()))
+}
+
+use image::ImageEncoder;
+
+/// Tone maps with `exposure` and writes an sRGB PNG.
+pub fn write_png(path: &Path, image: &RgbImageF32, exposure: f32) -> Result<(), ImageError> {
+    write_png_rgb8(
+        path,
+        image.width,
+        image.height,
+        &to_display_rgb8(image, exposure),
+    )
+}
+
+/// Writes linear radiance as a 32-bit float, ZIP-compressed OpenEXR.
+pub fn write_exr(path: &Path, image: &RgbImageF32) -> Result<(), ImageError> {
+    use exr::prelude::*;
+    let error = |message: String| ImageError::Write {
+        path: path.to_owned(),
+        message,
+    };
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let c = image.get(p.x(), p.y());
+        (c.x, c.y, c.z)
+    });
+    let layer = Layer::new(
+        (image.width, image.height),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        channels,
+    );
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| error(e.to_string()))?;
+    write_atomic(path, bytes.get_ref()).map_err(|e| error(e.to_string()))
+}
+
+/// Reads the RGB channels of an OpenEXR file.
+pub fn read_exr(path: &Path) -> Result<RgbImageF32, ImageError> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| RgbImageF32::filled(resolution.width(), resolution.height(), Rgb::ZERO),
+        |image: &mut RgbImageF32, p, (r, g, b, _a): (f32, f32, f32, f32)| {
+            let width = image.width;
+            image.pixels[p.y() * width + p.x()] = Rgb::new(r, g, b);
+        },
+    )
+    .map_err(|e| ImageError::Read {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })?;
+    Ok(image.layer_data.channel_data.pixels)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trip_is_exact() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.exr");
+        let pixels = (0..12)
+            .map(|i| Rgb::new(i as f32, 0.5 * i as f32, 1e4))
+            .collect();
+        let image = RgbImageF32::new(4, 3, pixels);
+        write_exr(&path, &image).unwrap();
+        assert_eq!(read_exr(&path).unwrap(), image);
+    }
+
+    #[test]
+    fn tonemap_and_srgb() {
+        assert_eq!(tonemap(Rgb::ZERO, 1.0), Rgb::ZERO);
+        assert!((tonemap(Rgb::ONE, 1.0).x - (1.0 - (-1.0f32).exp())).abs() < 1e-6);
+        assert!((srgb_encode(1.0) - 1.0).abs() < 1e-6);
+        assert!((srgb_encode(0.5) - 0.7353569).abs() < 1e-5);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.png");
+        write_png(&path, &RgbImageF32::filled(3, 2, Rgb::ONE), 1.0).unwrap();
+        let back = image::open(&path).unwrap().into_rgb8();
+        assert_eq!(back.dimensions(), (3, 2));
+    }
+}

@@ -1,0 +1,564 @@
+//! Decomposition of an environment map into a low-order SH polynomial plus directional lights
+//! at its concentrated sources (thesis 4.3.3):
+//!
+//! 1. smooth the cube map with a spherical Gaussian ([`smoothing`]),
+//! 2. sample it on a subdivided icosahedron ([`icosphere`]),
+//! 3. project the cube map onto SH and window the coefficients ([`projection`], [`window`]),
+//! 4. find the local maxima of the residual by hill climbing, refine them with a tangent-plane
+//!    quadric ([`peaks`]), and keep as many as the Weber-law elbow allows ([`weber`]).
+//!
+//! Two ways of turning the peaks into lights ([`DecomposeMode`]): the thesis' own, and an
+//! energy-consistent one in which the lights carry exactly the map's energy in their caps and
+//! the SH part is refitted to what remains.
+
+pub mod icosphere;
+pub mod peaks;
+pub mod projection;
+pub mod smoothing;
+pub mod visualize;
+pub mod weber;
+pub mod window;
+
+use crate::cubemap::{CubeGeometry, CubeMap};
+use crate::light::DirectionalLight;
+use glam::Vec3;
+use icosphere::Icosphere;
+use precompute::sh::{ShCoeffs, clamped_cosine_bands};
+use precompute::{Rgb, luminance};
+use projection::{BasisTable, ShProjector};
+use smoothing::GaussianSmoothing;
+use std::f32::consts::PI;
+pub use window::Window;
+
+/// How light power and the SH part are formed from the peaks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DecomposeMode {
+    /// Exactly as the thesis: the SH part is the windowed projection of the whole map and a
+    /// light's power is `2π(1 − cos R)(λ_i − P(Ξ_i))`.
+    Thesis,
+    /// Energy-consistent: a light's power is the map's excess over the SH part inside its cap,
+    /// and the SH part is fitted to the map with that excess removed, so the two integrate to
+    /// the map's total.
+    Consistent,
+}
+
+impl std::str::FromStr for DecomposeMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "thesis" => Ok(DecomposeMode::Thesis),
+            "consistent" => Ok(DecomposeMode::Consistent),
+            _ => Err(format!(
+                "unknown decomposition mode {s:?} (thesis, consistent)"
+            )),
+        }
+    }
+}
+
+impl DecomposeMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            DecomposeMode::Thesis => "thesis",
+            DecomposeMode::Consistent => "consistent",
+        }
+    }
+}
+
+/// Parameters of the decomposition.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DecomposeSettings {
+    pub mode: DecomposeMode,
+    /// SH order of the polynomial part.
+    pub order: usize,
+    /// Cube-map face resolution.
+    pub face_size: usize,
+    /// Subdivision level of the icosahedron (level 4: 2562 vertices, about 4° apart).
+    pub ico_level: u32,
+    /// Standard deviation of the smoothing Gaussian, in degrees.
+    pub smoothing_deg: f32,
+    /// Radius R of the SRBFs / light caps, in degrees.
+    pub radius_deg: f32,
+    /// Weber fraction: a light is kept while it adds more than this share of the luminance of
+    /// the lights before it.
+    pub threshold: f32,
+    /// Upper bound on the number of lights.
+    pub max_lights: usize,
+    /// A peak counts only if its residual exceeds this multiple of the map's mean luminance.
+    pub min_contrast: f32,
+    /// Window of the SH part; `None` uses the mode's default (Hanning for `thesis`, none for
+    /// `consistent`, whose SH part no longer contains the sources that ring).
+    pub window: Option<Window>,
+}
+
+impl Default for DecomposeSettings {
+    fn default() -> Self {
+        Self {
+            mode: DecomposeMode::Consistent,
+            order: 5,
+            face_size: 64,
+            ico_level: 4,
+            smoothing_deg: 2.0,
+            radius_deg: 8.0,
+            threshold: 0.05,
+            max_lights: 8,
+            min_contrast: 1.0,
+            window: None,
+        }
+    }
+}
+
+/// Most peaks considered per frame (the brightest residual maxima).
+const MAX_CANDIDATES: usize = 24;
+/// Fixed-point iterations of the consistent mode's refit.
+const CONSISTENT_ITERATIONS: usize = 3;
+/// The window used to find peaks (and for the thesis' SH part).
+const DETECTION_WINDOW: Window = Window::Hanning;
+
+impl DecomposeSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        precompute::sh::check_order(self.order).map_err(|e| e.to_string())?;
+        if !(4..=1024).contains(&self.face_size) {
+            return Err(format!("face size {} outside 4..=1024", self.face_size));
+        }
+        if self.ico_level > 7 {
+            return Err(format!("icosahedron level {} above 7", self.ico_level));
+        }
+        if !(self.radius_deg > 0.0 && self.radius_deg <= 45.0) {
+            return Err(format!("radius {}° outside (0, 45]", self.radius_deg));
+        }
+        if !(self.smoothing_deg > 0.0 && self.smoothing_deg <= 30.0) {
+            return Err(format!("smoothing {}° outside (0, 30]", self.smoothing_deg));
+        }
+        if !(0.0..=1.0).contains(&self.threshold) {
+            return Err(format!("threshold {} outside [0, 1]", self.threshold));
+        }
+        if self.min_contrast.is_nan() || self.min_contrast < 0.0 {
+            return Err(format!("min contrast {} is negative", self.min_contrast));
+        }
+        Ok(())
+    }
+
+    /// The window actually applied to the SH part.
+    pub fn sh_window(&self) -> Window {
+        self.window.unwrap_or(match self.mode {
+            DecomposeMode::Thesis => Window::Hanning,
+            DecomposeMode::Consistent => Window::None,
+        })
+    }
+}
+
+/// The result: SH part plus lights.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Decomposition {
+    /// The polynomial part (what the PRT pass is lit by).
+    pub sh: ShCoeffs<Rgb>,
+    /// Lights, brightest first.
+    pub lights: Vec<DirectionalLight>,
+    /// `∫ L dω` of the map.
+    pub total_power: Rgb,
+    /// Peaks that passed the contrast test (before the Weber elbow).
+    pub candidates: usize,
+}
+
+impl Decomposition {
+    /// Unshadowed Lambertian irradiance of SH part plus lights for unit normal `n`.
+    pub fn irradiance(&self, n: Vec3) -> Rgb {
+        let mut sh = self.sh.clone();
+        sh.scale_bands(&clamped_cosine_bands(sh.order()));
+        let lights: Rgb = self.lights.iter().map(|l| l.irradiance(n)).sum();
+        sh.eval(n) + lights
+    }
+
+    /// `∫` of SH part plus lights over the sphere.
+    pub fn total(&self) -> Rgb {
+        self.sh.as_slice()[0] * (4.0 * PI).sqrt() + self.lights.iter().map(|l| l.power).sum::<Rgb>()
+    }
+}
+
+/// A residual maximum after refinement.
+#[derive(Debug, Clone, Copy)]
+struct Peak {
+    direction: Vec3,
+    /// Residual luminance at the refined maximum.
+    value: f32,
+    /// Residual RGB at the refined maximum.
+    rgb: Rgb,
+}
+
+/// Face size of the analysis (smoothing, peak search, projection). SH of order ≤ 20 and a
+/// smoothing kernel of a few degrees lose nothing at this resolution; larger input maps are
+/// box-filtered down to it (solid-angle weighted, so integrals are kept), while light caps are
+/// still measured on the full-resolution map.
+pub const ANALYSIS_FACE_SIZE: usize = 64;
+
+/// Everything about the decomposition that does not depend on the map, computed once.
+pub struct Decomposer {
+    settings: DecomposeSettings,
+    /// The input maps' geometry.
+    geometry: CubeGeometry,
+    /// For each analysis texel, the input texels it averages (empty when not downsampling).
+    downsample: Vec<(Vec<u32>, Vec<f32>)>,
+    analysis_map: CubeMap,
+    basis: precompute::sh::ShBasis<f32>,
+    ico: Icosphere,
+    smoothing: GaussianSmoothing,
+    projector: ShProjector,
+    ico_basis: BasisTable,
+    detection_window: Vec<f32>,
+    sh_window: Vec<f32>,
+    // Per-frame scratch buffers.
+    smoothed: Vec<Rgb>,
+    ring: Vec<u32>,
+    cap: Vec<u32>,
+    owner: Vec<(u16, f32)>,
+    member_basis: Vec<f32>,
+}
+
+impl Decomposer {
+    pub fn new(settings: DecomposeSettings) -> Result<Self, String> {
+        settings.validate()?;
+        let geometry = CubeGeometry::new(settings.face_size);
+        let n = settings.face_size;
+        let a = if n > ANALYSIS_FACE_SIZE && n.is_multiple_of(ANALYSIS_FACE_SIZE) {
+            ANALYSIS_FACE_SIZE
+        } else {
+            n
+        };
+        let analysis = CubeGeometry::new(a);
+        let downsample = if a == n {
+            Vec::new()
+        } else {
+            downsample_blocks(&geometry, a)
+        };
+        let ico = Icosphere::new(settings.ico_level);
+        let smoothing = GaussianSmoothing::new(
+            &analysis,
+            &ico.vertices,
+            settings.smoothing_deg.to_radians(),
+        );
+        let projector = ShProjector::new(&analysis, settings.order);
+        let ico_basis = BasisTable::new(settings.order, &ico.vertices);
+        let texels = geometry.texel_count();
+        Ok(Self {
+            analysis_map: CubeMap::uniform(a, Rgb::ZERO),
+            downsample,
+            basis: precompute::sh::ShBasis::new(settings.order).map_err(|e| e.to_string())?,
+            member_basis: Vec::new(),
+            detection_window: DETECTION_WINDOW.factors(settings.order),
+            sh_window: settings.sh_window().factors(settings.order),
+            settings,
+            geometry,
+            ico,
+            smoothing,
+            projector,
+            ico_basis,
+            smoothed: Vec::new(),
+            ring: Vec::new(),
+            cap: Vec::new(),
+            owner: vec![(u16::MAX, 0.0); texels],
+        })
+    }
+
+    pub fn settings(&self) -> &DecomposeSettings {
+        &self.settings
+    }
+
+    pub fn geometry(&self) -> &CubeGeometry {
+        &self.geometry
+    }
+
+    pub fn icosphere(&self) -> &Icosphere {
+        &self.ico
+    }
+
+    /// Plain (unwindowed) SH projection of the whole map: the thesis' PRT baseline lighting.
+    pub fn project(&mut self, map: &CubeMap) -> ShCoeffs<Rgb> {
+        self.prepare_analysis(map);
+        self.projector.project(self.analysis_map(map))
+    }
+
+    /// Box-filters `map` to the analysis resolution (when it is larger).
+    fn prepare_analysis(&mut self, map: &CubeMap) {
+        if self.downsample.is_empty() {
+            return;
+        }
+        let texels = map.texels();
+        for (out, (members, weights)) in self
+            .analysis_map
+            .texels_mut()
+            .iter_mut()
+            .zip(&self.downsample)
+        {
+            *out = members
+                .iter()
+                .zip(weights)
+                .map(|(t, w)| texels[*t as usize] * *w)
+                .sum();
+        }
+    }
+
+    fn analysis_map<'a>(&'a self, map: &'a CubeMap) -> &'a CubeMap {
+        if self.downsample.is_empty() {
+            map
+        } else {
+            &self.analysis_map
+        }
+    }
+
+    /// Decomposes `map` (a cube map of the configured face size).
+    pub fn decompose(&mut self, map: &CubeMap) -> Decomposition {
+        assert_eq!(
+            map.size(),
+            self.settings.face_size,
+            "cube map of the wrong size"
+        );
+        let total_power = map.total_power(&self.geometry);
+        self.prepare_analysis(map);
+        let full = self.projector.project(self.analysis_map(map));
+        let mut detection = full.clone();
+        detection.scale_bands(&self.detection_window);
+        let peaks = self.find_peaks(map, &detection, luminance(total_power) / (4.0 * PI));
+        let candidates = peaks.len();
+        let (sh, mut lights) = match self.settings.mode {
+            DecomposeMode::Thesis => (detection, self.thesis_lights(&peaks)),
+            DecomposeMode::Consistent => self.consistent_lights(map, &full, &peaks),
+        };
+        let total_luminance = luminance(total_power).max(f32::MIN_POSITIVE);
+        for light in &mut lights {
+            light.share = luminance(light.power) / total_luminance;
+        }
+        Decomposition {
+            sh,
+            lights,
+            total_power,
+            candidates,
+        }
+    }
+
+    /// Steps 1, 2 and 4: smoothed map minus SH part on the icosahedron, its significant local
+    /// maxima, refined; brightest first.
+    fn find_peaks(
+        &mut self,
+        map: &CubeMap,
+        detection: &ShCoeffs<Rgb>,
+        mean_luminance: f32,
+    ) -> Vec<Peak> {
+        let analysis = if self.downsample.is_empty() {
+            map
+        } else {
+            &self.analysis_map
+        };
+        self.smoothing.apply(analysis, &mut self.smoothed);
+        let residual_rgb: Vec<Rgb> = self
+            .smoothed
+            .iter()
+            .enumerate()
+            .map(|(v, s)| *s - self.ico_basis.eval(detection, v))
+            .collect();
+        let residual: Vec<f32> = residual_rgb.iter().map(|r| luminance(*r)).collect();
+        let floor = self.settings.min_contrast * mean_luminance;
+        let mut maxima: Vec<u32> = self
+            .ico
+            .hill_climb_maxima(&residual)
+            .into_iter()
+            .filter(|&v| residual[v as usize] > floor && residual[v as usize] > 0.0)
+            .collect();
+        maxima.sort_by(|a, b| residual[*b as usize].total_cmp(&residual[*a as usize]));
+        maxima.truncate(MAX_CANDIDATES);
+        let mut peaks: Vec<Peak> = maxima
+            .into_iter()
+            .map(|v| {
+                let (direction, value) =
+                    peaks::refine_peak(&self.ico, &residual, v, &mut self.ring);
+                let at_vertex = residual[v as usize];
+                Peak {
+                    direction,
+                    value,
+                    rgb: residual_rgb[v as usize] * (value / at_vertex),
+                }
+            })
+            .collect();
+        peaks.sort_by(|a, b| b.value.total_cmp(&a.value));
+        peaks
+    }
+
+    fn keep_count(&self, luminances: &[f32]) -> usize {
+        weber::weber_elbow(luminances, self.settings.threshold).min(self.settings.max_lights)
+    }
+
+    /// Thesis: power `2π(1 − cos R)(λ_i − P(Ξ_i))` per light.
+    fn thesis_lights(&self, peaks: &[Peak]) -> Vec<DirectionalLight> {
+        let radius = self.settings.radius_deg.to_radians();
+        let cap = 2.0 * PI * (1.0 - radius.cos());
+        let values: Vec<f32> = peaks.iter().map(|p| p.value).collect();
+        peaks[..self.keep_count(&values)]
+            .iter()
+            .map(|p| DirectionalLight {
+                direction: p.direction,
+                power: p.rgb.max(Rgb::ZERO) * cap,
+                cap_radius: radius,
+                angular_radius: radius,
+                share: 0.0,
+            })
+            .collect()
+    }
+
+    /// Consistent: lights carry the map's excess over the SH part in their caps; the SH part is
+    /// the projection of what remains.
+    fn consistent_lights(
+        &mut self,
+        map: &CubeMap,
+        full: &ShCoeffs<Rgb>,
+        peaks: &[Peak],
+    ) -> (ShCoeffs<Rgb>, Vec<DirectionalLight>) {
+        let centres: Vec<Vec3> = peaks.iter().map(|p| p.direction).collect();
+        // One refit step is enough to rank the candidates.
+        let (_, trial) = self.extract(map, full, &centres, 1);
+        let mut order: Vec<usize> = (0..trial.len())
+            .filter(|&i| luminance(trial[i].power) > 0.0)
+            .collect();
+        order.sort_by(|a, b| luminance(trial[*b].power).total_cmp(&luminance(trial[*a].power)));
+        let luminances: Vec<f32> = order.iter().map(|&i| luminance(trial[i].power)).collect();
+        let kept: Vec<Vec3> = order[..self.keep_count(&luminances)]
+            .iter()
+            .map(|&i| centres[i])
+            .collect();
+        let (mut sh, mut lights) = self.extract(map, full, &kept, CONSISTENT_ITERATIONS);
+        sh.scale_bands(&self.sh_window);
+        lights.retain(|l| luminance(l.power) > 0.0);
+        lights.sort_by(|a, b| luminance(b.power).total_cmp(&luminance(a.power)));
+        (sh, lights)
+    }
+
+    /// For caps of radius R around `centres`: the excess `max(0, L − P)` of the map over the SH
+    /// part `P`, where `P` is refitted to the map minus that excess (a few fixed-point steps).
+    /// Texels in several caps belong to the nearest centre. Returns the final `P` and one light
+    /// per centre.
+    fn extract(
+        &mut self,
+        map: &CubeMap,
+        full: &ShCoeffs<Rgb>,
+        centres: &[Vec3],
+        iterations: usize,
+    ) -> (ShCoeffs<Rgb>, Vec<DirectionalLight>) {
+        let radius = self.settings.radius_deg.to_radians();
+        // Assign cap texels to their nearest centre.
+        let mut members: Vec<u32> = Vec::new();
+        for (i, c) in centres.iter().enumerate() {
+            self.geometry.texels_within(*c, radius, &mut self.cap);
+            for &t in &self.cap {
+                let cos = self.geometry.directions()[t as usize].dot(*c);
+                let slot = &mut self.owner[t as usize];
+                if slot.0 == u16::MAX {
+                    members.push(t);
+                    *slot = (i as u16, cos);
+                } else if cos > slot.1 {
+                    *slot = (i as u16, cos);
+                }
+            }
+        }
+        let texels = map.texels();
+        // SH basis at the cap texels, evaluated once per frame.
+        let n = self.basis.num_coeffs();
+        self.member_basis.resize(members.len() * n, 0.0);
+        for (row, &t) in self.member_basis.chunks_exact_mut(n).zip(&members) {
+            self.basis.eval(self.geometry.directions()[t as usize], row);
+        }
+        let mut sh = full.clone();
+        let mut excess: Vec<Rgb> = vec![Rgb::ZERO; members.len()];
+        for _ in 0..iterations {
+            for ((e, &t), y) in excess
+                .iter_mut()
+                .zip(&members)
+                .zip(self.member_basis.chunks_exact(n))
+            {
+                *e = (texels[t as usize] - sh.dot_basis(y)).max(Rgb::ZERO);
+            }
+            // P = SH(map) − SH(excess).
+            sh = full.clone();
+            for ((e, &t), y) in excess
+                .iter()
+                .zip(&members)
+                .zip(self.member_basis.chunks_exact(n))
+            {
+                let weighted = *e * self.geometry.solid_angles()[t as usize];
+                for (c, yk) in sh.as_mut_slice().iter_mut().zip(y) {
+                    *c -= weighted * *yk;
+                }
+            }
+        }
+        // Each light: power, luminance-weighted centroid and spread of its excess.
+        let mut power = vec![Rgb::ZERO; centres.len()];
+        let mut moment = vec![Vec3::ZERO; centres.len()];
+        for (e, &t) in excess.iter().zip(&members) {
+            let i = self.owner[t as usize].0 as usize;
+            let d_omega = self.geometry.solid_angles()[t as usize];
+            power[i] += *e * d_omega;
+            moment[i] += self.geometry.directions()[t as usize] * (luminance(*e) * d_omega);
+        }
+        let directions: Vec<Vec3> = moment
+            .iter()
+            .zip(centres)
+            .map(|(m, c)| m.try_normalize().unwrap_or(*c))
+            .collect();
+        let mut spread = vec![0.0f32; centres.len()];
+        for (e, &t) in excess.iter().zip(&members) {
+            let i = self.owner[t as usize].0 as usize;
+            let theta = self.geometry.directions()[t as usize].angle_between(directions[i]);
+            spread[i] += theta * theta * luminance(*e) * self.geometry.solid_angles()[t as usize];
+        }
+        for &t in &members {
+            self.owner[t as usize] = (u16::MAX, 0.0);
+        }
+        let lights = (0..centres.len())
+            .map(|i| {
+                let lum = luminance(power[i]);
+                // A uniform disc of radius ρ has E[θ²] = ρ²/2.
+                let rho = if lum > 0.0 {
+                    (2.0 * spread[i] / lum).sqrt()
+                } else {
+                    0.0
+                };
+                DirectionalLight {
+                    direction: directions[i],
+                    power: power[i],
+                    cap_radius: radius,
+                    angular_radius: rho.clamp(0.25f32.to_radians(), radius),
+                    share: 0.0,
+                }
+            })
+            .collect();
+        (sh, lights)
+    }
+}
+
+/// For each texel of an `analysis`-sized cube map, the `k × k` block of input texels it covers
+/// and their solid-angle weights (normalised to sum to 1), `k = input / analysis`.
+fn downsample_blocks(input: &CubeGeometry, analysis: usize) -> Vec<(Vec<u32>, Vec<f32>)> {
+    let n = input.size();
+    let k = n / analysis;
+    let mut out = Vec::with_capacity(6 * analysis * analysis);
+    for face in 0..6 {
+        for y in 0..analysis {
+            for x in 0..analysis {
+                let members: Vec<u32> = (0..k * k)
+                    .map(|i| ((face * n + y * k + i / k) * n + x * k + i % k) as u32)
+                    .collect();
+                let total: f32 = members
+                    .iter()
+                    .map(|t| input.solid_angles()[*t as usize])
+                    .sum();
+                let weights = members
+                    .iter()
+                    .map(|t| input.solid_angles()[*t as usize] / total)
+                    .collect();
+                out.push((members, weights));
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests;
