@@ -18,6 +18,10 @@ enum Command {
     Bake(commands::bake::BakeArgs),
     /// Decompose an environment map into an SH polynomial plus directional lights.
     Decompose(commands::decompose::DecomposeArgs),
+    /// Render the CPU path-traced reference of a scene.
+    Reference(commands::reference::ReferenceArgs),
+    /// Write the scene as a Mitsuba 3 scene, to cross-check the reference.
+    Export(commands::export::ExportArgs),
     /// Benchmarks anyone can rerun (bake throughput, ...).
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
@@ -41,6 +45,8 @@ fn main() {
         Command::Bake(args) => commands::bake::run(args),
         Command::Bench(cmd) => commands::bench::run(cmd),
         Command::Decompose(args) => commands::decompose::run(args),
+        Command::Reference(args) => commands::reference::run(args),
+        Command::Export(args) => commands::export::run(args),
     };
     if let Err(error) = result {
         eprintln!("error: {error:#}");

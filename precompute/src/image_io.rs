@@ -108,11 +108,16 @@ pub fn write_png(path: &Path, image: &RgbImageF32, exposure: f32) -> Result<(), 
 
 /// Writes linear radiance as a 32-bit float, ZIP-compressed OpenEXR.
 pub fn write_exr(path: &Path, image: &RgbImageF32) -> Result<(), ImageError> {
-    use exr::prelude::*;
     let error = |message: String| ImageError::Write {
         path: path.to_owned(),
         message,
     };
+    write_atomic(path, &exr_bytes(image).map_err(error)?).map_err(|e| error(e.to_string()))
+}
+
+/// The OpenEXR file of an image, in memory (32-bit float RGB, ZIP compression).
+pub fn exr_bytes(image: &RgbImageF32) -> Result<Vec<u8>, String> {
+    use exr::prelude::*;
     let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
         let c = image.get(p.x(), p.y());
         (c.x, c.y, c.z)
@@ -127,8 +132,8 @@ pub fn write_exr(path: &Path, image: &RgbImageF32) -> Result<(), ImageError> {
     Image::from_layer(layer)
         .write()
         .to_buffered(&mut bytes)
-        .map_err(|e| error(e.to_string()))?;
-    write_atomic(path, bytes.get_ref()).map_err(|e| error(e.to_string()))
+        .map_err(|e| e.to_string())?;
+    Ok(bytes.into_inner())
 }
 
 /// Reads the RGB channels of an OpenEXR file.

@@ -6,9 +6,11 @@
 
 pub mod color;
 pub mod envmap;
+pub mod export;
 pub mod image_io;
 pub mod mesh;
 pub mod quadrature;
+pub mod reference;
 pub mod sampling;
 pub mod sh;
 

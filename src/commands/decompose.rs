@@ -73,7 +73,7 @@ pub struct DecomposeArgs {
     #[arg(long)]
     pub layout: Option<Layout>,
     /// Rotation of the map about +Y in degrees (counter-clockwise seen from above).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
     pub rotate: f32,
     #[command(flatten)]
     pub options: DecomposeOptions,

@@ -3,6 +3,8 @@
 pub mod bake;
 pub mod bench;
 pub mod decompose;
+pub mod export;
+pub mod reference;
 
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -41,4 +43,41 @@ pub fn progress_bar(length: u64, what: &str) -> ProgressBar {
         .progress_chars("=> "),
     );
     bar
+}
+
+/// The environment a command lights a scene with: `--env` or the scene's default map, and
+/// `--rotate` or the scene's rotation.
+pub struct ChosenEnvironment {
+    pub path: std::path::PathBuf,
+    pub loaded: precompute::envmap::LoadedEnvMap,
+    pub rotation_deg: f32,
+}
+
+pub fn choose_environment(
+    scene: &Scene,
+    env: Option<&Path>,
+    layout: Option<precompute::envmap::Layout>,
+    rotate: Option<f32>,
+) -> anyhow::Result<ChosenEnvironment> {
+    let (path, scene_rotation) = match (env, &scene.environment) {
+        (Some(path), _) => (path.to_owned(), 0.0),
+        (None, Some(spec)) => (spec.map.clone(), spec.rotation_deg),
+        (None, None) => anyhow::bail!(
+            "{} names no [environment]; pass --env MAP",
+            scene.path.display()
+        ),
+    };
+    let loaded = decompose::load_map(&path, layout)?;
+    Ok(ChosenEnvironment {
+        path,
+        loaded,
+        rotation_deg: rotate.unwrap_or(scene_rotation),
+    })
+}
+
+/// The default tone-mapping exposure for a map: a white Lambertian surface seeing the whole
+/// environment (radiance = the map's mean luminance) maps to `1 - e^(-1/2)` (about 0.39
+/// linear, 0.66 after sRGB encoding), leaving headroom for sunlit surfaces.
+pub fn default_exposure(map: &precompute::envmap::EnvMap) -> f32 {
+    0.5 / map.mean_luminance().max(1e-6)
 }

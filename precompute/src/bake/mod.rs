@@ -107,6 +107,56 @@ impl BakeStats {
 /// Where the ray-epsilon scale of a scene comes from: a fraction of its bounding-box diagonal.
 pub const RAY_OFFSET_FRACTION: f32 = 1e-5;
 
+/// The result of the tracing pass: the direct transfer and the interreflection operator, from
+/// which any number of bounces follows without tracing again.
+pub struct TracedScene {
+    pub direct: TransferVectors,
+    pub operator: InterreflectionOperator,
+    /// Seconds the tracing took.
+    pub seconds: f64,
+}
+
+impl TracedScene {
+    /// The indirect transfer after each of `bounces` Neumann-series steps: item `b` is
+    /// `Σ_{k=1..b+1} (diag(ρ) W)^k T_direct`.
+    pub fn cumulative_indirect<'a>(
+        &'a self,
+        albedo: &'a [crate::color::Rgb],
+        bounces: u32,
+    ) -> impl Iterator<Item = TransferVectors> + 'a {
+        let order = self.direct.order();
+        let mut previous = self.direct.clone();
+        let mut sum = TransferVectors::zeros(order, self.direct.vertex_count());
+        (0..bounces).map(move |_| {
+            previous = self.operator.apply(&previous, albedo);
+            for (acc, x) in sum.as_mut_slice().iter_mut().zip(previous.as_slice()) {
+                *acc += x;
+            }
+            sum.clone()
+        })
+    }
+}
+
+/// Traces every (vertex, sample) ray once: the direct transfer and the interreflection
+/// operator. `progress` counts vertices.
+pub fn trace(
+    geometry: &SceneMesh,
+    bvh: &SceneBvh,
+    settings: &BakeSettings,
+    progress: &ProgressBar,
+) -> Result<TracedScene, String> {
+    settings.validate()?;
+    let start = Instant::now();
+    progress.set_length(geometry.mesh.vertex_count() as u64);
+    let traced = visibility::trace_vertices(geometry, bvh, settings, progress);
+    let direct = traced.direct_transfer(&geometry.albedo, settings.order);
+    Ok(TracedScene {
+        direct,
+        operator: traced.operator,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
 /// Bakes the transfer of every vertex of `geometry`. `progress` counts vertices of the
 /// tracing pass (pass `ProgressBar::hidden()` for none).
 pub fn bake(
@@ -115,42 +165,35 @@ pub fn bake(
     settings: &BakeSettings,
     progress: &ProgressBar,
 ) -> Result<(Transfer, BakeStats), String> {
-    settings.validate()?;
     let start = Instant::now();
+    let traced = trace(geometry, bvh, settings, progress)?;
     let vertex_count = geometry.mesh.vertex_count();
-    progress.set_length(vertex_count as u64);
-
-    let traced = visibility::trace_vertices(geometry, bvh, settings, progress);
-    let direct_seconds = start.elapsed().as_secs_f64();
-
     let mut stats = BakeStats {
         vertices: vertex_count,
         rays: vertex_count as u64 * settings.samples as u64,
-        direct_seconds,
+        direct_seconds: traced.seconds,
         operator_entries: traced.operator.entries(),
         ..Default::default()
     };
-    let direct = traced.direct_transfer(&geometry.albedo, settings.order);
     let mut indirect = TransferVectors::zeros(settings.order, vertex_count);
-    let mut previous = direct.clone();
-    for bounce in 0..settings.bounces {
-        progress.set_message(format!("bounce {}/{}", bounce + 1, settings.bounces));
-        let bounce_start = Instant::now();
-        let next = traced.operator.apply(&previous, &geometry.albedo);
-        for (acc, x) in indirect.as_mut_slice().iter_mut().zip(next.as_slice()) {
-            *acc += x;
-        }
-        previous = next;
+    let mut bounce_start = Instant::now();
+    for (bounce, sum) in traced
+        .cumulative_indirect(&geometry.albedo, settings.bounces)
+        .enumerate()
+    {
         stats
             .bounce_seconds
             .push(bounce_start.elapsed().as_secs_f64());
+        progress.set_message(format!("bounce {}/{}", bounce + 1, settings.bounces));
+        indirect = sum;
+        bounce_start = Instant::now();
     }
     stats.total_seconds = start.elapsed().as_secs_f64();
     progress.finish_and_clear();
     Ok((
         Transfer {
             settings: *settings,
-            direct,
+            direct: traced.direct,
             indirect,
         },
         stats,

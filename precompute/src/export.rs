@@ -1,0 +1,321 @@
+//! The scene exactly as hprt sees it, as a Mitsuba 3 scene, so anyone can cross-check the
+//! reference renderer against an independent one. See the README's "Cross-checking with
+//! Mitsuba 3" for the mapping.
+
+use crate::atomic_file::write_atomic;
+use crate::camera::Camera;
+use crate::envmap::EnvMap;
+use crate::image_io::{RgbImageF32, write_exr};
+use crate::mesh::TriangleMesh;
+use crate::scene::SceneMesh;
+use ply_rs_bw::ply::{
+    Addable, DefaultElement, ElementDef, Encoding, Ply, Property, PropertyDef, PropertyType,
+    ScalarType,
+};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    #[error("{}: {message}", path.display())]
+    Write { path: PathBuf, message: String },
+}
+
+/// What the exported scene renders.
+#[derive(Debug, Clone)]
+pub struct ExportSettings {
+    pub camera: Camera,
+    pub rotation_deg: f32,
+    pub spp: u32,
+    pub bounces: u32,
+}
+
+/// Mitsuba's `max_depth` for hprt's `bounces`: depth 1 is the directly visible environment,
+/// depth 2 adds direct lighting, each further level one indirect bounce.
+pub fn mitsuba_max_depth(bounces: u32) -> u32 {
+    bounces + 2
+}
+
+/// A binary little-endian PLY with positions and normals.
+pub fn ply_bytes(mesh: &TriangleMesh) -> Vec<u8> {
+    let mut ply = Ply::<DefaultElement>::new();
+    ply.header.encoding = Encoding::BinaryLittleEndian;
+    ply.header
+        .comments
+        .push("exported by hprt (world space)".into());
+    let mut vertex = ElementDef::new("vertex".into());
+    for name in ["x", "y", "z", "nx", "ny", "nz"] {
+        vertex.properties.add(PropertyDef::new(
+            name.into(),
+            PropertyType::Scalar(ScalarType::Float),
+        ));
+    }
+    ply.header.elements.add(vertex);
+    let mut face = ElementDef::new("face".into());
+    face.properties.add(PropertyDef::new(
+        "vertex_indices".into(),
+        PropertyType::List(ScalarType::UChar, ScalarType::UInt),
+    ));
+    ply.header.elements.add(face);
+    let vertices = mesh
+        .positions
+        .iter()
+        .zip(&mesh.normals)
+        .map(|(p, n)| {
+            let mut e = DefaultElement::new();
+            for (name, value) in ["x", "y", "z", "nx", "ny", "nz"]
+                .iter()
+                .zip(p.to_array().into_iter().chain(n.to_array()))
+            {
+                e.insert((*name).into(), Property::Float(value));
+            }
+            e
+        })
+        .collect();
+    let faces = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let mut e = DefaultElement::new();
+            e.insert("vertex_indices".into(), Property::ListUInt(t.to_vec()));
+            e
+        })
+        .collect();
+    ply.payload.insert("vertex".into(), vertices);
+    ply.payload.insert("face".into(), faces);
+    let mut out = Vec::new();
+    ply_rs_bw::writer::Writer::new()
+        .write_ply(&mut out, &mut ply)
+        .expect("writing PLY to memory cannot fail");
+    out
+}
+
+/// The sub-mesh of one scene object (its own vertex range).
+fn object_mesh(geometry: &SceneMesh, object: usize) -> TriangleMesh {
+    let o = &geometry.objects[object];
+    let mesh = &geometry.mesh;
+    let (v0, v1) = (o.vertices.start as usize, o.vertices.end as usize);
+    TriangleMesh {
+        positions: mesh.positions[v0..v1].to_vec(),
+        normals: mesh.normals[v0..v1].to_vec(),
+        triangles: mesh.triangles[o.triangles.start as usize..o.triangles.end as usize]
+            .iter()
+            .map(|t| t.map(|i| i - v0 as u32))
+            .collect(),
+    }
+}
+
+fn file_name_for(name: &str, index: usize) -> String {
+    let clean: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("{index:02}_{clean}.ply")
+}
+
+/// The Mitsuba 3 scene description.
+pub fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
+    let c = &settings.camera;
+    let v = |v: glam::Vec3| format!("{}, {}, {}", v.x, v.y, v.z);
+    let mut xml = String::new();
+    let _ = writeln!(xml, "<?xml version=\"1.0\" encoding=\"utf-8\"?>");
+    let _ = writeln!(
+        xml,
+        "<!-- Exported by hprt; see its README, \"Cross-checking with Mitsuba 3\". -->"
+    );
+    let _ = writeln!(xml, "<scene version=\"3.0.0\">");
+    let _ = writeln!(xml, "    <integrator type=\"path\">");
+    let _ = writeln!(
+        xml,
+        "        <!-- hprt bounces = {} -->\n        <integer name=\"max_depth\" value=\"{}\"/>",
+        settings.bounces,
+        mitsuba_max_depth(settings.bounces)
+    );
+    let _ = writeln!(
+        xml,
+        "        <integer name=\"rr_depth\" value=\"{}\"/>",
+        mitsuba_max_depth(settings.bounces) + 1
+    );
+    let _ = writeln!(xml, "    </integrator>");
+    let _ = writeln!(xml, "    <sensor type=\"perspective\">");
+    let _ = writeln!(
+        xml,
+        "        <float name=\"fov\" value=\"{}\"/>",
+        c.fov_y_deg
+    );
+    let _ = writeln!(xml, "        <string name=\"fov_axis\" value=\"y\"/>");
+    let _ = writeln!(xml, "        <transform name=\"to_world\">");
+    let _ = writeln!(
+        xml,
+        "            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>",
+        v(c.position),
+        v(c.target),
+        v(c.up)
+    );
+    let _ = writeln!(xml, "        </transform>");
+    let _ = writeln!(xml, "        <sampler type=\"independent\">");
+    let _ = writeln!(
+        xml,
+        "            <integer name=\"sample_count\" value=\"{}\"/>",
+        settings.spp
+    );
+    let _ = writeln!(xml, "        </sampler>");
+    let _ = writeln!(xml, "        <film type=\"hdrfilm\">");
+    let _ = writeln!(
+        xml,
+        "            <integer name=\"width\" value=\"{}\"/>",
+        c.width
+    );
+    let _ = writeln!(
+        xml,
+        "            <integer name=\"height\" value=\"{}\"/>",
+        c.height
+    );
+    let _ = writeln!(
+        xml,
+        "            <string name=\"pixel_format\" value=\"rgb\"/>"
+    );
+    let _ = writeln!(xml, "            <rfilter type=\"box\"/>");
+    let _ = writeln!(xml, "        </film>");
+    let _ = writeln!(xml, "    </sensor>");
+    let _ = writeln!(xml, "    <emitter type=\"envmap\">");
+    let _ = writeln!(
+        xml,
+        "        <string name=\"filename\" value=\"envmap.exr\"/>"
+    );
+    let _ = writeln!(xml, "        <transform name=\"to_world\">");
+    let _ = writeln!(
+        xml,
+        "            <rotate y=\"1\" angle=\"{}\"/>",
+        settings.rotation_deg
+    );
+    let _ = writeln!(xml, "        </transform>");
+    let _ = writeln!(xml, "    </emitter>");
+    for (i, o) in geometry.objects.iter().enumerate() {
+        let a = o.albedo;
+        let _ = writeln!(
+            xml,
+            "    <shape type=\"ply\" id=\"{}\">",
+            xml_escape(&o.name)
+        );
+        let _ = writeln!(
+            xml,
+            "        <string name=\"filename\" value=\"meshes/{}\"/>",
+            file_name_for(&o.name, i)
+        );
+        let _ = writeln!(
+            xml,
+            "        <boolean name=\"face_normals\" value=\"false\"/>"
+        );
+        let _ = writeln!(xml, "        <bsdf type=\"twosided\">");
+        let _ = writeln!(xml, "            <bsdf type=\"diffuse\">");
+        let _ = writeln!(
+            xml,
+            "                <rgb name=\"reflectance\" value=\"{}, {}, {}\"/>",
+            a.x, a.y, a.z
+        );
+        let _ = writeln!(xml, "            </bsdf>");
+        let _ = writeln!(xml, "        </bsdf>");
+        let _ = writeln!(xml, "    </shape>");
+    }
+    let _ = writeln!(xml, "</scene>");
+    xml
+}
+
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('"', "&quot;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// Writes `dir/scene.xml`, `dir/envmap.exr` and `dir/meshes/*.ply`.
+pub fn export_mitsuba(
+    dir: &Path,
+    geometry: &SceneMesh,
+    map: &EnvMap,
+    settings: &ExportSettings,
+) -> Result<(), ExportError> {
+    let error = |path: &Path, message: String| ExportError::Write {
+        path: path.to_owned(),
+        message,
+    };
+    let meshes = dir.join("meshes");
+    std::fs::create_dir_all(&meshes).map_err(|e| error(&meshes, e.to_string()))?;
+    for i in 0..geometry.objects.len() {
+        let path = meshes.join(file_name_for(&geometry.objects[i].name, i));
+        write_atomic(&path, &ply_bytes(&object_mesh(geometry, i)))
+            .map_err(|e| error(&path, e.to_string()))?;
+    }
+    let env_path = dir.join("envmap.exr");
+    let image = RgbImageF32::new(map.width(), map.height(), map.texels().to_vec());
+    write_exr(&env_path, &image).map_err(|e| error(&env_path, e.to_string()))?;
+    let xml_path = dir.join("scene.xml");
+    write_atomic(&xml_path, scene_xml(geometry, settings).as_bytes())
+        .map_err(|e| error(&xml_path, e.to_string()))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Rgb;
+    use crate::mesh::{LoadOptions, box_mesh, read_mesh};
+    use glam::Vec3;
+
+    #[test]
+    fn exported_ply_reads_back_identically() {
+        let mesh = box_mesh(Vec3::ZERO, Vec3::ONE, [2, 1, 3], [false; 6]);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("box.ply");
+        std::fs::write(&path, ply_bytes(&mesh)).unwrap();
+        let back = read_mesh(&path, &LoadOptions::default()).unwrap();
+        assert_eq!(back.positions, mesh.positions);
+        assert_eq!(back.normals.unwrap(), mesh.normals);
+        assert_eq!(back.triangles, mesh.triangles);
+    }
+
+    #[test]
+    fn scene_xml_names_every_object_and_the_depth() {
+        let mut geometry = SceneMesh::default();
+        geometry.push_object(
+            "table top".into(),
+            &box_mesh(Vec3::ZERO, Vec3::ONE, [1, 1, 1], [false; 6]),
+            Rgb::splat(0.5),
+        );
+        let settings = ExportSettings {
+            camera: Camera {
+                position: Vec3::new(0.0, 1.0, 5.0),
+                target: Vec3::ZERO,
+                up: Vec3::Y,
+                fov_y_deg: 40.0,
+                width: 64,
+                height: 48,
+            },
+            rotation_deg: 30.0,
+            spp: 16,
+            bounces: 3,
+        };
+        let xml = scene_xml(&geometry, &settings);
+        assert!(xml.contains("<integer name=\"max_depth\" value=\"5\"/>"));
+        assert!(xml.contains("meshes/00_table_top.ply"));
+        assert!(xml.contains("<rotate y=\"1\" angle=\"30\"/>"));
+        assert!(xml.contains("<rfilter type=\"box\"/>"));
+        let dir = tempfile::tempdir().unwrap();
+        export_mitsuba(
+            dir.path(),
+            &geometry,
+            &EnvMap::uniform(8, 4, Rgb::ONE),
+            &settings,
+        )
+        .unwrap();
+        assert!(dir.path().join("meshes/00_table_top.ply").exists());
+        assert!(dir.path().join("envmap.exr").exists());
+    }
+}

@@ -1,0 +1,203 @@
+//! Furnace tests, convergence and determinism of the reference renderer.
+
+use super::*;
+use crate::envmap::EnvMap;
+use crate::mesh::{TriangleMesh, box_mesh, sphere_mesh};
+use glam::Vec3;
+
+fn scene_of(objects: &[(&TriangleMesh, Rgb)]) -> SceneMesh {
+    let mut s = SceneMesh::default();
+    for (i, (mesh, albedo)) in objects.iter().enumerate() {
+        s.push_object(format!("o{i}"), mesh, *albedo);
+    }
+    s
+}
+
+fn camera(position: Vec3, target: Vec3, size: u32) -> Camera {
+    Camera {
+        position,
+        target,
+        up: Vec3::Y,
+        fov_y_deg: 40.0,
+        width: size,
+        height: size,
+    }
+}
+
+fn render_simple(
+    geometry: &SceneMesh,
+    map: &EnvMap,
+    cam: &Camera,
+    spp: u32,
+    bounces: u32,
+    seed: u64,
+) -> ReferenceImage {
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let light = EnvironmentLight::new(map, 0.0);
+    render(
+        geometry,
+        &bvh,
+        &light,
+        cam,
+        &ReferenceSettings { spp, bounces, seed },
+        &ProgressBar::hidden(),
+    )
+}
+
+fn covered_mean(image: &ReferenceImage) -> Rgb {
+    let (sum, n) = image
+        .radiance
+        .pixels
+        .iter()
+        .zip(&image.coverage)
+        .filter(|(_, c)| **c > 0.0)
+        .fold((Rgb::ZERO, 0), |(s, n), (p, _)| (s + *p, n + 1));
+    sum / n as f32
+}
+
+#[test]
+fn furnace_sphere_reflects_its_albedo() {
+    let albedo = Rgb::new(0.8, 0.5, 0.3);
+    let geometry = scene_of(&[(&sphere_mesh(Vec3::ZERO, 1.0, 4), albedo)]);
+    let map = EnvMap::uniform(64, 32, Rgb::ONE);
+    let cam = camera(Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, 48);
+    let image = render_simple(&geometry, &map, &cam, 16, 3, 1);
+    let mean = covered_mean(&image);
+    assert!(
+        ((mean - albedo) / albedo).abs().max_element() < 0.005,
+        "{mean}"
+    );
+    // Uncovered pixels show the environment; a convex sphere sees its whole sky, except for
+    // the few directions below a facet that its smooth normal still counts as above.
+    assert!(image.coverage.iter().any(|c| *c == 0.0));
+    let covered: Vec<f32> = image
+        .visibility
+        .iter()
+        .zip(&image.coverage)
+        .filter(|(_, c)| **c > 0.0)
+        .map(|(v, _)| *v)
+        .collect();
+    let mean_visibility = covered.iter().sum::<f32>() / covered.len() as f32;
+    assert!(mean_visibility > 0.995, "{mean_visibility}");
+}
+
+/// An open box seen from above through its missing top.
+fn open_box() -> TriangleMesh {
+    let outer = box_mesh(
+        Vec3::new(-1.0, 0.0, -1.0),
+        Vec3::new(1.0, 1.5, 1.0),
+        [4, 4, 4],
+        [false, false, true, false, false, false],
+    );
+    // Turn it inside out so the walls face the interior.
+    TriangleMesh {
+        positions: outer.positions.clone(),
+        normals: outer.normals.iter().map(|n| -*n).collect(),
+        triangles: outer.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect(),
+    }
+}
+
+#[test]
+fn white_furnace_concave_scene_renders_one() {
+    let geometry = scene_of(&[(&open_box(), Rgb::ONE)]);
+    let map = EnvMap::uniform(64, 32, Rgb::ONE);
+    let cam = camera(Vec3::new(0.0, 4.0, 0.01), Vec3::ZERO, 32);
+    let image = render_simple(&geometry, &map, &cam, 32, 64, 2);
+    let mean = covered_mean(&image).y;
+    assert!((mean - 1.0).abs() < 0.01, "{mean}");
+    // The floor of the box really is occluded.
+    let centre = (16 * 32 + 16) as usize;
+    assert!(
+        image.coverage[centre] == 1.0 && image.visibility[centre] < 0.6,
+        "{}",
+        image.visibility[centre]
+    );
+}
+
+fn sphere_on_plane() -> SceneMesh {
+    let plane = box_mesh(
+        Vec3::new(-3.0, -0.2, -3.0),
+        Vec3::new(3.0, 0.0, 3.0),
+        [1, 1, 1],
+        [false; 6],
+    );
+    scene_of(&[
+        (
+            &sphere_mesh(Vec3::new(0.0, 1.0, 0.0), 1.0, 3),
+            Rgb::splat(0.7),
+        ),
+        (&plane, Rgb::new(0.6, 0.5, 0.4)),
+    ])
+}
+
+fn sunny_map() -> EnvMap {
+    EnvMap::from_fn(128, 64, 2, |w| {
+        let sun = if w.dot(Vec3::new(0.4, 0.8, 0.45).normalize()) > 0.995 {
+            300.0
+        } else {
+            0.0
+        };
+        Rgb::new(0.3, 0.4, 0.6) * (0.5 + w.y.max(0.0)) + Rgb::splat(sun)
+    })
+}
+
+#[test]
+fn same_image_whatever_the_thread_count() {
+    let geometry = sphere_on_plane();
+    let map = sunny_map();
+    let cam = camera(Vec3::new(2.0, 3.0, 5.0), Vec3::new(0.0, 0.5, 0.0), 24);
+    let in_pool = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| render_simple(&geometry, &map, &cam, 8, 2, 7))
+    };
+    let (a, b) = (in_pool(1), in_pool(3));
+    assert_eq!(a.radiance, b.radiance);
+    assert_eq!(a.visibility, b.visibility);
+    assert_ne!(
+        render_simple(&geometry, &map, &cam, 8, 2, 8).radiance,
+        a.radiance
+    );
+}
+
+#[test]
+fn error_falls_as_one_over_root_spp() {
+    let geometry = sphere_on_plane();
+    let map = sunny_map();
+    let cam = camera(Vec3::new(2.0, 3.0, 5.0), Vec3::new(0.0, 0.5, 0.0), 20);
+    let truth = render_simple(&geometry, &map, &cam, 4096, 2, 100);
+    let rmse = |spp: u32| {
+        // Average the squared error over several seeds to tame its own noise.
+        let mut total = 0.0f64;
+        for seed in 0..4 {
+            let image = render_simple(&geometry, &map, &cam, spp, 2, seed);
+            total += image
+                .radiance
+                .pixels
+                .iter()
+                .zip(&truth.radiance.pixels)
+                .map(|(a, b)| (*a - *b).length_squared() as f64)
+                .sum::<f64>();
+        }
+        total.sqrt()
+    };
+    let errors: Vec<f64> = [4, 16, 64].iter().map(|&spp| rmse(spp)).collect();
+    for pair in errors.windows(2) {
+        // 4x the samples: the error should halve (allow 1.6-2.5, the truth has noise too).
+        let ratio = pair[0] / pair[1];
+        assert!((1.6..2.5).contains(&ratio), "errors {errors:?}");
+    }
+}
+
+#[test]
+fn shadows_show_in_the_visibility_image() {
+    let geometry = sphere_on_plane();
+    let map = sunny_map();
+    // Look straight down on the plane: the sphere's shadow falls opposite the sun.
+    let cam = camera(Vec3::new(0.0, 8.0, 0.01), Vec3::ZERO, 40);
+    let image = render_simple(&geometry, &map, &cam, 32, 0, 3);
+    let min = image.visibility.iter().cloned().fold(1.0f32, f32::min);
+    assert!(min < 0.3, "a hard sun shadow: {min}");
+}

@@ -1,0 +1,141 @@
+//! `hprt reference`: the CPU path-traced ground truth.
+
+use super::{choose_environment, default_exposure, load_scene, progress_bar, with_threads};
+use anyhow::Context;
+use clap::Args;
+use precompute::bvh::SceneBvh;
+use precompute::envmap::Layout;
+use precompute::image_io::{RgbImageF32, exr_bytes, write_exr, write_png};
+use precompute::reference::{self, EnvironmentLight, ReferenceImage, ReferenceSettings};
+use precompute::{Rgb, atomic_file::AtomicOutput};
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+pub struct ReferenceArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Environment map (default: the scene's).
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    /// Layout of the map (default: from the aspect ratio).
+    #[arg(long)]
+    pub layout: Option<Layout>,
+    /// Rotation of the map about +Y in degrees (default: the scene's).
+    #[arg(long, allow_negative_numbers = true)]
+    pub rotate: Option<f32>,
+    /// Image width (default: the scene camera's).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height (default: the scene camera's).
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Light paths per pixel.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: u32,
+    /// Indirect bounces, as in the bake (0: shadowed direct lighting).
+    #[arg(long, default_value_t = 3)]
+    pub bounces: u32,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Worker threads (default: all cores); the image does not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Tone-mapping exposure of the PNG (default: 1 / the map's mean luminance).
+    #[arg(long)]
+    pub exposure: Option<f32>,
+    /// Output linear OpenEXR.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Also write a tone-mapped PNG.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Also write coverage and direct-visibility images (EXR and PNG) into this folder.
+    #[arg(long)]
+    pub aux: Option<PathBuf>,
+}
+
+/// Writes a single-channel image as grey EXR and PNG.
+pub fn write_grey(
+    dir: &Path,
+    name: &str,
+    width: usize,
+    height: usize,
+    values: &[f32],
+) -> anyhow::Result<()> {
+    let image = RgbImageF32::new(
+        width,
+        height,
+        values.iter().map(|v| Rgb::splat(*v)).collect(),
+    );
+    write_exr(&dir.join(format!("{name}.exr")), &image)?;
+    // Linear 0..1 shown directly (exposure chosen so that tonemap(1) is near white).
+    let rgb: Vec<u8> = values
+        .iter()
+        .flat_map(|v| [(v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8; 3])
+        .collect();
+    precompute::image_io::write_png_rgb8(&dir.join(format!("{name}.png")), width, height, &rgb)?;
+    Ok(())
+}
+
+pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
+    let scene = load_scene(&args.scene)?;
+    let env = choose_environment(&scene, args.env.as_deref(), args.layout, args.rotate)?;
+    let camera = scene.camera.with_size(
+        args.width.unwrap_or(scene.camera.width),
+        args.height.unwrap_or(scene.camera.height),
+    );
+    camera
+        .validate()
+        .map_err(|m| anyhow::anyhow!("invalid image size: {m}"))?;
+    let output = AtomicOutput::create(&args.output)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    if let Some(dir) = &args.aux {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    let settings = ReferenceSettings {
+        spp: args.spp,
+        bounces: args.bounces,
+        seed: args.seed,
+    };
+    println!(
+        "{}: {}x{}, {} spp, {} bounces, lit by {} rotated {}°",
+        scene.name,
+        camera.width,
+        camera.height,
+        settings.spp,
+        settings.bounces,
+        env.path.display(),
+        env.rotation_deg
+    );
+    let image: ReferenceImage = with_threads(args.threads, || {
+        let bvh = SceneBvh::build(&scene.geometry.mesh);
+        let light = EnvironmentLight::new(&env.loaded.map, env.rotation_deg);
+        let progress = progress_bar(camera.height as u64, "rendering rows");
+        reference::render(&scene.geometry, &bvh, &light, &camera, &settings, &progress)
+    })?;
+    let exr =
+        exr_bytes(&image.radiance).map_err(|m| anyhow::anyhow!("cannot encode the EXR: {m}"))?;
+    output
+        .commit(&exr)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    let exposure = args
+        .exposure
+        .unwrap_or_else(|| default_exposure(&env.loaded.map));
+    if let Some(png) = &args.png {
+        write_png(png, &image.radiance, exposure)?;
+    }
+    if let Some(dir) = &args.aux {
+        let (w, h) = (camera.width as usize, camera.height as usize);
+        write_grey(dir, "coverage", w, h, &image.coverage)?;
+        write_grey(dir, "visibility", w, h, &image.visibility)?;
+    }
+    let megapixel_samples = camera.width as f64 * camera.height as f64 * settings.spp as f64 / 1e6;
+    println!(
+        "rendered in {:.2} s: {:.2} M rays/s, {:.3} s per megapixel per sample; wrote {}",
+        image.stats.seconds,
+        image.stats.rays_per_second() / 1e6,
+        image.stats.seconds / megapixel_samples,
+        args.output.display()
+    );
+    Ok(())
+}
