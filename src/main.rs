@@ -18,6 +18,8 @@ enum Command {
     Bake(commands::bake::BakeArgs),
     /// Decompose an environment map into an SH polynomial plus directional lights.
     Decompose(commands::decompose::DecomposeArgs),
+    /// Render a baked scene on the GPU: hybrid (SH + shadow-mapped lights) or plain PRT.
+    Render(commands::render::RenderArgs),
     /// Render the CPU path-traced reference of a scene.
     Reference(commands::reference::ReferenceArgs),
     /// Write the scene as a Mitsuba 3 scene, to cross-check the reference.
@@ -46,6 +48,7 @@ fn main() {
         Command::Bench(cmd) => commands::bench::run(cmd),
         Command::Decompose(args) => commands::decompose::run(args),
         Command::Reference(args) => commands::reference::run(args),
+        Command::Render(args) => commands::render::run(args),
         Command::Export(args) => commands::export::run(args),
     };
     if let Err(error) = result {

@@ -71,6 +71,20 @@ pub fn to_display_rgb8(image: &RgbImageF32, exposure: f32) -> Vec<u8> {
         .collect()
 }
 
+/// The PNG file of 8-bit RGB pixels, in memory.
+pub fn png_bytes(rgb: &[u8], width: usize, height: usize) -> Result<Vec<u8>, String> {
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(
+            rgb,
+            width as u32,
+            height as u32,
+            image::ExtendedColorType::Rgb8,
+        )
+        .map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
 /// Writes 8-bit RGB pixels as a PNG.
 pub fn write_png_rgb8(
     path: &Path,
@@ -82,15 +96,7 @@ pub fn write_png_rgb8(
         path: path.to_owned(),
         message,
     };
-    let mut bytes = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut bytes)
-        .write_image(
-            rgb,
-            width as u32,
-            height as u32,
-            image::ExtendedColorType::Rgb8,
-        )
-        .map_err(|e| error(e.to_string()))?;
+    let bytes = png_bytes(rgb, width, height).map_err(error)?;
     write_atomic(path, &bytes).map_err(|e| error(e.to_string()))
 }
 

@@ -8,3 +8,4 @@ pub mod light;
 pub use cubemap::{CubeGeometry, CubeMap, CubeResampler, CubeSource};
 pub use decompose::{DecomposeMode, DecomposeSettings, Decomposer, Decomposition, Window};
 pub use light::DirectionalLight;
+pub mod render;

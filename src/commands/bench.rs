@@ -5,6 +5,7 @@ use clap::{Args, Subcommand};
 use indicatif::ProgressBar;
 use precompute::bake::{self, BakeSettings};
 use precompute::bvh::SceneBvh;
+use runtime::render::ShadowSettings;
 use std::path::PathBuf;
 
 #[derive(Subcommand)]
@@ -13,6 +14,43 @@ pub enum BenchCommand {
     Bake(BenchBakeArgs),
     /// Reference renderer speed: seconds, rays per second, seconds per megapixel per sample.
     Reference(BenchReferenceArgs),
+    /// GPU frame times of prt and hybrid, static and dynamic lighting, and the CPU work per
+    /// frame (decomposition and uploads).
+    Render(BenchRenderArgs),
+}
+
+#[derive(Args)]
+pub struct BenchRenderArgs {
+    /// Scene files (default: the bundled teapot and dragon scenes).
+    #[arg(default_values = ["scenes/teapot.toml", "scenes/dragon.toml"])]
+    pub scenes: Vec<PathBuf>,
+    /// Environment map; hall.exr has many ceiling lights, so the hybrid gets its 8 lights.
+    #[arg(long, default_value = "scenes/env/hall.exr")]
+    pub env: PathBuf,
+    #[arg(long, default_value_t = 1280)]
+    pub width: u32,
+    #[arg(long, default_value_t = 720)]
+    pub height: u32,
+    /// Lights of the hybrid (the Weber threshold is set to 0 so the brightest N are kept).
+    #[arg(long, default_value_t = 8)]
+    pub lights: usize,
+    #[arg(long, default_value_t = 2048)]
+    pub shadow_res: u32,
+    /// PCF taps per side.
+    #[arg(long, default_value_t = ShadowSettings::default().pcf_taps)]
+    pub pcf: u32,
+    /// Size the PCF kernel from each light's angular radius (blocker search).
+    #[arg(long, value_enum, default_value = "on")]
+    pub pcf_from_radius: super::render::Switch,
+    /// Frames timed per configuration (after one warm-up frame); medians are reported.
+    #[arg(long, default_value_t = 20)]
+    pub frames: usize,
+    /// Rays per vertex of the bakes made for the benchmark (their quality does not matter).
+    #[arg(long, default_value_t = 32)]
+    pub bake_samples: u32,
+    /// Graphics backend: auto, vulkan or gl.
+    #[arg(long, default_value = "auto")]
+    pub backend: runtime::render::Backend,
 }
 
 #[derive(Args)]
@@ -59,6 +97,7 @@ pub fn run(command: BenchCommand) -> anyhow::Result<()> {
     match command {
         BenchCommand::Bake(args) => bench_bake(args),
         BenchCommand::Reference(args) => bench_reference(args),
+        BenchCommand::Render(args) => bench_render(args),
     }
 }
 
@@ -178,6 +217,143 @@ fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
          ({:.2}x the speed of Mitsuba 3 scalar_rgb's ~{MITSUBA_SCALAR_SECONDS_PER_MEGAPIXEL_SAMPLE} s)",
         rays_per_second / 1e6,
         MITSUBA_SCALAR_SECONDS_PER_MEGAPIXEL_SAMPLE / per
+    );
+    Ok(())
+}
+
+/// Median milliseconds of `frames` calls of `frame` (after one untimed call).
+fn time_frames(
+    frames: usize,
+    mut frame: impl FnMut() -> anyhow::Result<()>,
+) -> anyhow::Result<f64> {
+    frame()?;
+    let mut times = Vec::with_capacity(frames);
+    for _ in 0..frames.max(1) {
+        let start = std::time::Instant::now();
+        frame()?;
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(median(times))
+}
+
+fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
+    use runtime::render::{FrameLighting, GpuContext, RenderMode, Renderer};
+    use runtime::{CubeSource, DecomposeSettings, Decomposer};
+    let map = super::decompose::load_map(&args.env, None)?.map;
+    let gpu = GpuContext::headless(args.backend)?;
+    println!(
+        "render benchmark on {}: {}x{}, {} lights, {}² shadow maps, PCF {}x{}{}, median of {} frames",
+        gpu.description(),
+        args.width,
+        args.height,
+        args.lights,
+        args.shadow_res,
+        args.pcf,
+        args.pcf,
+        if args.pcf_from_radius == super::render::Switch::On {
+            " sized from the light radius"
+        } else {
+            ""
+        },
+        args.frames
+    );
+    println!(
+        "{:<8} {:>10} {:>12} {:>8} {:>11} {:>13} {:>8} {:>13} {:>16}",
+        "scene",
+        "prt ms",
+        "hybrid ms",
+        "ratio",
+        "prt dyn ms",
+        "hybrid dyn ms",
+        "ratio",
+        "CPU/frame ms",
+        "unshadowed ms"
+    );
+    for path in &args.scenes {
+        let scene = load_scene(path)?;
+        let settings = BakeSettings {
+            order: 5,
+            samples: args.bake_samples,
+            bounces: 1,
+            seed: 0,
+        };
+        let bvh = SceneBvh::build(&scene.geometry.mesh);
+        let (transfer, _) = bake::bake(&scene.geometry, &bvh, &settings, &ProgressBar::hidden())
+            .map_err(|m| anyhow::anyhow!(m))?;
+        let decompose = DecomposeSettings {
+            threshold: 0.0,
+            max_lights: args.lights,
+            ..Default::default()
+        };
+        let source = CubeSource::new(&map, decompose.face_size);
+        let mut cube = source.cube(0.0);
+        let mut decomposer = Decomposer::new(decompose).map_err(|m| anyhow::anyhow!(m))?;
+        let camera = scene.camera.with_size(args.width, args.height);
+        let shadow = ShadowSettings {
+            resolution: args.shadow_res,
+            pcf_taps: args.pcf,
+            from_angular_radius: args.pcf_from_radius == super::render::Switch::On,
+        };
+        let mut renderer = Renderer::new(&gpu, &scene.geometry, &transfer, &camera, shadow)?;
+        renderer.set_environment(&map, 0.0);
+        let decomposition = decomposer.decompose(&cube);
+        let projection = decomposer.project(&cube);
+        if decomposition.lights.len() != args.lights {
+            println!("note: the map gives {} lights", decomposition.lights.len());
+        }
+        let mut results = Vec::new();
+        // Static lighting: shadow maps and vertex radiance are computed once.
+        for mode in [RenderMode::Prt, RenderMode::Hybrid, RenderMode::Unshadowed] {
+            renderer.set_lighting(&FrameLighting::for_mode(
+                mode,
+                &projection,
+                &decomposition,
+                true,
+            ))?;
+            results.push(time_frames(args.frames, || {
+                renderer.render()?;
+                renderer.wait();
+                Ok(())
+            })?);
+        }
+        // Dynamic lighting: the map turns a degree per frame, everything is redone.
+        let mut cpu_ms = Vec::new();
+        for mode in [RenderMode::Prt, RenderMode::Hybrid] {
+            let mut angle = 0.0f32;
+            results.push(time_frames(args.frames, || {
+                let start = std::time::Instant::now();
+                angle += 1.0;
+                source.cube_into(angle.to_radians(), &mut cube);
+                let lighting = if mode == RenderMode::Prt {
+                    FrameLighting::prt(decomposer.project(&cube))
+                } else {
+                    FrameLighting::for_mode(mode, &projection, &decomposer.decompose(&cube), true)
+                };
+                renderer.set_environment_rotation(angle);
+                renderer.set_lighting(&lighting)?;
+                if mode == RenderMode::Hybrid {
+                    cpu_ms.push(start.elapsed().as_secs_f64() * 1e3);
+                }
+                renderer.render()?;
+                renderer.wait();
+                Ok(())
+            })?);
+        }
+        println!(
+            "{:<8} {:>10.2} {:>12.2} {:>8.2} {:>11.2} {:>13.2} {:>8.2} {:>13.3} {:>16.2}",
+            scene.name,
+            results[0],
+            results[1],
+            results[1] / results[0],
+            results[3],
+            results[4],
+            results[4] / results[3],
+            median(cpu_ms),
+            results[2]
+        );
+    }
+    println!(
+        "CPU/frame: resampling the turned map, decomposing it and setting the lighting (face size 64)."
     );
     Ok(())
 }

@@ -10,48 +10,46 @@ use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer, Decompos
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Options shared by every command that decomposes a map.
+/// Options shared by every command that decomposes a map (defaults: `DecomposeSettings`).
 #[derive(Args, Clone, Debug)]
 pub struct DecomposeOptions {
-    /// SH order of the polynomial part.
-    #[arg(long, default_value_t = 5)]
-    pub order: usize,
+    /// SH order of the polynomial part (default: 5, or the bake's order when rendering).
+    #[arg(long)]
+    pub order: Option<usize>,
     /// Weber fraction: keep lights while each adds more than this share of the luminance of
     /// the brighter ones.
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = DecomposeSettings::default().threshold)]
     pub threshold: f32,
     /// Radius of the SRBF / light caps in degrees.
-    #[arg(long, default_value_t = 8.0)]
+    #[arg(long, default_value_t = DecomposeSettings::default().radius_deg)]
     pub radius: f32,
     /// Cube-map face resolution.
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = DecomposeSettings::default().face_size)]
     pub face: usize,
-    /// thesis: the thesis' light power; consistent: lights and SH part add up to the map.
-    #[arg(long = "mode", default_value = "consistent")]
-    pub mode: DecomposeMode,
     /// Most lights kept.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = DecomposeSettings::default().max_lights)]
     pub max_lights: usize,
     /// Icosahedron subdivision level of the peak search.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = DecomposeSettings::default().ico_level)]
     pub ico_level: u32,
     /// Standard deviation of the smoothing Gaussian, in degrees.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = DecomposeSettings::default().smoothing_deg)]
     pub smoothing: f32,
     /// Window of the SH part (none, hanning, lanczos); default: hanning for thesis, none for
     /// consistent.
     #[arg(long)]
     pub window: Option<Window>,
     /// A peak must exceed this multiple of the map's mean luminance to become a light.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = DecomposeSettings::default().min_contrast)]
     pub min_contrast: f32,
 }
 
 impl DecomposeOptions {
-    pub fn settings(&self) -> DecomposeSettings {
+    /// The settings for `mode`, with `default_order` unless `--order` was given.
+    pub fn settings(&self, mode: DecomposeMode, default_order: usize) -> DecomposeSettings {
         DecomposeSettings {
-            mode: self.mode,
-            order: self.order,
+            mode,
+            order: self.order.unwrap_or(default_order),
             face_size: self.face,
             ico_level: self.ico_level,
             smoothing_deg: self.smoothing,
@@ -75,6 +73,9 @@ pub struct DecomposeArgs {
     /// Rotation of the map about +Y in degrees (counter-clockwise seen from above).
     #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
     pub rotate: f32,
+    /// thesis: the thesis' light power; consistent: lights and SH part add up to the map.
+    #[arg(long, default_value = "consistent")]
+    pub mode: DecomposeMode,
     #[command(flatten)]
     pub options: DecomposeOptions,
     /// Output JSON.
@@ -120,7 +121,9 @@ struct DecompositionJson<'a> {
 }
 
 pub fn run(args: DecomposeArgs) -> anyhow::Result<()> {
-    let settings = args.options.settings();
+    let settings = args
+        .options
+        .settings(args.mode, DecomposeSettings::default().order);
     settings
         .validate()
         .map_err(|m| anyhow::anyhow!("invalid decomposition settings: {m}"))?;

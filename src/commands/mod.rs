@@ -5,6 +5,7 @@ pub mod bench;
 pub mod decompose;
 pub mod export;
 pub mod reference;
+pub mod render;
 
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};

@@ -1,0 +1,38 @@
+// Per-frame data shared by the geometry and light passes.
+struct Frame {
+    view_proj: mat4x4<f32>,
+    inv_view_proj: mat4x4<f32>,
+    // Width, height, 1/width, 1/height.
+    viewport: vec4<f32>,
+    // cos and sin of the environment's rotation about +Y, then unused.
+    env_rotation: vec4<f32>,
+    light_count: u32,
+    // Bit 1: show the environment behind the scene.
+    flags: u32,
+    // PCF kernel: taps per side (odd).
+    pcf_taps: u32,
+    _pad: u32,
+};
+
+struct Light {
+    // Direction the light comes from (unit), w unused.
+    direction: vec4<f32>,
+    // RGB power (∫ L dω over the source), w unused.
+    power: vec4<f32>,
+    // World to shadow-map clip space (orthographic).
+    shadow_matrix: mat4x4<f32>,
+    // x: world size of a shadow-map texel, y: world depth range of the map,
+    // z: tan of the source's angular radius, w: shadow-map layer.
+    params: vec4<f32>,
+};
+
+// A depth in [0, 1] split over two half floats (about 22 bits together), for colour targets
+// that every backend can render to.
+fn encode_depth(depth: f32) -> vec4<f32> {
+    let high = unpack2x16float(pack2x16float(vec2<f32>(depth, 0.0))).x;
+    return vec4<f32>(high, depth - high, 0.0, 1.0);
+}
+
+fn decode_depth(encoded: vec4<f32>) -> f32 {
+    return encoded.x + encoded.y;
+}

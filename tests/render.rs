@@ -1,0 +1,415 @@
+//! The GPU renderer on the software adapter (lavapipe or llvmpipe in CI).
+
+mod common;
+
+use common::*;
+use glam::Vec3;
+use indicatif::ProgressBar;
+use precompute::bake::{self, BakeSettings, Transfer};
+use precompute::bvh::SceneBvh;
+use precompute::camera::Camera;
+use precompute::envmap::EnvMap;
+use precompute::image_io::{RgbImageF32, tonemap};
+use precompute::mesh::{box_mesh, sphere_mesh};
+use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
+use precompute::scene::{Scene, SceneMesh};
+use precompute::sh::ShCoeffs;
+use precompute::{Rgb, luminance};
+use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
+use runtime::{CubeSource, DecomposeSettings, Decomposer, DirectionalLight};
+
+fn gpu() -> GpuContext {
+    GpuContext::headless(Backend::Auto)
+        .expect("a (software) GPU adapter; run tests/run.sh to install one")
+}
+
+fn bake_of(geometry: &SceneMesh, order: usize, samples: u32, bounces: u32) -> Transfer {
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let settings = BakeSettings {
+        order,
+        samples,
+        bounces,
+        seed: 0,
+    };
+    bake::bake(geometry, &bvh, &settings, &ProgressBar::hidden())
+        .unwrap()
+        .0
+}
+
+fn sphere_on_plane() -> SceneMesh {
+    let mut geometry = SceneMesh::default();
+    geometry.push_object(
+        "sphere".into(),
+        &sphere_mesh(Vec3::new(0.0, 1.0, 0.0), 1.0, 4),
+        Rgb::splat(0.7),
+    );
+    let plane = box_mesh(
+        Vec3::new(-4.0, -0.2, -4.0),
+        Vec3::new(4.0, 0.0, 4.0),
+        [32, 1, 32],
+        [false; 6],
+    );
+    geometry.push_object("plane".into(), &plane, Rgb::new(0.6, 0.5, 0.4));
+    geometry
+}
+
+fn camera(position: Vec3, target: Vec3, width: u32, height: u32) -> Camera {
+    Camera {
+        position,
+        target,
+        up: Vec3::Y,
+        fov_y_deg: 40.0,
+        width,
+        height,
+    }
+}
+
+fn render(
+    gpu: &GpuContext,
+    geometry: &SceneMesh,
+    transfer: &Transfer,
+    camera: &Camera,
+    lighting: &FrameLighting,
+) -> RgbImageF32 {
+    let mut renderer =
+        Renderer::new(gpu, geometry, transfer, camera, ShadowSettings::default()).unwrap();
+    renderer.background = false;
+    renderer.set_lighting(lighting).unwrap();
+    renderer.render().unwrap();
+    renderer.read_back().unwrap()
+}
+
+fn uniform_sh(order: usize, value: f32) -> ShCoeffs<Rgb> {
+    let mut sh = ShCoeffs::zeros(order);
+    sh.as_mut_slice()[0] = Rgb::splat(value * (4.0 * std::f32::consts::PI).sqrt());
+    sh
+}
+
+#[test]
+fn furnace_prt_surfaces_equal_their_albedo() {
+    let albedo = Rgb::new(0.8, 0.5, 0.3);
+    let mut geometry = SceneMesh::default();
+    geometry.push_object("sphere".into(), &sphere_mesh(Vec3::ZERO, 1.0, 4), albedo);
+    let transfer = bake_of(&geometry, 3, 64, 1);
+    let cam = camera(Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, 64, 64);
+    let image = render(
+        &gpu(),
+        &geometry,
+        &transfer,
+        &cam,
+        &FrameLighting::prt(uniform_sh(3, 1.0)),
+    );
+    let covered: Vec<Rgb> = image
+        .pixels
+        .iter()
+        .copied()
+        .filter(|p| p.max_element() > 0.0)
+        .collect();
+    assert!(covered.len() > 1000, "the sphere is in view");
+    for p in covered {
+        assert!(
+            ((p - albedo) / albedo).abs().max_element() < 0.01,
+            "{p} vs {albedo}"
+        );
+    }
+}
+
+#[test]
+fn hybrid_without_lights_equals_prt_pixel_for_pixel() {
+    let geometry = sphere_on_plane();
+    let transfer = bake_of(&geometry, 4, 64, 1);
+    let map = EnvMap::from_fn(128, 64, 1, |w| {
+        Rgb::new(0.5, 0.6, 0.9) * (1.0 + w.y) + Rgb::splat(0.2 * w.x.max(0.0))
+    });
+    let sh = map.sh_projection(4);
+    let cam = camera(Vec3::new(3.0, 4.0, 6.0), Vec3::new(0.0, 0.5, 0.0), 80, 60);
+    let gpu = gpu();
+    let prt = render(
+        &gpu,
+        &geometry,
+        &transfer,
+        &cam,
+        &FrameLighting::prt(sh.clone()),
+    );
+    let hybrid = FrameLighting {
+        sh,
+        lights: Vec::new(),
+        lights_indirect: true,
+        shadows: true,
+    };
+    assert_eq!(prt, render(&gpu, &geometry, &transfer, &cam, &hybrid));
+    assert!(prt.pixels.iter().any(|p| p.max_element() > 0.1));
+}
+
+#[test]
+fn shadow_of_a_sphere_lands_where_geometry_predicts() {
+    let geometry = sphere_on_plane();
+    let transfer = bake_of(&geometry, 2, 16, 0);
+    // 30° above the horizon, so the shadow's centre is not hidden under the sphere seen from
+    // above.
+    let direction =
+        Vec3::new(0.75, 0.0, 0.45).normalize() * 30f32.to_radians().cos() + Vec3::Y * 0.5;
+    let light = DirectionalLight {
+        direction,
+        power: Rgb::splat(5.0),
+        cap_radius: 0.05,
+        angular_radius: 0.005,
+        share: 1.0,
+    };
+    let lighting = FrameLighting {
+        sh: ShCoeffs::zeros(2),
+        lights: vec![light],
+        lights_indirect: false,
+        shadows: true,
+    };
+    // Looking straight down at the plane.
+    let cam = Camera {
+        up: Vec3::NEG_Z,
+        ..camera(Vec3::new(0.0, 12.0, 0.0), Vec3::ZERO, 128, 128)
+    };
+    let image = render(&gpu(), &geometry, &transfer, &cam, &lighting);
+    if let Ok(path) = std::env::var("HPRT_DEBUG_PNG") {
+        precompute::image_io::write_png(std::path::Path::new(&path), &image, 1.0).unwrap();
+    }
+    let view_proj = cam.projection_matrix(0.1, 100.0) * cam.view_matrix();
+    let pixel_of = |p: Vec3| {
+        let ndc = view_proj.project_point3(p);
+        let x = ((ndc.x + 1.0) * 0.5 * 128.0) as usize;
+        let y = ((1.0 - ndc.y) * 0.5 * 128.0) as usize;
+        image.get(x, y)
+    };
+    // The sphere's centre casts its shadow along -direction onto y = 0.
+    let centre = Vec3::new(0.0, 1.0, 0.0);
+    let shadow_centre = centre - direction * (centre.y / direction.y);
+    // Lit plane: ρ/π · power · cos θ.
+    let lit = Rgb::new(0.6, 0.5, 0.4) / std::f32::consts::PI * 5.0 * direction.y;
+    let far_from_shadow = shadow_centre + Vec3::new(0.0, 0.0, 2.5);
+    assert!(
+        pixel_of(shadow_centre).max_element() < 0.02 * lit.max_element(),
+        "{}",
+        pixel_of(shadow_centre)
+    );
+    assert!(
+        ((pixel_of(far_from_shadow) - lit) / lit)
+            .abs()
+            .max_element()
+            < 0.02,
+        "{}",
+        pixel_of(far_from_shadow)
+    );
+    // The shadow is where predicted, not mirrored: the other side of the sphere is lit.
+    let mirrored = Vec3::new(-shadow_centre.x, 0.0, -shadow_centre.z);
+    assert!(pixel_of(mirrored).max_element() > 0.9 * lit.max_element());
+}
+
+/// Mean |Y(tonemap(a)) - Y(tonemap(b))| over the masked pixels.
+fn tone_mapped_error(a: &RgbImageF32, b: &RgbImageF32, mask: &[bool], exposure: f32) -> f32 {
+    let (sum, n) = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .zip(mask)
+        .filter(|(_, m)| **m)
+        .fold((0.0f32, 0usize), |(s, n), ((x, y), _)| {
+            (
+                s + (luminance(tonemap(*x, exposure)) - luminance(tonemap(*y, exposure))).abs(),
+                n + 1,
+            )
+        });
+    sum / n.max(1) as f32
+}
+
+#[test]
+fn hybrid_beats_prt_in_the_shadows_against_the_reference() {
+    let teapot = Scene::load(&scene("teapot.toml")).unwrap();
+    let map = precompute::envmap::load(&scene("env/sunrise.exr"), None)
+        .unwrap()
+        .map;
+    let rotation = teapot.environment.as_ref().unwrap().rotation_deg;
+    let cam = teapot.camera.with_size(160, 120);
+    let transfer = bake_of(&teapot.geometry, 5, 256, 2);
+
+    // The reference at test time: small and noisy, but unbiased.
+    let bvh = SceneBvh::build(&teapot.geometry.mesh);
+    let light = EnvironmentLight::new(&map, rotation);
+    let settings = ReferenceSettings {
+        spp: 96,
+        bounces: 2,
+        seed: 1,
+    };
+    let truth = reference::render(
+        &teapot.geometry,
+        &bvh,
+        &light,
+        &cam,
+        &settings,
+        &ProgressBar::hidden(),
+    );
+
+    let decompose = DecomposeSettings::default();
+    let cube = CubeSource::new(&map, decompose.face_size).cube(rotation.to_radians());
+    let mut decomposer = Decomposer::new(decompose).unwrap();
+    let decomposition = decomposer.decompose(&cube);
+    let projection = decomposer.project(&cube);
+    let gpu = gpu();
+    let mut images = Vec::new();
+    for mode in [RenderMode::Hybrid, RenderMode::Prt] {
+        let lighting = FrameLighting::for_mode(mode, &projection, &decomposition, true);
+        images.push(render(&gpu, &teapot.geometry, &transfer, &cam, &lighting));
+    }
+    let exposure = 0.5 / map.mean_luminance();
+    let covered: Vec<bool> = truth.coverage.iter().map(|c| *c > 0.0).collect();
+    let shadow: Vec<bool> = truth
+        .coverage
+        .iter()
+        .zip(&truth.visibility)
+        .map(|(c, v)| *c > 0.0 && *v < 0.5)
+        .collect();
+    assert!(
+        shadow.iter().filter(|s| **s).count() > 500,
+        "the teapot casts a shadow"
+    );
+    let hybrid = tone_mapped_error(&images[0], &truth.radiance, &covered, exposure);
+    let prt = tone_mapped_error(&images[1], &truth.radiance, &covered, exposure);
+    let hybrid_shadow = tone_mapped_error(&images[0], &truth.radiance, &shadow, exposure);
+    let prt_shadow = tone_mapped_error(&images[1], &truth.radiance, &shadow, exposure);
+    println!(
+        "mean error: hybrid {hybrid:.4} prt {prt:.4}; shadow region: hybrid {hybrid_shadow:.4} prt {prt_shadow:.4}"
+    );
+    // Bound: the thesis' PRT on its teapot scenes ranged 0.0065-0.0271 (Table 5.1); 0.02 allows
+    // for this test's 96-spp reference noise (about 0.005 per pixel) on top of approximation
+    // error, and is still below what plain PRT reaches in the shadows here.
+    assert!(hybrid < 0.02, "hybrid mean error {hybrid}");
+    assert!(
+        hybrid_shadow < prt_shadow,
+        "shadow region: hybrid {hybrid_shadow} vs prt {prt_shadow}"
+    );
+}
+
+#[test]
+fn bad_inputs_give_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = write_scene(
+        d,
+        "a.toml",
+        "box = { min = [-1, 0, -1], max = [1, 1, 1] }\nalbedo = [0.5, 0.5, 0.5]",
+    );
+    let b = write_scene(
+        d,
+        "b.toml",
+        "box = { min = [-1, 0, -1], max = [1, 2, 1] }\nalbedo = [0.5, 0.5, 0.5]",
+    );
+    let env = scene("env/city.exr");
+    assert!(
+        hprt(d, &["bake", a.to_str().unwrap(), "-o", "a.bake"])
+            .status
+            .success()
+    );
+    let base = |s: &std::path::Path| {
+        vec![
+            "render".to_owned(),
+            s.to_str().unwrap().to_owned(),
+            "--bake".into(),
+            "a.bake".into(),
+            "--env".into(),
+            env.to_str().unwrap().to_owned(),
+        ]
+    };
+    let run = |mut args: Vec<String>, extra: &[&str]| {
+        args.extend(extra.iter().map(|s| s.to_string()));
+        hprt(d, &args.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    assert_clean_failure(
+        &run(base(&b), &["-o", "x.png"]),
+        &["a.bake", "different mesh"],
+    );
+    assert_clean_failure(
+        &run(base(&a), &["--order", "6", "-o", "x.png"]),
+        &["order 2", "order 6", "re-bake"],
+    );
+    let mut missing = base(&a);
+    missing[5] = "nowhere.exr".into();
+    assert_clean_failure(&run(missing, &["-o", "x.png"]), &["nowhere.exr"]);
+    assert!(!d.join("x.png").exists());
+    // A working render, for contrast, reports its adapter.
+    let out = run(
+        base(&a),
+        &[
+            "--width", "32", "--height", "24", "-o", "ok.png", "--exr", "ok.exr",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("adapter:"));
+    assert!(d.join("ok.png").exists() && d.join("ok.exr").exists());
+}
+
+#[test]
+fn no_adapter_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = write_scene(
+        d,
+        "a.toml",
+        "box = { min = [-1, 0, -1], max = [1, 1, 1] }\nalbedo = [0.5, 0.5, 0.5]",
+    );
+    assert!(
+        hprt(d, &["bake", a.to_str().unwrap(), "-o", "a.bake"])
+            .status
+            .success()
+    );
+    // Hide every Vulkan driver from the loader.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hprt"))
+        .args([
+            "render",
+            a.to_str().unwrap(),
+            "--bake",
+            "a.bake",
+            "--env",
+            scene("env/city.exr").to_str().unwrap(),
+        ])
+        .args(["--backend", "vulkan", "-o", "x.png"])
+        .current_dir(d)
+        .env("VK_ICD_FILENAMES", "/nonexistent.json")
+        .env("VK_DRIVER_FILES", "/nonexistent.json")
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    assert_clean_failure(&out, &["no Vulkan graphics adapter", "mesa-vulkan-drivers"]);
+    assert!(!d.join("x.png").exists());
+}
+
+#[test]
+fn vulkan_and_opengl_software_adapters_draw_the_same_image() {
+    let geometry = sphere_on_plane();
+    let transfer = bake_of(&geometry, 3, 32, 1);
+    let light = DirectionalLight {
+        direction: Vec3::new(0.3, 0.8, 0.5).normalize(),
+        power: Rgb::splat(4.0),
+        cap_radius: 0.1,
+        angular_radius: 0.02,
+        share: 0.5,
+    };
+    let lighting = FrameLighting {
+        sh: uniform_sh(3, 0.5),
+        lights: vec![light],
+        lights_indirect: true,
+        shadows: true,
+    };
+    let cam = camera(Vec3::new(3.0, 4.0, 6.0), Vec3::new(0.0, 0.5, 0.0), 96, 72);
+    let images: Vec<RgbImageF32> = [Backend::Vulkan, Backend::Gl]
+        .iter()
+        .map(|&backend| {
+            let gpu = GpuContext::headless(backend)
+                .expect("lavapipe and llvmpipe (tests/run.sh installs them)");
+            render(&gpu, &geometry, &transfer, &cam, &lighting)
+        })
+        .collect();
+    let worst = images[0]
+        .pixels
+        .iter()
+        .zip(&images[1].pixels)
+        .map(|(a, b)| (*a - *b).abs().max_element())
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-2, "largest pixel difference {worst}");
+}
