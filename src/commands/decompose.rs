@@ -20,9 +20,10 @@ pub struct DecomposeOptions {
     /// the brighter ones.
     #[arg(long, default_value_t = DecomposeSettings::default().threshold)]
     pub threshold: f32,
-    /// Radius of the SRBF / light caps in degrees.
-    #[arg(long, default_value_t = DecomposeSettings::default().radius_deg)]
-    pub radius: f32,
+    /// Radius of the SRBF / light caps in degrees (default: 8 for consistent, √2 × the
+    /// smoothing for thesis, which keeps a point source's power under the thesis' formula).
+    #[arg(long)]
+    pub radius: Option<f32>,
     /// Cube-map face resolution.
     #[arg(long, default_value_t = DecomposeSettings::default().face_size)]
     pub face: usize,
@@ -53,7 +54,9 @@ impl DecomposeOptions {
             face_size: self.face,
             ico_level: self.ico_level,
             smoothing_deg: self.smoothing,
-            radius_deg: self.radius,
+            radius_deg: self
+                .radius
+                .unwrap_or_else(|| DecomposeSettings::default_radius(mode, self.smoothing)),
             threshold: self.threshold,
             max_lights: self.max_lights,
             min_contrast: self.min_contrast,

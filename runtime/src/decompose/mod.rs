@@ -77,7 +77,7 @@ pub struct DecomposeSettings {
     pub ico_level: u32,
     /// Standard deviation of the smoothing Gaussian, in degrees.
     pub smoothing_deg: f32,
-    /// Radius R of the SRBFs / light caps, in degrees.
+    /// Radius R of the SRBFs / light caps, in degrees (see [`DecomposeSettings::default_radius`]).
     pub radius_deg: f32,
     /// Weber fraction: a light is kept while it adds more than this share of the luminance of
     /// the lights before it.
@@ -137,6 +137,17 @@ impl DecomposeSettings {
             return Err(format!("min contrast {} is negative", self.min_contrast));
         }
         Ok(())
+    }
+
+    /// The default SRBF radius of a mode. `consistent`: a cap of 8°, wide enough for the
+    /// bundled maps' suns and lamps. `thesis` leaves R open; its power `2π(1 − cos R) λ` with λ
+    /// the Gaussian-smoothed peak gives a point source of power Φ the power `≈ (R²/2σ²) Φ`
+    /// (σ: the smoothing), so `R = √2 σ` is the choice that keeps point sources' power.
+    pub fn default_radius(mode: DecomposeMode, smoothing_deg: f32) -> f32 {
+        match mode {
+            DecomposeMode::Consistent => 8.0,
+            DecomposeMode::Thesis => std::f32::consts::SQRT_2 * smoothing_deg,
+        }
     }
 
     /// The window actually applied to the SH part.
