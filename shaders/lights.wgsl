@@ -145,6 +145,10 @@ fn visibility(index: u32, position: vec3<f32>, normal: vec3<f32>) -> f32 {
     if KERNEL_FROM_RADIUS {
         widest = clamp(light.params.y * light.params.z / light.params.x, 1.0, 32.0);
     }
+    if !KERNEL_FROM_RADIUS && frame.pcf_taps == 1u {
+        // The cheapest filter: one hardware 2×2 comparison.
+        return pcf(light, coords, slope, 1.0);
+    }
     // Most pixels are plainly lit or in umbra: decide those from 16 texels.
     let around = coverage(layer, coords, slope, widest);
     if around == 1.0 || around == 0.0 {

@@ -1,7 +1,9 @@
 //! `hprt`: hybrid precomputed radiance transfer + shadow-mapped lights for static diffuse
 //! scenes under distant HDR environment lighting.
 
+mod bake_cache;
 mod commands;
+mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -24,6 +26,8 @@ enum Command {
     Reference(commands::reference::ReferenceArgs),
     /// Write the scene as a Mitsuba 3 scene, to cross-check the reference.
     Export(commands::export::ExportArgs),
+    /// Open the real-time viewer (needs a display; see `hprt render` otherwise).
+    View(view::ViewArgs),
     /// Benchmarks anyone can rerun (bake throughput, ...).
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
@@ -49,6 +53,7 @@ fn main() {
         Command::Decompose(args) => commands::decompose::run(args),
         Command::Reference(args) => commands::reference::run(args),
         Command::Render(args) => commands::render::run(args),
+        Command::View(args) => view::run(args),
         Command::Export(args) => commands::export::run(args),
     };
     if let Err(error) = result {

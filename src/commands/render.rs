@@ -89,6 +89,15 @@ pub struct RenderArgs {
     pub width: Option<u32>,
     #[arg(long)]
     pub height: Option<u32>,
+    /// Camera position "x,y,z" (default: the scene's).
+    #[arg(long, value_parser = parse_vec3_arg, allow_hyphen_values = true)]
+    pub camera_position: Option<glam::Vec3>,
+    /// Camera target "x,y,z" (default: the scene's).
+    #[arg(long, value_parser = parse_vec3_arg, allow_hyphen_values = true)]
+    pub camera_target: Option<glam::Vec3>,
+    /// Vertical field of view in degrees (default: the scene's).
+    #[arg(long)]
+    pub fov: Option<f32>,
     /// Tone-mapping exposure (default: 0.5 / the map's mean luminance).
     #[arg(long)]
     pub exposure: Option<f32>,
@@ -100,17 +109,36 @@ pub struct RenderArgs {
     pub exr: Option<PathBuf>,
 }
 
-/// Reads the scene's bake, refusing one of another mesh or of another SH order than asked.
+fn parse_vec3_arg(text: &str) -> Result<glam::Vec3, String> {
+    parse_vec3(text)
+}
+
+/// A vector written "x,y,z".
+pub fn parse_vec3(text: &str) -> Result<glam::Vec3, String> {
+    let parts: Vec<f32> = text
+        .split(',')
+        .map(|p| p.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("expected \"x,y,z\", got {text:?}"))?;
+    match parts[..] {
+        [x, y, z] => Ok(glam::Vec3::new(x, y, z)),
+        _ => Err(format!("expected three numbers \"x,y,z\", got {text:?}")),
+    }
+}
+
+/// Reads the scene's bake, refusing one of another mesh, or one whose SH order is below the
+/// lighting order asked (a lower lighting order than the bake's just drops bands).
 pub fn load_bake(scene: &Scene, path: &Path, order: Option<usize>) -> anyhow::Result<Transfer> {
     let transfer = bakefile::read_for_mesh(path, &scene.geometry.content_hash())
         .context("cannot use the bake")?;
-    if let Some(order) = order.filter(|o| *o != transfer.settings.order) {
+    if let Some(order) = order.filter(|o| *o > transfer.settings.order || *o == 0) {
         anyhow::bail!(
             "{} was baked at SH order {}, but order {order} was asked; re-bake with \
-             `hprt bake {} --order {order}` or drop --order",
+             `hprt bake {} --order {order}` or ask for an order from 1 to {}",
             path.display(),
             transfer.settings.order,
-            scene.path.display()
+            scene.path.display(),
+            transfer.settings.order
         );
     }
     Ok(transfer)
@@ -146,13 +174,16 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let transfer = load_bake(&scene, &args.bake, args.decompose.order)?;
     let env = choose_environment(&scene, args.env.as_deref(), args.layout, args.rotate)?;
-    let camera = scene.camera.with_size(
+    let mut camera = scene.camera.with_size(
         args.width.unwrap_or(scene.camera.width),
         args.height.unwrap_or(scene.camera.height),
     );
+    camera.position = args.camera_position.unwrap_or(camera.position);
+    camera.target = args.camera_target.unwrap_or(camera.target);
+    camera.fov_y_deg = args.fov.unwrap_or(camera.fov_y_deg);
     camera
         .validate()
-        .map_err(|m| anyhow::anyhow!("invalid image size: {m}"))?;
+        .map_err(|m| anyhow::anyhow!("invalid camera or image size: {m}"))?;
     let output = AtomicOutput::create(&args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     let exr_output = match &args.exr {

@@ -649,15 +649,17 @@ impl Renderer {
         self.environment_rotation = rotation_deg.to_radians();
     }
 
-    /// The camera, and the image size with it.
-    pub fn set_camera(&mut self, camera: &Camera) -> Result<(), RenderError> {
+    /// The camera, and the image size with it. Returns whether the image (see
+    /// [`Self::color_view`]) was re-created for a new size.
+    pub fn set_camera(&mut self, camera: &Camera) -> Result<bool, RenderError> {
         camera.validate().map_err(RenderError::Settings)?;
-        if (camera.width, camera.height) != (self.targets.width, self.targets.height) {
+        let resized = (camera.width, camera.height) != (self.targets.width, self.targets.height);
+        if resized {
             self.targets = Targets::new(&self.device, camera.width, camera.height);
             self.light_bind_group = None;
         }
         self.camera = *camera;
-        Ok(())
+        Ok(resized)
     }
 
     pub fn set_lighting(&mut self, lighting: &FrameLighting) -> Result<(), RenderError> {

@@ -1,0 +1,705 @@
+//! `hprt view`: the real-time viewer (winit + egui). The lighting is decomposed again every
+//! frame it changes, as in the thesis' dynamic-lighting case.
+
+mod orbit;
+mod script;
+mod settings;
+mod ui;
+mod window;
+
+use crate::bake_cache;
+use crate::commands::{default_exposure, load_scene};
+use anyhow::Context;
+use clap::Args;
+use orbit::Orbit;
+use precompute::bake::{BakeSettings, Transfer};
+use precompute::envmap::EnvMap;
+use precompute::scene::Scene;
+use runtime::render::{Backend, FrameLighting, RenderMode, Renderer, ShadowSettings};
+use runtime::{CubeMap, CubeSource, DecomposeMode, Decomposer, Decomposition};
+use settings::ViewSettings;
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+use window::WindowGpu;
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::window::{Window, WindowId};
+
+#[derive(Args)]
+pub struct ViewArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Bake of the scene (default: the cached bake of the scene's [bake] settings, or offer
+    /// to make one).
+    #[arg(long)]
+    pub bake: Option<PathBuf>,
+    /// Environment map (default: the scene's).
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    /// Graphics backend: auto, vulkan or gl.
+    #[arg(long, default_value = "auto")]
+    pub backend: Backend,
+    /// Window size.
+    #[arg(long, default_value_t = 1280)]
+    pub width: u32,
+    #[arg(long, default_value_t = 720)]
+    pub height: u32,
+    /// Drive the viewer from a script of commands (see src/view/script.rs).
+    #[arg(long)]
+    pub script: Option<PathBuf>,
+}
+
+/// A bake running in the background for the viewer.
+struct BakeJob {
+    progress: indicatif::ProgressBar,
+    result: std::sync::mpsc::Receiver<anyhow::Result<Transfer>>,
+}
+
+/// The environment in use.
+struct Environment {
+    map: EnvMap,
+    source: CubeSource,
+    cube: CubeMap,
+}
+
+/// Everything the UI shows about the last decomposition.
+#[derive(Default)]
+pub struct Stats {
+    pub frame_ms: VecDeque<f64>,
+    pub decomposition_ms: f64,
+    pub decomposition: Option<Decomposition>,
+    pub adapter: String,
+    pub message: String,
+    pub panels: Vec<String>,
+}
+
+pub struct App {
+    scene: Scene,
+    bake_path: PathBuf,
+    transfer: Option<Arc<Transfer>>,
+    bake_job: Option<BakeJob>,
+    backend: Backend,
+    size: (u32, u32),
+    settings: ViewSettings,
+    /// Settings the lighting was last computed for.
+    lit_for: Option<(ViewSettings, usize)>,
+    env_path_text: String,
+    env_choices: Vec<PathBuf>,
+    environment: Option<Environment>,
+    decomposer: Option<(runtime::DecomposeSettings, Decomposer)>,
+    orbit: Orbit,
+    initial_orbit: Orbit,
+    window: Option<Arc<Window>>,
+    gpu: Option<WindowGpu>,
+    renderer: Option<Renderer>,
+    egui_ctx: egui::Context,
+    egui_state: Option<egui_winit::State>,
+    thumbnail: Option<egui::TextureHandle>,
+    thumbnail_for: Option<(PathBuf, i32)>,
+    stats: Stats,
+    last_frame: Option<Instant>,
+    drag: Option<(MouseButton, (f64, f64))>,
+    cursor: (f64, f64),
+    script: VecDeque<script::Command>,
+    script_wait: u32,
+    frames: u64,
+    /// Width of the control panel in pixels (the scene fills the rest of the window).
+    panel_px: u32,
+    error: Option<anyhow::Error>,
+}
+
+/// Fails clearly when there is no display to open a window on.
+fn check_display() -> anyhow::Result<()> {
+    let has = |name: &str| std::env::var_os(name).is_some_and(|v| !v.is_empty());
+    if !has("DISPLAY") && !has("WAYLAND_DISPLAY") {
+        anyhow::bail!(
+            "no display: hprt view needs a window (set DISPLAY or WAYLAND_DISPLAY, or run it under \
+             `xvfb-run`); to draw an image without a window use `hprt render SCENE --bake BAKE -o out.png`"
+        );
+    }
+    Ok(())
+}
+
+pub fn run(args: ViewArgs) -> anyhow::Result<()> {
+    check_display()?;
+    let scene = load_scene(&args.scene)?;
+    let bake_settings = scene.bake;
+    let (bake_path, transfer) = match &args.bake {
+        Some(path) => {
+            let transfer = crate::commands::render::load_bake(&scene, path, None)?;
+            (path.clone(), Some(Arc::new(transfer)))
+        }
+        None => {
+            let path = bake_cache::bake_path(&scene, &bake_settings);
+            let transfer = path
+                .exists()
+                .then(|| crate::commands::render::load_bake(&scene, &path, None).ok())
+                .flatten()
+                .map(Arc::new);
+            (path, transfer)
+        }
+    };
+    let env = match (&args.env, &scene.environment) {
+        (Some(p), _) => p.clone(),
+        (None, Some(spec)) => spec.map.clone(),
+        (None, None) => anyhow::bail!(
+            "{} names no [environment]; pass --env MAP",
+            scene.path.display()
+        ),
+    };
+    let rotation = scene.environment.as_ref().map_or(0.0, |e| e.rotation_deg);
+    let script = match &args.script {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read {}", path.display()))?;
+            script::parse(path, &text)?.into()
+        }
+        None => VecDeque::new(),
+    };
+    let env_dir = env.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut env_choices: Vec<PathBuf> = std::fs::read_dir(&env_dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
+                .collect()
+        })
+        .unwrap_or_default();
+    env_choices.sort();
+    let order = transfer
+        .as_ref()
+        .map_or(bake_settings.order, |t| t.settings.order);
+    let orbit = Orbit::from_camera(&scene.camera);
+    let settings = ViewSettings {
+        env: env.clone(),
+        rotation_deg: rotation,
+        animate: false,
+        animate_speed: 20.0,
+        mode: RenderMode::Hybrid,
+        decompose_mode: DecomposeMode::Consistent,
+        threshold: runtime::DecomposeSettings::default().threshold,
+        order,
+        shadow: ShadowSettings::default(),
+        lights_indirect: true,
+        exposure: 1.0,
+    };
+    let event_loop = EventLoop::new().map_err(|e| {
+        anyhow::anyhow!(
+            "cannot open a window ({e}); to draw an image without a window use `hprt render`"
+        )
+    })?;
+    let mut app = App {
+        scene,
+        bake_path,
+        transfer,
+        bake_job: None,
+        backend: args.backend,
+        size: (args.width, args.height),
+        env_path_text: env.display().to_string(),
+        settings,
+        lit_for: None,
+        env_choices,
+        environment: None,
+        decomposer: None,
+        orbit,
+        initial_orbit: orbit,
+        window: None,
+        gpu: None,
+        renderer: None,
+        egui_ctx: egui::Context::default(),
+        egui_state: None,
+        thumbnail: None,
+        thumbnail_for: None,
+        stats: Stats::default(),
+        last_frame: None,
+        drag: None,
+        cursor: (0.0, 0.0),
+        script,
+        script_wait: 0,
+        frames: 0,
+        panel_px: 0,
+        error: None,
+    };
+    app.load_environment();
+    event_loop
+        .run_app(&mut app)
+        .context("the window's event loop failed")?;
+    match app.error {
+        Some(error) => Err(error),
+        None => Ok(()),
+    }
+}
+
+impl App {
+    fn load_environment(&mut self) {
+        match precompute::envmap::load(&self.settings.env, None) {
+            Ok(loaded) => {
+                let source =
+                    CubeSource::new(&loaded.map, runtime::DecomposeSettings::default().face_size);
+                let cube = source.cube(self.settings.rotation_deg.to_radians());
+                if self.settings.exposure == 1.0 && self.environment.is_none() {
+                    self.settings.exposure = default_exposure(&loaded.map);
+                }
+                self.environment = Some(Environment {
+                    map: loaded.map,
+                    source,
+                    cube,
+                });
+                self.lit_for = None;
+                self.thumbnail_for = None;
+                self.stats.message = if loaded.sanitized > 0 {
+                    format!(
+                        "{} texels with negative or invalid radiance set to 0",
+                        loaded.sanitized
+                    )
+                } else {
+                    String::new()
+                };
+                if let Some(r) = self.renderer.as_mut() {
+                    let map = &self.environment.as_ref().expect("just set").map;
+                    r.set_environment(map, self.settings.rotation_deg);
+                    if let Some(gpu) = self.gpu.as_mut() {
+                        gpu.renderer_changed();
+                    }
+                }
+            }
+            Err(e) => self.stats.message = format!("cannot load the map: {e}"),
+        }
+    }
+
+    fn start_bake(&mut self) {
+        let scene = self.scene.clone();
+        let path = self.bake_path.clone();
+        let settings: BakeSettings = scene.bake;
+        let progress = indicatif::ProgressBar::hidden();
+        let bar = progress.clone();
+        let (sender, receiver) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let result = (|| -> anyhow::Result<Transfer> {
+                let bvh = precompute::bvh::SceneBvh::build(&scene.geometry.mesh);
+                let (transfer, _) = precompute::bake::bake(&scene.geometry, &bvh, &settings, &bar)
+                    .map_err(anyhow::Error::msg)?;
+                if let Some(dir) = path.parent() {
+                    std::fs::create_dir_all(dir)
+                        .with_context(|| format!("cannot create {}", dir.display()))?;
+                }
+                precompute::bakefile::write(&path, &transfer, &scene.geometry.content_hash())?;
+                Ok(transfer)
+            })();
+            let _ = sender.send(result);
+        });
+        self.bake_job = Some(BakeJob {
+            progress,
+            result: receiver,
+        });
+    }
+
+    fn poll_bake(&mut self) {
+        let Some(job) = &self.bake_job else { return };
+        match job.result.try_recv() {
+            Ok(Ok(transfer)) => {
+                self.settings.order = transfer.settings.order;
+                self.transfer = Some(Arc::new(transfer));
+                self.bake_job = None;
+                self.stats.message = format!("baked into {}", self.bake_path.display());
+            }
+            Ok(Err(e)) => {
+                self.stats.message = format!("the bake failed: {e:#}");
+                self.bake_job = None;
+            }
+            Err(_) => {}
+        }
+    }
+
+    /// The decomposition (and the renderer's lighting) when anything it depends on changed.
+    fn update_lighting(&mut self) -> anyhow::Result<()> {
+        let (Some(env), Some(renderer)) = (self.environment.as_mut(), self.renderer.as_mut())
+        else {
+            return Ok(());
+        };
+        let key = (self.settings.clone(), 0);
+        let needs = match &self.lit_for {
+            Some((previous, _)) => {
+                previous.rotation_deg != key.0.rotation_deg
+                    || previous.decompose_settings() != key.0.decompose_settings()
+                    || previous.mode != key.0.mode
+                    || previous.lights_indirect != key.0.lights_indirect
+                    || previous.env != key.0.env
+            }
+            None => true,
+        };
+        renderer.set_shadow_settings(self.settings.shadow)?;
+        if !needs {
+            return Ok(());
+        }
+        let wanted = self.settings.decompose_settings();
+        if self.decomposer.as_ref().is_none_or(|(s, _)| *s != wanted) {
+            self.decomposer = Some((
+                wanted.clone(),
+                Decomposer::new(wanted).map_err(anyhow::Error::msg)?,
+            ));
+        }
+        let (_, decomposer) = self.decomposer.as_mut().expect("just set");
+        let start = Instant::now();
+        env.source
+            .cube_into(self.settings.rotation_deg.to_radians(), &mut env.cube);
+        let decomposition = decomposer.decompose(&env.cube);
+        let lighting = if self.settings.mode == RenderMode::Prt {
+            FrameLighting::prt(decomposer.project(&env.cube))
+        } else {
+            FrameLighting::for_mode(
+                self.settings.mode,
+                &decomposition.sh,
+                &decomposition,
+                self.settings.lights_indirect,
+            )
+        };
+        self.stats.decomposition_ms = start.elapsed().as_secs_f64() * 1e3;
+        renderer.set_lighting(&lighting)?;
+        renderer.set_environment_rotation(self.settings.rotation_deg);
+        self.stats.decomposition = Some(decomposition);
+        self.lit_for = Some(key);
+        Ok(())
+    }
+
+    fn ensure_renderer(&mut self) -> anyhow::Result<()> {
+        if self.renderer.is_some() {
+            return Ok(());
+        }
+        let (Some(gpu), Some(transfer)) = (self.gpu.as_mut(), self.transfer.as_ref()) else {
+            return Ok(());
+        };
+        let camera = self.orbit.camera(gpu.config.width, gpu.config.height);
+        let mut renderer = Renderer::new(
+            &gpu.gpu,
+            &self.scene.geometry,
+            transfer,
+            &camera,
+            self.settings.shadow,
+        )?;
+        if let Some(env) = &self.environment {
+            renderer.set_environment(&env.map, self.settings.rotation_deg);
+        }
+        gpu.renderer_changed();
+        self.renderer = Some(renderer);
+        self.lit_for = None;
+        Ok(())
+    }
+
+    fn run_script(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<()> {
+        if self.script_wait > 0 {
+            self.script_wait -= 1;
+            return Ok(());
+        }
+        while let Some(command) = self.script.pop_front() {
+            use script::Command as C;
+            match command {
+                C::Wait(n) => {
+                    self.script_wait = n;
+                    return Ok(());
+                }
+                C::Orbit(dx, dy) => self.orbit.rotate(dx, dy),
+                C::Pan(dx, dy) => self.orbit.pan(dx, dy, self.size.1),
+                C::Zoom(steps) => self.orbit.zoom(steps),
+                C::Reset => self.orbit = self.initial_orbit,
+                C::Set(name, value) => {
+                    self.settings.set(&name, &value)?;
+                    if name == "env" {
+                        self.load_environment();
+                    }
+                }
+                C::Screenshot(path) => self.save_screenshot(&path)?,
+                C::WindowScreenshot(path) => self.save_window_screenshot(&path)?,
+                C::SaveCommand(path) => {
+                    let line = self.command_line(&PathBuf::from("render.png"));
+                    precompute::atomic_file::write_atomic(&path, format!("{line}\n").as_bytes())?;
+                }
+                C::State(path) => {
+                    let json = serde_json::to_string_pretty(&self.state_json())?;
+                    precompute::atomic_file::write_atomic(&path, json.as_bytes())?;
+                }
+                C::Quit => {
+                    event_loop.exit();
+                    return Ok(());
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn current_camera(&self) -> precompute::camera::Camera {
+        let (w, h) = self
+            .gpu
+            .as_ref()
+            .map_or(self.size, |g| (g.config.width, g.config.height));
+        self.orbit
+            .camera(w.saturating_sub(self.panel_px).max(16), h)
+    }
+
+    pub fn command_line(&self, output: &Path) -> String {
+        self.settings
+            .render_command(
+                &self.scene.path,
+                &self.bake_path,
+                &self.current_camera(),
+                output,
+            )
+            .iter()
+            .map(|w| settings::shell_quote(w))
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+
+    fn save_screenshot(&mut self, path: &Path) -> anyhow::Result<()> {
+        let renderer = self
+            .renderer
+            .as_ref()
+            .context("nothing rendered yet (no bake)")?;
+        let image = renderer.read_back()?;
+        let rgb = window::display_bytes(&image, self.settings.exposure);
+        precompute::image_io::write_png_rgb8(path, image.width, image.height, &rgb)?;
+        self.stats.message = format!("saved {}", path.display());
+        Ok(())
+    }
+
+    fn save_window_screenshot(&mut self, path: &Path) -> anyhow::Result<()> {
+        let window = self.window.clone().context("no window")?;
+        let (paint, screen) = self.run_ui(&window);
+        let gpu = self.gpu.as_mut().context("no window")?;
+        let (w, h, rgb) = gpu.capture(
+            self.renderer.as_ref(),
+            self.settings.exposure,
+            &paint,
+            &screen,
+        )?;
+        precompute::image_io::write_png_rgb8(path, w as usize, h as usize, &rgb)?;
+        Ok(())
+    }
+
+    fn state_json(&self) -> serde_json::Value {
+        let times: Vec<f64> = self.stats.frame_ms.iter().copied().collect();
+        let frame_ms = if times.is_empty() {
+            0.0
+        } else {
+            crate::commands::bench::median(times)
+        };
+        let lights: Vec<f32> = self
+            .stats
+            .decomposition
+            .as_ref()
+            .map(|d| d.lights.iter().map(|l| l.share).collect())
+            .unwrap_or_default();
+        serde_json::json!({
+            "adapter": self.stats.adapter,
+            "frames": self.frames,
+            "frame_ms": frame_ms,
+            "fps": if frame_ms > 0.0 { 1000.0 / frame_ms } else { 0.0 },
+            "decomposition_ms": self.stats.decomposition_ms,
+            "light_shares": lights,
+            "panels": self.stats.panels,
+            "mode": self.settings.mode.name(),
+            "rotation_deg": self.settings.rotation_deg,
+            "window": [self.current_camera().width, self.current_camera().height],
+            "command": self.command_line(Path::new("render.png")),
+        })
+    }
+
+    fn run_ui(
+        &mut self,
+        window: &Window,
+    ) -> (Vec<egui::ClippedPrimitive>, egui_wgpu::ScreenDescriptor) {
+        let state = self
+            .egui_state
+            .as_mut()
+            .expect("egui is set up with the window");
+        let input = state.take_egui_input(window);
+        let ctx = self.egui_ctx.clone();
+        let mut output = ctx.run_ui(input, |ui| ui::panel(self, ui));
+        let state = self
+            .egui_state
+            .as_mut()
+            .expect("egui is set up with the window");
+        state.handle_platform_output(window, output.platform_output);
+        let gpu = self.gpu.as_mut().expect("a window has its GPU");
+        for (id, deltas) in &output.textures_delta.set {
+            for delta in deltas {
+                gpu.egui
+                    .update_texture(&gpu.gpu.device, &gpu.gpu.queue, *id, delta);
+            }
+        }
+        for id in &output.textures_delta.free {
+            gpu.egui.free_texture(id);
+        }
+        // Applied above: tell epaint they were handled.
+        output.textures_delta.clear();
+        let paint = ctx.tessellate(output.shapes, output.pixels_per_point);
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [gpu.config.width, gpu.config.height],
+            pixels_per_point: output.pixels_per_point,
+        };
+        (paint, screen)
+    }
+
+    fn frame(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<()> {
+        let now = Instant::now();
+        if let Some(last) = self.last_frame {
+            let dt = now.duration_since(last).as_secs_f64();
+            self.stats.frame_ms.push_back(dt * 1e3);
+            if self.stats.frame_ms.len() > 60 {
+                self.stats.frame_ms.pop_front();
+            }
+            if self.settings.animate {
+                self.settings.rotation_deg = (self.settings.rotation_deg
+                    + self.settings.animate_speed * dt as f32)
+                    .rem_euclid(360.0);
+            }
+        }
+        self.last_frame = Some(now);
+        self.poll_bake();
+        self.run_script(event_loop)?;
+        self.ensure_renderer()?;
+        self.update_lighting()?;
+        let camera = self.current_camera();
+        if let Some(renderer) = self.renderer.as_mut() {
+            if renderer.set_camera(&camera)?
+                && let Some(gpu) = self.gpu.as_mut()
+            {
+                gpu.renderer_changed();
+            }
+            renderer.render()?;
+        }
+        let window = self.window.clone().context("no window")?;
+        let (paint, screen) = self.run_ui(&window);
+        let gpu = self.gpu.as_mut().context("no window")?;
+        let frame = match gpu.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(frame)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
+            other => {
+                log::warn!("skipping a frame: {other:?}");
+                let (w, h) = (gpu.config.width, gpu.config.height);
+                gpu.resize(w, h);
+                return Ok(());
+            }
+        };
+        let view = frame.texture.create_view(&Default::default());
+        let mut encoder = gpu.gpu.device.create_command_encoder(&Default::default());
+        gpu.record(
+            &mut encoder,
+            &view,
+            self.renderer.as_ref(),
+            self.settings.exposure,
+            &paint,
+            &screen,
+        );
+        gpu.gpu.queue.submit([encoder.finish()]);
+        window.pre_present_notify();
+        gpu.gpu.queue.present(frame);
+        self.frames += 1;
+        window.request_redraw();
+        Ok(())
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.window.is_some() {
+            return;
+        }
+        let attributes = Window::default_attributes()
+            .with_title(format!("hprt — {}", self.scene.name))
+            .with_inner_size(winit::dpi::PhysicalSize::new(self.size.0, self.size.1));
+        let result = (|| -> anyhow::Result<()> {
+            let window = Arc::new(
+                event_loop
+                    .create_window(attributes)
+                    .context("cannot create a window")?,
+            );
+            let mut descriptor = wgpu::InstanceDescriptor::new_with_display_handle(Box::new(
+                event_loop.owned_display_handle(),
+            ));
+            descriptor.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL;
+            let instance = wgpu::Instance::new(descriptor);
+            let gpu = WindowGpu::new(window.clone(), self.backend, instance)?;
+            self.stats.adapter = gpu.gpu.description().to_string();
+            println!("adapter: {}", self.stats.adapter);
+            self.egui_state = Some(egui_winit::State::new(
+                self.egui_ctx.clone(),
+                egui::ViewportId::ROOT,
+                &window,
+                Some(window.scale_factor() as f32),
+                None,
+                None,
+            ));
+            self.gpu = Some(gpu);
+            self.window = Some(window.clone());
+            window.request_redraw();
+            Ok(())
+        })();
+        if let Err(e) = result {
+            self.error = Some(e);
+            event_loop.exit();
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let consumed = match (&mut self.egui_state, &self.window) {
+            (Some(state), Some(window)) => state.on_window_event(window, &event).consumed,
+            _ => false,
+        };
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                if let Some(gpu) = self.gpu.as_mut() {
+                    gpu.resize(size.width, size.height);
+                }
+                self.size = (size.width.max(1), size.height.max(1));
+            }
+            WindowEvent::RedrawRequested => {
+                if let Err(e) = self.frame(event_loop) {
+                    self.error = Some(e);
+                    event_loop.exit();
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                let previous = self.cursor;
+                self.cursor = (position.x, position.y);
+                if let Some((button, _)) = self.drag {
+                    let (dx, dy) = (
+                        (position.x - previous.0) as f32,
+                        (position.y - previous.1) as f32,
+                    );
+                    match button {
+                        MouseButton::Left => self.orbit.rotate(dx, dy),
+                        _ => self.orbit.pan(dx, dy, self.size.1),
+                    }
+                }
+            }
+            WindowEvent::MouseInput { state, button, .. } if !consumed => match state {
+                ElementState::Pressed => self.drag = Some((button, self.cursor)),
+                ElementState::Released => self.drag = None,
+            },
+            WindowEvent::MouseInput {
+                state: ElementState::Released,
+                ..
+            } => self.drag = None,
+            WindowEvent::MouseWheel { delta, .. } if !consumed => {
+                let steps = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                self.orbit.zoom(steps);
+            }
+            WindowEvent::KeyboardInput { event, .. }
+                if !consumed
+                    && event.state == ElementState::Pressed
+                    && event.logical_key == winit::keyboard::Key::Character("r".into()) =>
+            {
+                self.orbit = self.initial_orbit;
+            }
+            _ => {}
+        }
+    }
+}

@@ -1,0 +1,99 @@
+//! Scripted input for the viewer (`hprt view --script FILE`): drives it without a person, for
+//! the smoke test and for reproducible timings. One command per line, `#` starts a comment:
+//!
+//! ```text
+//! wait 5                    # let 5 frames pass
+//! orbit 40 -10              # drag with the left button by (dx, dy) pixels
+//! pan 20 0                  # drag with the right button
+//! zoom 2                    # wheel notches (positive: closer)
+//! reset                     # the scene's camera again
+//! set rotation 30           # any setting of the panel, see `Setting`
+//! screenshot scene.png      # the rendered image, tone-mapped
+//! window-screenshot ui.png  # the whole window, panels included
+//! command render.sh         # the equivalent `hprt render` command line
+//! state state.json          # lights, timings and visible panels, as JSON
+//! quit
+//! ```
+
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    Wait(u32),
+    Orbit(f32, f32),
+    Pan(f32, f32),
+    Zoom(f32),
+    Reset,
+    Set(String, String),
+    Screenshot(PathBuf),
+    WindowScreenshot(PathBuf),
+    SaveCommand(PathBuf),
+    State(PathBuf),
+    Quit,
+}
+
+/// Parses a script; errors name the file and line.
+pub fn parse(path: &Path, text: &str) -> anyhow::Result<Vec<Command>> {
+    let mut commands = Vec::new();
+    for (number, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let error = |message: &str| {
+            anyhow::anyhow!(
+                "{}: line {}: {message}: {line:?}",
+                path.display(),
+                number + 1
+            )
+        };
+        let number_at = |i: usize| -> anyhow::Result<f32> {
+            words
+                .get(i)
+                .and_then(|w| w.parse::<f32>().ok())
+                .ok_or_else(|| error("expected a number"))
+        };
+        let path_at = |i: usize| -> anyhow::Result<PathBuf> {
+            words
+                .get(i)
+                .map(PathBuf::from)
+                .ok_or_else(|| error("expected a path"))
+        };
+        let command = match words[0] {
+            "wait" => Command::Wait(number_at(1)? as u32),
+            "orbit" => Command::Orbit(number_at(1)?, number_at(2)?),
+            "pan" => Command::Pan(number_at(1)?, number_at(2)?),
+            "zoom" => Command::Zoom(number_at(1)?),
+            "reset" => Command::Reset,
+            "set" if words.len() == 3 => Command::Set(words[1].to_owned(), words[2].to_owned()),
+            "set" => return Err(error("expected `set NAME VALUE`")),
+            "screenshot" => Command::Screenshot(path_at(1)?),
+            "window-screenshot" => Command::WindowScreenshot(path_at(1)?),
+            "command" => Command::SaveCommand(path_at(1)?),
+            "state" => Command::State(path_at(1)?),
+            "quit" => Command::Quit,
+            _ => return Err(error("unknown command")),
+        };
+        commands.push(command);
+    }
+    Ok(commands)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_every_command_and_reports_bad_lines() {
+        let text = "# smoke\nwait 3\norbit 10 -5\npan 1 2\nzoom -1.5\nreset\nset rotation 30\n\
+                    screenshot a.png\nwindow-screenshot b.png\ncommand c.sh\nstate d.json\nquit\n";
+        let commands = parse(Path::new("s.txt"), text).unwrap();
+        assert_eq!(commands.len(), 11);
+        assert_eq!(commands[1], Command::Orbit(10.0, -5.0));
+        assert_eq!(commands[5], Command::Set("rotation".into(), "30".into()));
+        let err = parse(Path::new("s.txt"), "wait\n").unwrap_err().to_string();
+        assert!(err.contains("s.txt: line 1"), "{err}");
+        assert!(parse(Path::new("s.txt"), "fly 1\n").is_err());
+    }
+}

@@ -1,0 +1,199 @@
+//! What the viewer's panel controls, and the `hprt render` command line that reproduces it.
+
+use precompute::camera::Camera;
+use runtime::render::{RenderMode, ShadowSettings};
+use runtime::{DecomposeMode, DecomposeSettings};
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewSettings {
+    pub env: PathBuf,
+    pub rotation_deg: f32,
+    pub animate: bool,
+    /// Degrees per second while animating.
+    pub animate_speed: f32,
+    pub mode: RenderMode,
+    pub decompose_mode: DecomposeMode,
+    pub threshold: f32,
+    /// SH order of the lighting (at most the bake's).
+    pub order: usize,
+    pub shadow: ShadowSettings,
+    pub lights_indirect: bool,
+    pub exposure: f32,
+}
+
+impl ViewSettings {
+    pub fn decompose_settings(&self) -> DecomposeSettings {
+        let defaults = DecomposeSettings::default();
+        DecomposeSettings {
+            mode: self.decompose_mode,
+            order: self.order,
+            radius_deg: DecomposeSettings::default_radius(
+                self.decompose_mode,
+                defaults.smoothing_deg,
+            ),
+            threshold: self.threshold,
+            ..defaults
+        }
+    }
+
+    /// Applies a `set NAME VALUE` of a script.
+    pub fn set(&mut self, name: &str, value: &str) -> anyhow::Result<()> {
+        let number = || {
+            value
+                .parse::<f32>()
+                .map_err(|_| anyhow::anyhow!("{name}: {value:?} is not a number"))
+        };
+        let switch = || match value {
+            "on" | "true" => Ok(true),
+            "off" | "false" => Ok(false),
+            _ => Err(anyhow::anyhow!("{name}: expected on or off, got {value:?}")),
+        };
+        match name {
+            "rotation" => self.rotation_deg = number()?,
+            "animate" => self.animate = switch()?,
+            "speed" => self.animate_speed = number()?,
+            "mode" => self.mode = value.parse().map_err(anyhow::Error::msg)?,
+            "decompose" => self.decompose_mode = value.parse().map_err(anyhow::Error::msg)?,
+            "threshold" => self.threshold = number()?,
+            "order" => self.order = number()? as usize,
+            "shadow_res" => self.shadow.resolution = number()? as u32,
+            "pcf" => self.shadow.pcf_taps = number()? as u32,
+            "pcf_from_radius" => self.shadow.from_angular_radius = switch()?,
+            "lights_indirect" => self.lights_indirect = switch()?,
+            "exposure" => self.exposure = number()?,
+            "env" => self.env = PathBuf::from(value),
+            _ => anyhow::bail!("unknown setting {name:?}"),
+        }
+        Ok(())
+    }
+
+    /// The `hprt render` arguments that draw exactly what the viewer shows.
+    pub fn render_command(
+        &self,
+        scene: &Path,
+        bake: &Path,
+        camera: &Camera,
+        output: &Path,
+    ) -> Vec<String> {
+        let v = |v: glam::Vec3| format!("{},{},{}", v.x, v.y, v.z);
+        let on_off = |b: bool| if b { "on" } else { "off" }.to_owned();
+        vec![
+            "hprt".into(),
+            "render".into(),
+            scene.display().to_string(),
+            "--bake".into(),
+            bake.display().to_string(),
+            "--env".into(),
+            self.env.display().to_string(),
+            format!("--rotate={}", self.rotation_deg),
+            "--mode".into(),
+            self.mode.name().into(),
+            "--decompose-mode".into(),
+            self.decompose_mode.name().into(),
+            "--threshold".into(),
+            self.threshold.to_string(),
+            "--order".into(),
+            self.order.to_string(),
+            "--shadow-res".into(),
+            self.shadow.resolution.to_string(),
+            "--pcf".into(),
+            self.shadow.pcf_taps.to_string(),
+            "--pcf-from-radius".into(),
+            on_off(self.shadow.from_angular_radius),
+            "--lights-indirect".into(),
+            on_off(self.lights_indirect),
+            format!("--camera-position={}", v(camera.position)),
+            format!("--camera-target={}", v(camera.target)),
+            "--fov".into(),
+            camera.fov_y_deg.to_string(),
+            "--width".into(),
+            camera.width.to_string(),
+            "--height".into(),
+            camera.height.to_string(),
+            "--exposure".into(),
+            self.exposure.to_string(),
+            "-o".into(),
+            output.display().to_string(),
+        ]
+    }
+}
+
+/// Quotes a word for a POSIX shell when needed.
+pub fn shell_quote(word: &str) -> String {
+    if !word.is_empty()
+        && word
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./=,:+".contains(c))
+    {
+        word.to_owned()
+    } else {
+        format!("'{}'", word.replace('\'', r"'\''"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn settings() -> ViewSettings {
+        ViewSettings {
+            env: PathBuf::from("scenes/env/sunrise.exr"),
+            rotation_deg: -100.0,
+            animate: false,
+            animate_speed: 20.0,
+            mode: RenderMode::Hybrid,
+            decompose_mode: DecomposeMode::Consistent,
+            threshold: 0.05,
+            order: 5,
+            shadow: ShadowSettings::default(),
+            lights_indirect: true,
+            exposure: 0.6,
+        }
+    }
+
+    #[test]
+    fn script_settings_apply_and_reject_nonsense() {
+        let mut s = settings();
+        s.set("rotation", "12.5").unwrap();
+        s.set("mode", "prt").unwrap();
+        s.set("pcf_from_radius", "off").unwrap();
+        assert_eq!(
+            (s.rotation_deg, s.mode, s.shadow.from_angular_radius),
+            (12.5, RenderMode::Prt, false)
+        );
+        assert!(s.set("mode", "fancy").is_err());
+        assert!(s.set("colour", "1").is_err());
+        assert!(s.set("threshold", "x").is_err());
+    }
+
+    #[test]
+    fn command_line_carries_every_setting() {
+        let camera = Camera {
+            position: glam::Vec3::new(1.0, 2.0, 3.0),
+            target: glam::Vec3::ZERO,
+            up: glam::Vec3::Y,
+            fov_y_deg: 40.0,
+            width: 320,
+            height: 200,
+        };
+        let args = settings().render_command(
+            Path::new("scenes/teapot.toml"),
+            Path::new("t.bake"),
+            &camera,
+            Path::new("out.png"),
+        );
+        let line = args.join(" ");
+        for needle in [
+            "--rotate=-100",
+            "--camera-position=1,2,3",
+            "--width 320",
+            "--pcf-from-radius on",
+            "--exposure 0.6",
+        ] {
+            assert!(line.contains(needle), "{line}");
+        }
+        assert_eq!(shell_quote("a b"), "'a b'");
+        assert_eq!(shell_quote("--rotate=-1"), "--rotate=-1");
+    }
+}

@@ -1,0 +1,150 @@
+//! The viewer under a virtual X server (Xvfb), driven by a script on the software adapter.
+
+mod common;
+
+use common::*;
+use std::process::Command;
+
+fn image_rgb(path: &std::path::Path) -> (u32, u32, Vec<u8>) {
+    let decoded = image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .into_rgb8();
+    (decoded.width(), decoded.height(), decoded.into_raw())
+}
+
+#[test]
+fn without_a_display_it_says_to_use_render() {
+    let out = Command::new(env!("CARGO_BIN_EXE_hprt"))
+        .args(["view", scene("teapot.toml").to_str().unwrap()])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert_clean_failure(&out, &["no display", "hprt render"]);
+}
+
+#[test]
+fn smoke_test_under_xvfb() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let teapot = scene("teapot.toml");
+    let bake = hprt(
+        d,
+        &[
+            "bake",
+            teapot.to_str().unwrap(),
+            "-o",
+            "t.bake",
+            "--order",
+            "3",
+            "--samples",
+            "32",
+            "--bounces",
+            "1",
+        ],
+    );
+    assert!(bake.status.success(), "{}", stderr(&bake));
+    std::fs::write(
+        d.join("smoke.script"),
+        "wait 2\norbit 60 -15\nzoom 1\npan 5 5\nset rotation 30\nwait 2\nscreenshot scene.png\n\
+         window-screenshot window.png\ncommand render.sh\nset animate on\nset speed 90\nwait 3\nstate state.json\nquit\n",
+    )
+    .unwrap();
+    let out = Command::new("xvfb-run")
+        .args([
+            "-a",
+            "-s",
+            "-screen 0 1024x768x24",
+            env!("CARGO_BIN_EXE_hprt"),
+            "view",
+        ])
+        .arg(&teapot)
+        .args([
+            "--bake",
+            "t.bake",
+            "--width",
+            "800",
+            "--height",
+            "500",
+            "--script",
+            "smoke.script",
+        ])
+        .current_dir(d)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("xvfb-run (package xvfb; tests/run.sh installs it)");
+    assert!(out.status.success(), "viewer failed: {}", stderr(&out));
+    assert!(stdout(&out).contains("adapter:"));
+
+    // The scene is drawn: covered pixels are not black.
+    let (w, h, rgb) = image_rgb(&d.join("scene.png"));
+    let lit = rgb
+        .chunks_exact(3)
+        .filter(|p| p.iter().any(|c| *c > 20))
+        .count();
+    assert!(
+        lit as f32 > 0.95 * (w * h) as f32,
+        "{lit} of {} pixels lit",
+        w * h
+    );
+
+    // The window shows the scene on the left and the control panel on the right.
+    let (ww, wh, window) = image_rgb(&d.join("window.png"));
+    assert_eq!((ww, wh), (800, 500));
+    assert!(w < ww, "the scene leaves room for the panel");
+    let column = |x: u32| -> Vec<u8> {
+        (0..wh)
+            .flat_map(|y| window[((y * ww + x) * 3) as usize..][..3].to_vec())
+            .collect()
+    };
+    assert_ne!(column(10), column(ww - 10), "panel and scene differ");
+
+    // The state names the panels, the lights and the timings.
+    let state: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("state.json")).unwrap()).unwrap();
+    let panels: Vec<&str> = state["panels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|p| p.as_str())
+        .collect();
+    for panel in [
+        "Environment",
+        "Decomposition",
+        "Shadows",
+        "Display",
+        "Lights",
+        "Save",
+    ] {
+        assert!(panels.contains(&panel), "{panels:?}");
+    }
+    assert!(!state["light_shares"].as_array().unwrap().is_empty());
+    assert!(state["fps"].as_f64().unwrap() > 0.0);
+    assert_ne!(
+        state["rotation_deg"].as_f64().unwrap(),
+        30.0,
+        "animation turns the map"
+    );
+
+    // The saved command line draws exactly the saved screenshot.
+    let line = std::fs::read_to_string(d.join("render.sh")).unwrap();
+    let args: Vec<String> = line
+        .split_whitespace()
+        .skip(1)
+        .map(|w| w.trim_matches('\'').to_owned())
+        .collect();
+    let rendered = hprt(d, &args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(rendered.status.success(), "{}", stderr(&rendered));
+    let (rw, rh, again) = image_rgb(&d.join("render.png"));
+    assert_eq!((rw, rh), (w, h));
+    let worst = rgb
+        .iter()
+        .zip(&again)
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap();
+    assert!(
+        worst <= 1,
+        "the command line reproduces the viewer's image (worst difference {worst})"
+    );
+}
