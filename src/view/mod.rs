@@ -413,7 +413,7 @@ impl App {
                 }
                 C::Screenshot(path) => self.save_screenshot(&path)?,
                 C::WindowScreenshot(path) => self.save_window_screenshot(&path)?,
-                C::SaveCommand(path) => {
+                C::SaveRenderLine(path) => {
                     let line = self.command_line(&PathBuf::from("render.png"));
                     precompute::atomic_file::write_atomic(&path, format!("{line}\n").as_bytes())?;
                 }

@@ -27,7 +27,7 @@ pub enum Command {
     Set(String, String),
     Screenshot(PathBuf),
     WindowScreenshot(PathBuf),
-    SaveCommand(PathBuf),
+    SaveRenderLine(PathBuf),
     State(PathBuf),
     Quit,
 }
@@ -70,7 +70,7 @@ pub fn parse(path: &Path, text: &str) -> anyhow::Result<Vec<Command>> {
             "set" => return Err(error("expected `set NAME VALUE`")),
             "screenshot" => Command::Screenshot(path_at(1)?),
             "window-screenshot" => Command::WindowScreenshot(path_at(1)?),
-            "command" => Command::SaveCommand(path_at(1)?),
+            "command" => Command::SaveRenderLine(path_at(1)?),
             "state" => Command::State(path_at(1)?),
             "quit" => Command::Quit,
             _ => return Err(error("unknown command")),
