@@ -8,11 +8,14 @@
 //! `T_b = diag(ρ) W T_{b-1}` reuses every hit without tracing again.
 
 mod bounce;
+mod inside;
 mod transfer;
 mod visibility;
 
 pub use bounce::InterreflectionOperator;
+pub use inside::{VertexNeighbours, fill_inside};
 pub use transfer::TransferVectors;
+pub use visibility::INSIDE_BACKFACE_FRACTION;
 
 use crate::bvh::SceneBvh;
 use crate::scene::SceneMesh;
@@ -112,6 +115,9 @@ pub const RAY_OFFSET_FRACTION: f32 = 1e-5;
 pub struct TracedScene {
     pub direct: TransferVectors,
     pub operator: InterreflectionOperator,
+    /// Vertices inside solids (see [`fill_inside`]); their transfer is their neighbours'.
+    pub inside: Vec<bool>,
+    neighbours: VertexNeighbours,
     /// Seconds the tracing took.
     pub seconds: f64,
 }
@@ -129,6 +135,7 @@ impl TracedScene {
         let mut sum = TransferVectors::zeros(order, self.direct.vertex_count());
         (0..bounces).map(move |_| {
             previous = self.operator.apply(&previous, albedo);
+            fill_inside(&mut previous, &self.inside, &self.neighbours);
             for (acc, x) in sum.as_mut_slice().iter_mut().zip(previous.as_slice()) {
                 *acc += x;
             }
@@ -149,10 +156,14 @@ pub fn trace(
     let start = Instant::now();
     progress.set_length(geometry.mesh.vertex_count() as u64);
     let traced = visibility::trace_vertices(geometry, bvh, settings, progress);
-    let direct = traced.direct_transfer(&geometry.albedo, settings.order);
+    let mut direct = traced.direct_transfer(&geometry.albedo, settings.order);
+    let neighbours = VertexNeighbours::new(&geometry.mesh);
+    fill_inside(&mut direct, &traced.inside, &neighbours);
     Ok(TracedScene {
         direct,
         operator: traced.operator,
+        inside: traced.inside,
+        neighbours,
         seconds: start.elapsed().as_secs_f64(),
     })
 }

@@ -20,7 +20,13 @@ pub(super) struct TracedVertices {
     visibility: Vec<f32>,
     /// Where the other rays landed, as interpolation weights over vertices.
     pub operator: InterreflectionOperator,
+    /// Vertices inside a solid: most of their rays reach the back of a surface.
+    pub inside: Vec<bool>,
 }
+
+/// A vertex counts as inside a solid when more than this fraction of its rays reach back
+/// faces (lightmappers call it the back-face tolerance).
+pub const INSIDE_BACKFACE_FRACTION: f32 = 0.5;
 
 impl TracedVertices {
     /// `T_direct,c(v) = ρ_c(v) · visibility(v)`.
@@ -72,6 +78,7 @@ struct Scratch {
 struct Chunk {
     visibility: Vec<f32>,
     operator: OperatorBlock,
+    inside: Vec<bool>,
 }
 
 const CHUNK: usize = 32;
@@ -90,6 +97,9 @@ pub(super) fn trace_vertices(
     let inv_samples = 1.0 / settings.samples as f32;
     let offset = RAY_OFFSET_FRACTION * geometry.diagonal();
     let record_hits = settings.bounces > 0;
+    let front_normals: Vec<Vec3> = (0..mesh.triangle_count())
+        .map(|t| mesh.front_normal(t))
+        .collect();
     let vertex_count = mesh.vertex_count();
 
     let chunks: Vec<Chunk> = (0..vertex_count.div_ceil(CHUNK))
@@ -104,6 +114,7 @@ pub(super) fn trace_vertices(
                 let mut chunk = Chunk {
                     visibility: vec![0.0; vertices.len() * n],
                     operator: OperatorBlock::new(),
+                    inside: Vec::with_capacity(vertices.len()),
                 };
                 for (local, v) in vertices.clone().enumerate() {
                     let normal = mesh.normals[v];
@@ -112,19 +123,19 @@ pub(super) fn trace_vertices(
                     let rotation = hash_to_unit2(mix64(settings.seed ^ mix64(v as u64)));
                     let visibility = &mut chunk.visibility[local * n..(local + 1) * n];
                     scratch.hits.clear();
+                    let mut back_faces = 0u32;
                     for u in &samples {
                         let direction =
                             frame.to_world(cosine_hemisphere(cranley_patterson(*u, rotation)));
-                        let vertex = v as u32;
-                        if record_hits {
-                            match bvh.intersect_from_vertex(vertex, origin, direction, 0.0) {
-                                None => accumulate_basis(
-                                    &basis,
-                                    direction,
-                                    &mut scratch.basis,
-                                    visibility,
-                                ),
-                                Some(hit) => {
+                        match bvh.intersect_from_vertex(v as u32, origin, direction, 0.0) {
+                            None => {
+                                accumulate_basis(&basis, direction, &mut scratch.basis, visibility)
+                            }
+                            Some(hit) => {
+                                if direction.dot(front_normals[hit.triangle as usize]) > 0.0 {
+                                    back_faces += 1;
+                                }
+                                if record_hits {
                                     // Either side of a triangle shows its front's radiance
                                     // (CONVENTIONS.md, "Surfaces").
                                     let corners = mesh.triangles[hit.triangle as usize];
@@ -133,10 +144,11 @@ pub(super) fn trace_vertices(
                                     }
                                 }
                             }
-                        } else if !bvh.occluded_from_vertex(vertex, origin, direction, 0.0) {
-                            accumulate_basis(&basis, direction, &mut scratch.basis, visibility);
                         }
                     }
+                    chunk
+                        .inside
+                        .push(back_faces as f32 > INSIDE_BACKFACE_FRACTION * samples.len() as f32);
                     for y in visibility.iter_mut() {
                         *y *= inv_samples;
                     }
@@ -153,14 +165,17 @@ pub(super) fn trace_vertices(
 
     let mut visibility = Vec::with_capacity(vertex_count * n);
     let mut blocks = Vec::with_capacity(chunks.len());
+    let mut inside = Vec::with_capacity(vertex_count);
     for chunk in chunks {
         visibility.extend_from_slice(&chunk.visibility);
         blocks.push(chunk.operator);
+        inside.extend(chunk.inside);
     }
     TracedVertices {
         order,
         visibility,
         operator: InterreflectionOperator::from_blocks(blocks),
+        inside,
     }
 }
 
