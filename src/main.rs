@@ -3,6 +3,7 @@
 
 mod bake_cache;
 mod commands;
+mod report;
 mod view;
 
 use clap::{Parser, Subcommand};
@@ -16,6 +17,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job: bake the teapot, then write the error report for every bundled map.
+    Demo(commands::demo::DemoArgs),
     /// Bake per-vertex SH transfer (shadowed direct + interreflected) for a scene.
     Bake(commands::bake::BakeArgs),
     /// Decompose an environment map into an SH polynomial plus directional lights.
@@ -26,6 +29,8 @@ enum Command {
     Reference(commands::reference::ReferenceArgs),
     /// Write the scene as a Mitsuba 3 scene, to cross-check the reference.
     Export(commands::export::ExportArgs),
+    /// Error statistics of plain PRT and the hybrid against the path-traced reference.
+    Report(commands::report::ReportArgs),
     /// Open the real-time viewer (needs a display; see `hprt render` otherwise).
     View(view::ViewArgs),
     /// Benchmarks anyone can rerun (bake throughput, ...).
@@ -48,6 +53,8 @@ fn main() {
         .init();
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Demo(args) => commands::demo::run(args),
+        Command::Report(args) => commands::report::run(args),
         Command::Bake(args) => commands::bake::run(args),
         Command::Bench(cmd) => commands::bench::run(cmd),
         Command::Decompose(args) => commands::decompose::run(args),

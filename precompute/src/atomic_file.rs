@@ -21,10 +21,14 @@ impl AtomicOutput {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .ok_or_else(|| std::io::Error::other("the output path has no file name"))?;
-        let temp = tempfile::Builder::new()
-            .prefix(&format!(".{name}."))
-            .suffix(".partial")
-            .tempfile_in(dir)?;
+        let prefix = format!(".{name}.");
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(".partial");
+        // Temporary files are private (0600) by default; the output is an ordinary file, so it
+        // gets the permissions `File::create` would give it (0666 less the umask).
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let temp = builder.tempfile_in(dir)?;
         Ok(Self {
             path: path.to_owned(),
             temp,
@@ -66,5 +70,22 @@ mod tests {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
         write_atomic(&dir.path().join("y.png"), b"data").unwrap();
         assert_eq!(std::fs::read(dir.path().join("y.png")).unwrap(), b"data");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn outputs_get_the_permissions_of_a_created_file() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        write_atomic(&dir.path().join("atomic.png"), b"data").unwrap();
+        std::fs::File::create(dir.path().join("plain.png")).unwrap();
+        let mode = |name: &str| {
+            std::fs::metadata(dir.path().join(name))
+                .unwrap()
+                .permissions()
+                .mode()
+                & 0o777
+        };
+        assert_eq!(mode("atomic.png"), mode("plain.png"));
     }
 }

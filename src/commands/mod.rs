@@ -3,9 +3,11 @@
 pub mod bake;
 pub mod bench;
 pub mod decompose;
+pub mod demo;
 pub mod export;
 pub mod reference;
 pub mod render;
+pub mod report;
 
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};

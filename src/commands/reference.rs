@@ -40,7 +40,7 @@ pub struct ReferenceArgs {
     /// Worker threads (default: all cores); the image does not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Tone-mapping exposure of the PNG (default: 1 / the map's mean luminance).
+    /// Tone-mapping exposure of the PNG (default: 0.5 / the map's mean luminance).
     #[arg(long)]
     pub exposure: Option<f32>,
     /// Output linear OpenEXR.

@@ -15,12 +15,20 @@ pub fn scene(name: &str) -> PathBuf {
 
 /// Runs the `hprt` binary with `args` in `dir`.
 pub fn hprt(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hprt"))
+    hprt_with_env(dir, args, &[])
+}
+
+/// Runs the `hprt` binary with `args` in `dir` and the environment variables `vars`.
+pub fn hprt_with_env(dir: &Path, args: &[&str], vars: &[(&str, &Path)]) -> Output {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_hprt"));
+    command
         .args(args)
         .current_dir(dir)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .expect("hprt runs")
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    for (name, value) in vars {
+        command.env(name, value);
+    }
+    command.output().expect("hprt runs")
 }
 
 pub fn stderr(out: &Output) -> String {

@@ -1,0 +1,58 @@
+//! `hprt demo`: the README's main command. Bakes the teapot (or reuses the cached bake) and
+//! writes the error report for every bundled environment map, at settings that finish in a few
+//! minutes on two CPU cores without a GPU; a second run reuses bake and references.
+
+use super::load_scene;
+use super::report::{ReportOptions, write};
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+pub struct DemoArgs {
+    /// Output folder.
+    #[arg(short, long, default_value = "hprt-demo")]
+    pub output: PathBuf,
+    /// Scene (default: the bundled teapot).
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// Light paths per pixel of the references.
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: u32,
+    #[arg(long, default_value_t = 400)]
+    pub width: u32,
+    #[arg(long, default_value_t = 300)]
+    pub height: u32,
+    /// Graphics backend: auto, vulkan or gl.
+    #[arg(long, default_value = "auto")]
+    pub backend: runtime::render::Backend,
+}
+
+/// The bundled teapot scene: `scenes/teapot.toml` under the working directory, else in the
+/// source tree the program was built from.
+fn bundled_teapot() -> PathBuf {
+    let local = Path::new("scenes/teapot.toml");
+    if local.exists() {
+        return local.to_owned();
+    }
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/teapot.toml")
+}
+
+pub fn run(args: DemoArgs) -> anyhow::Result<()> {
+    let scene = load_scene(&args.scene.unwrap_or_else(bundled_teapot))?;
+    let Some(environment) = &scene.environment else {
+        anyhow::bail!("{} names no [environment]", scene.path.display());
+    };
+    let envs = crate::report::maps_beside(&environment.map);
+    let options = ReportOptions {
+        bake: None,
+        spp: args.spp,
+        bounces: None,
+        width: Some(args.width),
+        height: Some(args.height),
+        seed: 0,
+        thresholds: vec![0.0, 0.02, 0.05, 0.1, 0.2, 0.4],
+        frames: 5,
+        backend: args.backend,
+    };
+    write(&scene, &envs, &options, &args.output)
+}

@@ -1,0 +1,251 @@
+//! `report.html`: one self-contained page (PNGs embedded as base64, plots as inline SVG), so
+//! it can be mailed or archived on its own.
+
+use super::{MapReport, Method, MethodResult, Report};
+use anyhow::Context;
+use base64::Engine;
+use std::fmt::Write;
+use std::path::Path;
+
+const STYLE: &str = "
+body { font-family: system-ui, sans-serif; margin: 2em; color: #222; max-width: 1400px; }
+h1 { font-size: 1.5em; } h2 { font-size: 1.25em; margin-top: 2em; border-bottom: 1px solid #ccc; }
+table { border-collapse: collapse; margin: 1em 0; font-variant-numeric: tabular-nums; }
+th, td { border: 1px solid #ccc; padding: 0.3em 0.6em; text-align: right; }
+th { background: #f3f3f3; } td.name { text-align: left; }
+td.best { font-weight: bold; background: #e8f5e9; }
+.row { display: flex; flex-wrap: wrap; gap: 0.8em; }
+figure { margin: 0; } figcaption { font-size: 0.9em; text-align: center; color: #555; }
+img { image-rendering: pixelated; max-width: 100%; }
+.failed { color: #b00020; } .note { color: #555; font-size: 0.9em; }
+";
+
+/// Escapes text for HTML.
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// `mean ± std` with the digits the errors need; "–" for an empty region.
+fn mean_std(mean: f64, std: f64) -> String {
+    if mean.is_finite() {
+        format!("{mean:.4} ± {std:.4}")
+    } else {
+        "–".into()
+    }
+}
+
+fn embedded_png(path: &Path) -> anyhow::Result<String> {
+    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    Ok(format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(bytes)
+    ))
+}
+
+fn figure(html: &mut String, src: &str, caption: &str) {
+    let _ = write!(
+        html,
+        "<figure><img src=\"{src}\" alt=\"{caption}\"><figcaption>{caption}</figcaption></figure>"
+    );
+}
+
+/// The per-map rows of the Table 5.1-style summary; the lowest error of each statistic bold.
+fn summary_table(html: &mut String, maps: &[&MapReport]) {
+    html.push_str(
+        "<table><tr><th>map</th><th>method</th><th>mean ± std</th><th>shadow mean ± std</th>\
+         <th>relative RMSE</th><th>lights</th><th>decomposition (ms)</th><th>frame (ms)</th></tr>",
+    );
+    for map in maps {
+        let best = |key: fn(&MethodResult) -> f64| {
+            map.methods
+                .iter()
+                .map(key)
+                .filter(|v| v.is_finite())
+                .fold(f64::INFINITY, f64::min)
+        };
+        let best_mean = best(|m| m.stats.mean);
+        let best_shadow = best(|m| m.stats.shadow_mean);
+        let best_rmse = best(|m| m.stats.relative_rmse);
+        let cell = |value: f64, best: f64, text: String| {
+            let class = if value == best { " class=\"best\"" } else { "" };
+            format!("<td{class}>{text}</td>")
+        };
+        for (k, m) in map.methods.iter().enumerate() {
+            let s = &m.stats;
+            let name = if k == 0 {
+                format!(
+                    "<td class=\"name\" rowspan=\"{}\">{}</td>",
+                    map.methods.len(),
+                    escape(&map.name)
+                )
+            } else {
+                String::new()
+            };
+            let _ = write!(
+                html,
+                "<tr>{name}<td class=\"name\">{}</td>{}{}{}<td>{}</td><td>{:.2}</td><td>{:.1}</td></tr>",
+                escape(&m.method),
+                cell(s.mean, best_mean, mean_std(s.mean, s.std)),
+                cell(
+                    s.shadow_mean,
+                    best_shadow,
+                    mean_std(s.shadow_mean, s.shadow_std)
+                ),
+                cell(
+                    s.relative_rmse,
+                    best_rmse,
+                    format!("{:.4}", s.relative_rmse)
+                ),
+                m.lights,
+                m.decomposition_ms,
+                m.frame_ms,
+            );
+        }
+    }
+    html.push_str("</table>");
+}
+
+fn sweep_table(html: &mut String, map: &MapReport) {
+    html.push_str(
+        "<table><tr><th>mode</th><th>Weber threshold</th><th>lights</th><th>mean</th>\
+         <th>shadow mean</th></tr>",
+    );
+    for (label, points) in &map.sweep {
+        for p in points {
+            let shadow = if p.shadow_mean.is_finite() {
+                format!("{:.4}", p.shadow_mean)
+            } else {
+                "–".into()
+            };
+            let _ = write!(
+                html,
+                "<tr><td class=\"name\">{}</td><td>{}</td><td>{}</td><td>{:.4}</td><td>{shadow}</td></tr>",
+                escape(label),
+                p.threshold,
+                p.lights,
+                p.mean
+            );
+        }
+    }
+    html.push_str("</table>");
+}
+
+fn map_section(html: &mut String, map: &MapReport, out: &Path) -> anyhow::Result<()> {
+    let dir = out.join(&map.name);
+    let _ = write!(
+        html,
+        "<h2 id=\"{0}\">{0}</h2><p class=\"note\">{1} · exposure {2:.4} · reference {3}</p>",
+        escape(&map.name),
+        escape(&map.path),
+        map.exposure,
+        if map.reference_cached {
+            "from the cache".to_owned()
+        } else {
+            format!("rendered in {:.1} s", map.reference_seconds)
+        }
+    );
+    html.push_str("<div class=\"row\">");
+    figure(
+        html,
+        &embedded_png(&dir.join("reference.png"))?,
+        "reference (path traced)",
+    );
+    for method in Method::ALL {
+        let png = dir.join(format!("{}.png", method.file_stem()));
+        figure(html, &embedded_png(&png)?, method.name());
+    }
+    html.push_str("</div><div class=\"row\">");
+    for method in Method::ALL {
+        let png = dir.join(format!("error-{}.png", method.file_stem()));
+        figure(
+            html,
+            &embedded_png(&png)?,
+            &format!("|ΔY| after tone mapping, {}", method.name()),
+        );
+    }
+    html.push_str("</div>");
+    summary_table(html, &[map]);
+    let svg_path = dir.join("threshold.svg");
+    let svg = std::fs::read_to_string(&svg_path)
+        .with_context(|| format!("cannot read {}", svg_path.display()))?;
+    let _ = write!(html, "<div class=\"row\"><div>{svg}</div><div>");
+    sweep_table(html, map);
+    html.push_str("</div></div>");
+    Ok(())
+}
+
+/// The page for `report`, whose images lie under `out`.
+pub fn page(report: &Report, out: &Path) -> anyhow::Result<String> {
+    let mut html = String::new();
+    let s = &report.settings;
+    let _ = write!(
+        html,
+        "<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">\
+         <title>hprt report: {scene}</title><style>{STYLE}</style></head><body>\
+         <h1>hprt error report: {scene}</h1>\
+         <p>Hybrid (SH polynomial + shadow-mapped directional lights) and plain PRT against a \
+         path-traced reference, as in Table 5.1 of the thesis. Errors are \
+         |Y(tonemap(test)) − Y(tonemap(reference))| over pixels covered by geometry, one exposure \
+         per map; the shadow region is the covered pixels whose direct visibility of the \
+         environment is below {threshold}; relative RMSE is of linear luminance, relative to the \
+         reference's mean. Bold: the lowest error per map.</p>\
+         <p class=\"note\">{w}×{h} pixels · reference {spp} paths per pixel, {bounces} bounces, \
+         seed {seed} · bake {bake} · adapter {adapter} · frame time: median of {frames} frames</p>",
+        scene = escape(&report.scene),
+        threshold = report.shadow_visibility_threshold,
+        w = s.width,
+        h = s.height,
+        spp = s.spp,
+        bounces = s.bounces,
+        seed = s.seed,
+        bake = escape(&report.bake),
+        adapter = escape(&report.adapter),
+        frames = s.frames,
+    );
+    let ok: Vec<&MapReport> = report.maps.iter().filter(|m| m.status == "ok").collect();
+    let failed: Vec<&MapReport> = report.maps.iter().filter(|m| m.status != "ok").collect();
+    if !ok.is_empty() {
+        html.push_str("<h2>Summary</h2>");
+        summary_table(&mut html, &ok);
+    }
+    if !failed.is_empty() {
+        html.push_str("<h2 class=\"failed\">Maps that failed</h2><ul>");
+        for map in &failed {
+            let _ = write!(
+                html,
+                "<li class=\"failed\"><b>{}</b> ({}): {}</li>",
+                escape(&map.name),
+                escape(&map.path),
+                escape(map.error.as_deref().unwrap_or("unknown error"))
+            );
+        }
+        html.push_str("</ul>");
+    }
+    for map in ok {
+        map_section(&mut html, map, out)?;
+    }
+    html.push_str("</body></html>\n");
+    Ok(html)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escapes_markup() {
+        assert_eq!(
+            escape("<a href=\"x\">&</a>"),
+            "&lt;a href=&quot;x&quot;&gt;&amp;&lt;/a&gt;"
+        );
+    }
+
+    #[test]
+    fn empty_region_shows_a_dash() {
+        assert_eq!(mean_std(f64::NAN, f64::NAN), "–");
+        assert_eq!(mean_std(0.01, 0.002), "0.0100 ± 0.0020");
+    }
+}

@@ -1,0 +1,592 @@
+//! Error-statistics reports (thesis chapter 5, Table 5.1 and Figures 5.7–5.11): for each
+//! environment map, the path-traced reference, the plain PRT image and the hybrid in both
+//! decomposition modes, their error images and statistics, and the error against the Weber
+//! threshold; written as `report.html`, `stats.json` and `stats.csv`.
+
+pub mod figures;
+mod html;
+pub mod stats;
+
+use crate::bake_cache::cache_dir;
+use anyhow::Context;
+use figures::Curve;
+use precompute::bake::Transfer;
+use precompute::bvh::SceneBvh;
+use precompute::camera::Camera;
+use precompute::envmap::EnvMap;
+use precompute::image_io::{RgbImageF32, read_exr, write_exr, write_png};
+use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
+use precompute::scene::Scene;
+use precompute::{Rgb, atomic_file::write_atomic};
+use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
+use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer};
+use stats::{ErrorStats, Masks, error_stats};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What a report renders.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ReportSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Paths per pixel of the reference.
+    pub spp: u32,
+    /// Indirect bounces of the reference (the bake has its own).
+    pub bounces: u32,
+    pub seed: u64,
+    /// Weber thresholds of the error-against-threshold plot.
+    pub thresholds: Vec<f32>,
+    /// Frames timed per method (median reported).
+    pub frames: usize,
+    #[serde(skip)]
+    pub backend: Backend,
+}
+
+/// The methods of the comparison, in the table's order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// The SH projection of the whole map (the thesis' baseline).
+    Prt,
+    /// SH part + shadow-mapped lights, from a decomposition in the given mode.
+    Hybrid(DecomposeMode),
+}
+
+impl Method {
+    pub const ALL: [Method; 3] = [
+        Method::Prt,
+        Method::Hybrid(DecomposeMode::Thesis),
+        Method::Hybrid(DecomposeMode::Consistent),
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Prt => "prt",
+            Method::Hybrid(DecomposeMode::Thesis) => "hybrid/thesis",
+            Method::Hybrid(DecomposeMode::Consistent) => "hybrid/consistent",
+        }
+    }
+
+    /// The method's name in file names.
+    pub fn file_stem(self) -> &'static str {
+        match self {
+            Method::Prt => "prt",
+            Method::Hybrid(DecomposeMode::Thesis) => "hybrid-thesis",
+            Method::Hybrid(DecomposeMode::Consistent) => "hybrid-consistent",
+        }
+    }
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct MethodResult {
+    pub method: String,
+    #[serde(flatten)]
+    pub stats: ErrorStats,
+    pub lights: usize,
+    pub decomposition_ms: f64,
+    pub frame_ms: f64,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SweepPoint {
+    pub threshold: f32,
+    pub lights: usize,
+    pub mean: f64,
+    pub shadow_mean: f64,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct MapReport {
+    pub name: String,
+    pub path: String,
+    /// "ok" or "failed".
+    pub status: String,
+    pub error: Option<String>,
+    pub exposure: f32,
+    pub reference_cached: bool,
+    pub reference_seconds: f64,
+    pub methods: Vec<MethodResult>,
+    pub sweep: Vec<(String, Vec<SweepPoint>)>,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Report {
+    pub scene: String,
+    pub adapter: String,
+    pub bake: String,
+    pub settings: ReportSettings,
+    pub shadow_visibility_threshold: f32,
+    pub maps: Vec<MapReport>,
+}
+
+/// Everything that determines a reference image, hashed: the cache key.
+fn reference_key(
+    scene: &Scene,
+    camera: &Camera,
+    env: &Path,
+    rotation_deg: f32,
+    settings: &ReferenceSettings,
+) -> anyhow::Result<String> {
+    let mut hasher = blake3::Hasher::new();
+    hasher.update(b"hprt reference v1");
+    hasher.update(&scene.geometry.content_hash());
+    hasher.update(serde_json::to_string(camera)?.as_bytes());
+    hasher.update(&std::fs::read(env).with_context(|| format!("cannot read {}", env.display()))?);
+    hasher.update(&rotation_deg.to_le_bytes());
+    hasher.update(serde_json::to_string(settings)?.as_bytes());
+    Ok(hasher.finalize().to_hex()[..24].to_owned())
+}
+
+fn grey(values: &[f32], width: usize, height: usize) -> RgbImageF32 {
+    RgbImageF32::new(
+        width,
+        height,
+        values.iter().map(|v| Rgb::splat(*v)).collect(),
+    )
+}
+
+/// The reference with its coverage and visibility, from the cache or rendered (then cached).
+struct ReferenceImages {
+    radiance: RgbImageF32,
+    coverage: Vec<f32>,
+    visibility: Vec<f32>,
+    cached: bool,
+    seconds: f64,
+}
+
+fn reference_images(
+    scene: &Scene,
+    camera: &Camera,
+    map: &EnvMap,
+    env: &Path,
+    rotation_deg: f32,
+    settings: &ReferenceSettings,
+) -> anyhow::Result<ReferenceImages> {
+    let key = reference_key(scene, camera, env, rotation_deg, settings)?;
+    let dir = cache_dir().join("references");
+    let paths =
+        ["radiance", "coverage", "visibility"].map(|kind| dir.join(format!("{key}.{kind}.exr")));
+    if paths.iter().all(|p| p.exists()) {
+        let loaded = (|| -> anyhow::Result<ReferenceImages> {
+            Ok(ReferenceImages {
+                radiance: read_exr(&paths[0])?,
+                coverage: read_exr(&paths[1])?.pixels.iter().map(|p| p.x).collect(),
+                visibility: read_exr(&paths[2])?.pixels.iter().map(|p| p.x).collect(),
+                cached: true,
+                seconds: 0.0,
+            })
+        })();
+        if let Ok(images) = loaded {
+            return Ok(images);
+        }
+        log::warn!("the cached reference {key} is unreadable; rendering it again");
+    }
+    let start = Instant::now();
+    let bvh = SceneBvh::build(&scene.geometry.mesh);
+    let light = EnvironmentLight::new(map, rotation_deg);
+    let progress = crate::commands::progress_bar(camera.height as u64, "reference rows");
+    let image = reference::render(&scene.geometry, &bvh, &light, camera, settings, &progress);
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    write_exr(&paths[0], &image.radiance)?;
+    write_exr(&paths[1], &grey(&image.coverage, w, h))?;
+    write_exr(&paths[2], &grey(&image.visibility, w, h))?;
+    Ok(ReferenceImages {
+        radiance: image.radiance,
+        coverage: image.coverage,
+        visibility: image.visibility,
+        cached: false,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// Renders with `lighting` and times `frames` frames (static lighting, median).
+fn render_timed(
+    renderer: &mut Renderer,
+    lighting: &FrameLighting,
+    frames: usize,
+) -> anyhow::Result<(RgbImageF32, f64)> {
+    renderer.set_lighting(lighting)?;
+    renderer.render()?;
+    let image = renderer.read_back()?;
+    let mut times = Vec::new();
+    for _ in 0..frames.max(1) {
+        let start = Instant::now();
+        renderer.render()?;
+        renderer.wait();
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok((image, crate::commands::bench::median(times)))
+}
+
+fn map_name(path: &Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "map".into())
+}
+
+struct MapJob<'a> {
+    scene: &'a Scene,
+    camera: Camera,
+    settings: &'a ReportSettings,
+    renderer: &'a mut Renderer,
+    out: &'a Path,
+}
+
+/// A map's lighting for each method, from its cube map (resampled once).
+struct LightingSource {
+    cube: runtime::CubeMap,
+    order: usize,
+}
+
+impl LightingSource {
+    /// The lighting of `method` at Weber `threshold`, its number of lights and the
+    /// decomposition (or projection) time in milliseconds.
+    fn lighting(
+        &self,
+        method: Method,
+        threshold: f32,
+    ) -> anyhow::Result<(FrameLighting, usize, f64)> {
+        let defaults = DecomposeSettings::default();
+        let mode = match method {
+            Method::Prt => defaults.mode,
+            Method::Hybrid(mode) => mode,
+        };
+        let settings = DecomposeSettings {
+            mode,
+            order: self.order,
+            threshold,
+            radius_deg: DecomposeSettings::default_radius(mode, defaults.smoothing_deg),
+            ..defaults
+        };
+        let mut decomposer = Decomposer::new(settings).map_err(anyhow::Error::msg)?;
+        let start = Instant::now();
+        Ok(match method {
+            Method::Prt => {
+                let sh = decomposer.project(&self.cube);
+                let ms = start.elapsed().as_secs_f64() * 1e3;
+                (FrameLighting::prt(sh), 0, ms)
+            }
+            Method::Hybrid(mode) => {
+                let d = decomposer.decompose(&self.cube);
+                let ms = start.elapsed().as_secs_f64() * 1e3;
+                // The consistent mode's lights carry their bounce light; the thesis' do not.
+                let indirect = mode == DecomposeMode::Consistent;
+                let lighting = FrameLighting::for_mode(RenderMode::Hybrid, &d.sh, &d, indirect);
+                (lighting, d.lights.len(), ms)
+            }
+        })
+    }
+}
+
+/// The reference's images, written into the map's folder.
+fn write_reference(dir: &Path, reference: &ReferenceImages, exposure: f32) -> anyhow::Result<()> {
+    let (w, h) = (reference.radiance.width, reference.radiance.height);
+    write_exr(&dir.join("reference.exr"), &reference.radiance)?;
+    write_png(&dir.join("reference.png"), &reference.radiance, exposure)?;
+    write_exr(
+        &dir.join("reference-coverage.exr"),
+        &grey(&reference.coverage, w, h),
+    )?;
+    write_exr(
+        &dir.join("reference-visibility.exr"),
+        &grey(&reference.visibility, w, h),
+    )?;
+    Ok(())
+}
+
+/// Error heat maps on one scale per map, the baseline's (PRT's) 99th percentile over covered
+/// pixels; larger errors saturate.
+fn write_heat_maps(
+    dir: &Path,
+    images: &[RgbImageF32],
+    reference: &RgbImageF32,
+    masks: &Masks,
+    exposure: f32,
+) -> anyhow::Result<()> {
+    let errors: Vec<Vec<f32>> = images
+        .iter()
+        .map(|image| stats::error_image(image, reference, exposure))
+        .collect();
+    let scale = stats::covered_percentile(&errors[0], &masks.covered, 0.99).max(1e-3);
+    for (method, errors) in Method::ALL.iter().zip(&errors) {
+        let (w, h) = (reference.width as u32, reference.height as u32);
+        let png = figures::heat_map(errors, &masks.covered, w, h, scale, method.name())?;
+        write_atomic(&dir.join(format!("error-{}.png", method.file_stem())), &png)?;
+    }
+    Ok(())
+}
+
+/// One map's section; an error is reported as a failed map by the caller.
+fn report_map(job: &mut MapJob, env: &Path) -> anyhow::Result<MapReport> {
+    let name = map_name(env);
+    let map = crate::commands::decompose::load_map(env, None)?.map;
+    let rotation = job
+        .scene
+        .environment
+        .as_ref()
+        .map_or(0.0, |e| e.rotation_deg);
+    let exposure = crate::commands::default_exposure(&map);
+    let dir = job.out.join(&name);
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+
+    let reference_settings = ReferenceSettings {
+        spp: job.settings.spp,
+        bounces: job.settings.bounces,
+        seed: job.settings.seed,
+    };
+    let reference = reference_images(
+        job.scene,
+        &job.camera,
+        &map,
+        env,
+        rotation,
+        &reference_settings,
+    )?;
+    if reference.cached {
+        println!("{name}: reference from the cache");
+    } else {
+        println!(
+            "{name}: reference ({}x{}, {} spp) rendered in {:.1} s",
+            job.camera.width, job.camera.height, job.settings.spp, reference.seconds
+        );
+    }
+    write_reference(&dir, &reference, exposure)?;
+    let masks = Masks::new(&reference.coverage, &reference.visibility);
+
+    job.renderer.set_environment(&map, rotation);
+    let lighting = LightingSource {
+        cube: CubeSource::new(&map, DecomposeSettings::default().face_size)
+            .cube(rotation.to_radians()),
+        order: job.renderer.order(),
+    };
+    let default_threshold = DecomposeSettings::default().threshold;
+    let mut methods = Vec::new();
+    let mut images = Vec::new();
+    for method in Method::ALL {
+        let (frame, lights, decomposition_ms) = lighting.lighting(method, default_threshold)?;
+        let (image, frame_ms) = render_timed(job.renderer, &frame, job.settings.frames)?;
+        write_exr(&dir.join(format!("{}.exr", method.file_stem())), &image)?;
+        write_png(
+            &dir.join(format!("{}.png", method.file_stem())),
+            &image,
+            exposure,
+        )?;
+        methods.push(MethodResult {
+            method: method.name().to_owned(),
+            stats: error_stats(&image, &reference.radiance, &masks, exposure),
+            lights,
+            decomposition_ms,
+            frame_ms,
+        });
+        images.push(image);
+    }
+    write_heat_maps(&dir, &images, &reference.radiance, &masks, exposure)?;
+
+    // Error against the Weber threshold, for both hybrid modes.
+    let mut sweep = Vec::new();
+    let mut curves = Vec::new();
+    for method in &Method::ALL[1..] {
+        let mut points = Vec::new();
+        for &threshold in &job.settings.thresholds {
+            let (frame, lights, _) = lighting.lighting(*method, threshold)?;
+            job.renderer.set_lighting(&frame)?;
+            job.renderer.render()?;
+            let image = job.renderer.read_back()?;
+            let s = error_stats(&image, &reference.radiance, &masks, exposure);
+            points.push(SweepPoint {
+                threshold,
+                lights,
+                mean: s.mean,
+                shadow_mean: s.shadow_mean,
+            });
+        }
+        curves.push(Curve {
+            label: method.name().to_owned(),
+            points: points
+                .iter()
+                .map(|p| (p.threshold, p.mean, p.lights))
+                .collect(),
+        });
+        sweep.push((method.name().to_owned(), points));
+    }
+    let svg = figures::threshold_plot(&name, &curves, methods[0].stats.mean)?;
+    write_atomic(&dir.join("threshold.svg"), svg.as_bytes())?;
+    Ok(MapReport {
+        name,
+        path: env.display().to_string(),
+        status: "ok".into(),
+        error: None,
+        exposure,
+        reference_cached: reference.cached,
+        reference_seconds: reference.seconds,
+        methods,
+        sweep,
+    })
+}
+
+/// Writes the whole report into `out`; maps that fail are reported as failed.
+pub fn run_report(
+    scene: &Scene,
+    transfer: &Transfer,
+    bake: &Path,
+    envs: &[PathBuf],
+    settings: &ReportSettings,
+    out: &Path,
+) -> anyhow::Result<Report> {
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let camera = scene.camera.with_size(settings.width, settings.height);
+    camera
+        .validate()
+        .map_err(|m| anyhow::anyhow!("invalid image size: {m}"))?;
+    let gpu = GpuContext::headless(settings.backend)?;
+    println!("adapter: {}", gpu.description());
+    let mut renderer = Renderer::new(
+        &gpu,
+        &scene.geometry,
+        transfer,
+        &camera,
+        ShadowSettings::default(),
+    )?;
+    let mut maps = Vec::new();
+    for env in envs {
+        let mut cx = MapJob {
+            scene,
+            camera,
+            settings,
+            renderer: &mut renderer,
+            out,
+        };
+        let report = report_map(&mut cx, env).unwrap_or_else(|e| {
+            println!("{}: failed: {e:#}", env.display());
+            MapReport {
+                name: map_name(env),
+                path: env.display().to_string(),
+                status: "failed".into(),
+                error: Some(format!("{e:#}")),
+                exposure: 0.0,
+                reference_cached: false,
+                reference_seconds: 0.0,
+                methods: Vec::new(),
+                sweep: Vec::new(),
+            }
+        });
+        maps.push(report);
+    }
+    let report = Report {
+        scene: scene.path.display().to_string(),
+        adapter: gpu.description().to_string(),
+        bake: bake.display().to_string(),
+        settings: settings.clone(),
+        shadow_visibility_threshold: stats::SHADOW_VISIBILITY,
+        maps,
+    };
+    write_atomic(
+        &out.join("stats.json"),
+        serde_json::to_string_pretty(&report)?.as_bytes(),
+    )?;
+    write_atomic(&out.join("stats.csv"), &csv_bytes(&report)?)?;
+    write_atomic(
+        &out.join("report.html"),
+        html::page(&report, out)?.as_bytes(),
+    )?;
+    Ok(report)
+}
+
+fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    writer.write_record([
+        "map",
+        "status",
+        "method",
+        "mean",
+        "std",
+        "shadow_mean",
+        "shadow_std",
+        "relative_rmse",
+        "lights",
+        "decomposition_ms",
+        "frame_ms",
+        "covered_pixels",
+        "shadow_pixels",
+    ])?;
+    for map in &report.maps {
+        if map.methods.is_empty() {
+            writer.write_record([
+                map.name.as_str(),
+                map.status.as_str(),
+                "",
+                "",
+                "",
+                "",
+                "",
+                "",
+                "",
+                "",
+                "",
+                "",
+                "",
+            ])?;
+        }
+        for m in &map.methods {
+            let s = &m.stats;
+            writer.write_record([
+                map.name.clone(),
+                map.status.clone(),
+                m.method.clone(),
+                format!("{:.6}", s.mean),
+                format!("{:.6}", s.std),
+                format!("{:.6}", s.shadow_mean),
+                format!("{:.6}", s.shadow_std),
+                format!("{:.6}", s.relative_rmse),
+                m.lights.to_string(),
+                format!("{:.3}", m.decomposition_ms),
+                format!("{:.3}", m.frame_ms),
+                s.covered_pixels.to_string(),
+                s.shadow_pixels.to_string(),
+            ])?;
+        }
+    }
+    writer.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
+}
+
+/// The maps next to `map` (its folder's `.exr` and `.hdr` files), sorted.
+pub fn maps_beside(map: &Path) -> Vec<PathBuf> {
+    let dir = map.parent().unwrap_or(Path::new("."));
+    let mut maps: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
+                .collect()
+        })
+        .unwrap_or_default();
+    maps.sort();
+    maps
+}
+
+/// Uses `bake` if given, else the cached bake of the scene's settings, baking it if missing.
+pub fn bake_for(scene: &Scene, bake: Option<&Path>) -> anyhow::Result<(PathBuf, Transfer)> {
+    if let Some(path) = bake {
+        return Ok((
+            path.to_owned(),
+            crate::commands::render::load_bake(scene, path, None)?,
+        ));
+    }
+    let path = crate::bake_cache::bake_path(scene, &scene.bake);
+    if let Ok(transfer) = crate::commands::render::load_bake(scene, &path, None) {
+        println!("using the cached bake {}", path.display());
+        return Ok((path, transfer));
+    }
+    println!("baking {} into {}", scene.name, path.display());
+    let bvh = SceneBvh::build(&scene.geometry.mesh);
+    let progress =
+        crate::commands::progress_bar(scene.geometry.mesh.vertex_count() as u64, "baking");
+    let (transfer, stats) = precompute::bake::bake(&scene.geometry, &bvh, &scene.bake, &progress)
+        .map_err(anyhow::Error::msg)?;
+    crate::commands::bake::print_stats(&stats);
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    precompute::bakefile::write(&path, &transfer, &scene.geometry.content_hash())?;
+    Ok((path, transfer))
+}

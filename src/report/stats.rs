@@ -1,0 +1,158 @@
+//! Error statistics of a test image against the reference (CONVENTIONS.md, "Error
+//! statistics"): `|Y(tonemap(test)) − Y(tonemap(reference))|` over covered pixels and over the
+//! shadow region, and the RMSE of linear luminance relative to the reference's mean.
+
+use precompute::image_io::{RgbImageF32, tonemap};
+use precompute::luminance;
+
+/// Pixels whose reference direct visibility is below this belong to the shadow region.
+pub const SHADOW_VISIBILITY: f32 = 0.5;
+
+/// The statistics of one image.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ErrorStats {
+    /// Mean and standard deviation of the tone-mapped luminance error over covered pixels.
+    pub mean: f64,
+    pub std: f64,
+    /// The same over the shadow region (NaN when it is empty).
+    pub shadow_mean: f64,
+    pub shadow_std: f64,
+    /// RMSE of linear luminance over covered pixels, relative to the reference's mean there.
+    pub relative_rmse: f64,
+    pub covered_pixels: usize,
+    pub shadow_pixels: usize,
+}
+
+/// The masks the statistics use, from the reference's auxiliary images.
+pub struct Masks {
+    pub covered: Vec<bool>,
+    pub shadow: Vec<bool>,
+}
+
+impl Masks {
+    pub fn new(coverage: &[f32], visibility: &[f32]) -> Self {
+        let covered: Vec<bool> = coverage.iter().map(|c| *c > 0.5).collect();
+        let shadow = covered
+            .iter()
+            .zip(visibility)
+            .map(|(c, v)| *c && *v < SHADOW_VISIBILITY)
+            .collect();
+        Self { covered, shadow }
+    }
+}
+
+/// Per-pixel `|Y(tonemap(test)) − Y(tonemap(reference))|`.
+pub fn error_image(test: &RgbImageF32, reference: &RgbImageF32, exposure: f32) -> Vec<f32> {
+    test.pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(t, r)| (luminance(tonemap(*t, exposure)) - luminance(tonemap(*r, exposure))).abs())
+        .collect()
+}
+
+/// The `q` quantile (0..=1, nearest rank) of `values` over covered pixels; 0 when none is.
+pub fn covered_percentile(values: &[f32], covered: &[bool], q: f64) -> f32 {
+    let mut kept: Vec<f32> = values
+        .iter()
+        .zip(covered)
+        .filter(|(_, c)| **c)
+        .map(|(v, _)| *v)
+        .collect();
+    if kept.is_empty() {
+        return 0.0;
+    }
+    kept.sort_by(f32::total_cmp);
+    let rank = ((kept.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
+    kept[rank]
+}
+
+fn mean_std(values: impl Iterator<Item = f64> + Clone) -> (f64, f64, usize) {
+    let n = values.clone().count();
+    if n == 0 {
+        return (f64::NAN, f64::NAN, 0);
+    }
+    let mean = values.clone().sum::<f64>() / n as f64;
+    let variance = values.map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+    (mean, variance.sqrt(), n)
+}
+
+pub fn error_stats(
+    test: &RgbImageF32,
+    reference: &RgbImageF32,
+    masks: &Masks,
+    exposure: f32,
+) -> ErrorStats {
+    let errors = error_image(test, reference, exposure);
+    let masked = |mask: &[bool]| {
+        let errors = &errors;
+        mask.iter()
+            .zip(errors.iter())
+            .filter(|(m, _)| **m)
+            .map(|(_, e)| *e as f64)
+            .collect::<Vec<f64>>()
+    };
+    let covered = masked(&masks.covered);
+    let shadow = masked(&masks.shadow);
+    let (mean, std, covered_pixels) = mean_std(covered.iter().copied());
+    let (shadow_mean, shadow_std, shadow_pixels) = mean_std(shadow.iter().copied());
+    let (mut squared, mut reference_sum) = (0.0f64, 0.0f64);
+    for ((t, r), _) in test
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .zip(&masks.covered)
+        .filter(|(_, c)| **c)
+    {
+        squared += ((luminance(*t) - luminance(*r)) as f64).powi(2);
+        reference_sum += luminance(*r) as f64;
+    }
+    let n = covered_pixels.max(1) as f64;
+    ErrorStats {
+        mean,
+        std,
+        shadow_mean,
+        shadow_std,
+        relative_rmse: (squared / n).sqrt() / (reference_sum / n).max(1e-12),
+        covered_pixels,
+        shadow_pixels,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use precompute::Rgb;
+
+    #[test]
+    fn percentile_ignores_uncovered_pixels() {
+        let values: Vec<f32> = (0..=100).map(|v| v as f32).chain([1e6]).collect();
+        let mut covered = vec![true; 101];
+        covered.push(false);
+        assert_eq!(covered_percentile(&values, &covered, 0.99), 99.0);
+        assert_eq!(covered_percentile(&values, &covered, 0.0), 0.0);
+        assert_eq!(covered_percentile(&values, &[false; 102], 0.5), 0.0);
+    }
+
+    #[test]
+    fn statistics_of_a_known_difference() {
+        let exposure = 1.0;
+        let reference = RgbImageF32::new(2, 2, vec![Rgb::splat(1.0); 4]);
+        let mut test = reference.clone();
+        test.pixels[1] = Rgb::splat(2.0);
+        test.pixels[3] = Rgb::splat(5.0); // not covered: ignored
+        let masks = Masks::new(&[1.0, 1.0, 1.0, 0.0], &[1.0, 0.2, 1.0, 1.0]);
+        let stats = error_stats(&test, &reference, &masks, exposure);
+        let e = (1.0 - (-2.0f64).exp()) - (1.0 - (-1.0f64).exp());
+        assert!((stats.mean - e / 3.0).abs() < 1e-6);
+        assert!((stats.shadow_mean - e).abs() < 1e-6 && stats.shadow_pixels == 1);
+        // One covered pixel off by 1 in luminance: RMSE √(1/3), reference mean 1.
+        assert!((stats.relative_rmse - (1.0f64 / 3.0).sqrt()).abs() < 1e-6);
+        assert_eq!(stats.covered_pixels, 3);
+        let empty = Masks::new(&[1.0; 4], &[1.0; 4]);
+        assert!(
+            error_stats(&test, &reference, &empty, exposure)
+                .shadow_mean
+                .is_nan()
+        );
+    }
+}

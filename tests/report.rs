@@ -1,0 +1,267 @@
+//! `hprt report` end to end on a small configuration: teapot under sunrise.exr at a small image
+//! size and low path count, plus maps that fail to load. The report is left in
+//! `target/tmp/report/` for inspection.
+
+mod common;
+
+use common::*;
+use precompute::image_io::read_exr;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// Statistics recomputed here from the written EXRs, straight from CONVENTIONS.md.
+struct Recomputed {
+    mean: f64,
+    std: f64,
+    shadow_mean: f64,
+    shadow_std: f64,
+    relative_rmse: f64,
+    covered: usize,
+    shadow: usize,
+}
+
+fn luminance(rgb: [f32; 3]) -> f64 {
+    0.2126 * rgb[0] as f64 + 0.7152 * rgb[1] as f64 + 0.0722 * rgb[2] as f64
+}
+
+/// Tone mapping as displayed: negative radiance (SH ringing in PRT images) shows as black.
+fn tonemapped_luminance(rgb: [f32; 3], exposure: f64) -> f64 {
+    luminance(rgb.map(|c| (1.0 - (-exposure * c.max(0.0) as f64).exp()) as f32))
+}
+
+fn pixels(path: &Path) -> Vec<[f32; 3]> {
+    read_exr(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .pixels
+        .iter()
+        .map(|p| [p.x, p.y, p.z])
+        .collect()
+}
+
+fn recompute(dir: &Path, method_file: &str, exposure: f64, shadow_threshold: f64) -> Recomputed {
+    let reference = pixels(&dir.join("reference.exr"));
+    let test = pixels(&dir.join(format!("{method_file}.exr")));
+    let coverage = pixels(&dir.join("reference-coverage.exr"));
+    let visibility = pixels(&dir.join("reference-visibility.exr"));
+    let (mut all, mut shadow) = (Vec::new(), Vec::new());
+    let (mut squared, mut reference_sum) = (0.0, 0.0);
+    for i in 0..reference.len() {
+        if coverage[i][0] <= 0.5 {
+            continue;
+        }
+        let error = (tonemapped_luminance(test[i], exposure)
+            - tonemapped_luminance(reference[i], exposure))
+        .abs();
+        all.push(error);
+        if (visibility[i][0] as f64) < shadow_threshold {
+            shadow.push(error);
+        }
+        squared += (luminance(test[i]) - luminance(reference[i])).powi(2);
+        reference_sum += luminance(reference[i]);
+    }
+    let mean_std = |v: &[f64]| {
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / v.len() as f64;
+        (mean, var.sqrt())
+    };
+    let (mean, std) = mean_std(&all);
+    let (shadow_mean, shadow_std) = mean_std(&shadow);
+    let n = all.len() as f64;
+    Recomputed {
+        mean,
+        std,
+        shadow_mean,
+        shadow_std,
+        relative_rmse: (squared / n).sqrt() / (reference_sum / n),
+        covered: all.len(),
+        shadow: shadow.len(),
+    }
+}
+
+fn close(a: f64, b: &Value, what: &str) {
+    let b = b.as_f64().unwrap_or_else(|| panic!("{what} missing"));
+    assert!(
+        (a - b).abs() <= 1e-5 * b.abs().max(1e-3),
+        "{what}: stats.json says {b}, the images give {a}"
+    );
+}
+
+fn output_dir() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("report");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn report_measures_shadows_and_survives_bad_maps() {
+    let dir = output_dir();
+    let cache = dir.join("cache");
+    let bake = dir.join("teapot.bake");
+    let out = bake_cli_ok(&dir, &bake);
+    assert!(out.status.success(), "bake failed: {}", stderr(&out));
+
+    let garbage = dir.join("garbage.exr");
+    std::fs::write(&garbage, b"not an exr").unwrap();
+    let sunrise = scene("env/sunrise.exr");
+    let venice = scene("env/venice_dwab.exr");
+    let report_dir = dir.join("out");
+    let teapot = scene("teapot.toml");
+    let args = [
+        "report",
+        teapot.to_str().unwrap(),
+        "--bake",
+        bake.to_str().unwrap(),
+        "--envs",
+        sunrise.to_str().unwrap(),
+        venice.to_str().unwrap(),
+        garbage.to_str().unwrap(),
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--spp",
+        "128",
+        "--thresholds",
+        "0.05",
+        "0.3",
+        "--frames",
+        "1",
+        "-o",
+        report_dir.to_str().unwrap(),
+    ];
+    let out = hprt_with_env(&dir, &args, &[("HPRT_CACHE", &cache)]);
+    assert!(
+        out.status.success(),
+        "report failed: {}\n{}",
+        stdout(&out),
+        stderr(&out)
+    );
+    assert!(!stdout(&out).contains("from the cache"));
+
+    let stats: Value =
+        serde_json::from_slice(&std::fs::read(report_dir.join("stats.json")).unwrap()).unwrap();
+    let maps = stats["maps"].as_array().unwrap();
+    assert_eq!(maps.len(), 3);
+
+    // The maps that cannot be read are reported as failed, with the reason.
+    for (map, reason) in [(&maps[1], "DWAB"), (&maps[2], "garbage.exr")] {
+        assert_eq!(map["status"], "failed");
+        let error = map["error"].as_str().unwrap();
+        assert!(error.contains(reason), "{error}");
+        assert!(!report_dir.join(map["name"].as_str().unwrap()).exists());
+    }
+    let html = std::fs::read_to_string(report_dir.join("report.html")).unwrap();
+    assert!(html.contains("venice_dwab") && html.contains("Maps that failed"));
+    let csv = std::fs::read_to_string(report_dir.join("stats.csv")).unwrap();
+    assert!(csv.contains("venice_dwab,failed"));
+
+    // The working map: every statistic in stats.json is what its images give.
+    let sunrise_report = &maps[0];
+    assert_eq!(sunrise_report["status"], "ok");
+    let map_dir = report_dir.join("sunrise");
+    let exposure = sunrise_report["exposure"].as_f64().unwrap();
+    let threshold = stats["shadow_visibility_threshold"].as_f64().unwrap();
+    let methods = sunrise_report["methods"].as_array().unwrap();
+    let names: Vec<&str> = methods
+        .iter()
+        .map(|m| m["method"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["prt", "hybrid/thesis", "hybrid/consistent"]);
+    let mut shadow_errors = Vec::new();
+    for m in methods {
+        let name = m["method"].as_str().unwrap();
+        let r = recompute(&map_dir, &name.replace('/', "-"), exposure, threshold);
+        close(r.mean, &m["mean"], &format!("{name} mean"));
+        close(r.std, &m["std"], &format!("{name} std"));
+        close(
+            r.shadow_mean,
+            &m["shadow_mean"],
+            &format!("{name} shadow mean"),
+        );
+        close(
+            r.shadow_std,
+            &m["shadow_std"],
+            &format!("{name} shadow std"),
+        );
+        close(
+            r.relative_rmse,
+            &m["relative_rmse"],
+            &format!("{name} rmse"),
+        );
+        assert_eq!(m["covered_pixels"].as_u64(), Some(r.covered as u64));
+        assert_eq!(m["shadow_pixels"].as_u64(), Some(r.shadow as u64));
+        shadow_errors.push(r.shadow_mean);
+        for file in [
+            format!("{}.png", name.replace('/', "-")),
+            format!("error-{}.png", name.replace('/', "-")),
+        ] {
+            assert!(map_dir.join(&file).exists(), "{file} missing");
+        }
+    }
+    // The teapot casts a real shadow on the table under sunrise's sun.
+    let shadow_pixels = methods[0]["shadow_pixels"].as_u64().unwrap();
+    assert!(shadow_pixels > 200, "only {shadow_pixels} shadow pixels");
+    // What the method is for: the hybrid's shadows are closer to the truth than PRT's.
+    let (prt, hybrid) = (shadow_errors[0], shadow_errors[2]);
+    assert!(
+        hybrid < 0.7 * prt,
+        "hybrid shadow error {hybrid} not well below prt's {prt}"
+    );
+    assert!(methods[2]["lights"].as_u64().unwrap() >= 1);
+    for file in ["reference.png", "threshold.svg"] {
+        assert!(map_dir.join(file).exists(), "{file} missing");
+    }
+
+    // A rerun with the same inputs takes the reference from the cache.
+    let out = hprt_with_env(&dir, &args, &[("HPRT_CACHE", &cache)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("sunrise: reference from the cache"));
+    let again: Value =
+        serde_json::from_slice(&std::fs::read(report_dir.join("stats.json")).unwrap()).unwrap();
+    assert_eq!(again["maps"][0]["reference_cached"], true);
+    assert_eq!(
+        again["maps"][0]["methods"][0]["mean"],
+        stats["maps"][0]["methods"][0]["mean"]
+    );
+}
+
+/// Bakes the teapot at test settings.
+fn bake_cli_ok(dir: &Path, bake: &Path) -> std::process::Output {
+    hprt(
+        dir,
+        &[
+            "bake",
+            scene("teapot.toml").to_str().unwrap(),
+            "--samples",
+            "256",
+            "--bounces",
+            "2",
+            "-o",
+            bake.to_str().unwrap(),
+        ],
+    )
+}
+
+#[test]
+fn report_with_a_missing_bake_fails_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let garbage = dir.path().join("broken.hdr");
+    std::fs::write(&garbage, b"#?RADIANCE\nnonsense").unwrap();
+    let out = hprt_with_env(
+        dir.path(),
+        &[
+            "report",
+            scene("teapot.toml").to_str().unwrap(),
+            "--envs",
+            garbage.to_str().unwrap(),
+            "--bake",
+            dir.path().join("missing.bake").to_str().unwrap(),
+            "-o",
+            "out",
+        ],
+        &[("HPRT_CACHE", dir.path())],
+    );
+    assert_clean_failure(&out, &["missing.bake"]);
+    assert!(!dir.path().join("out").exists());
+}
