@@ -8,13 +8,15 @@ use std::fmt::Write;
 use std::path::Path;
 
 const STYLE: &str = "
-body { font-family: system-ui, sans-serif; margin: 2em; color: #222; max-width: 1400px; }
+body { font-family: system-ui, sans-serif; margin: 2em; color: #222; max-width: 1700px; }
 h1 { font-size: 1.5em; } h2 { font-size: 1.25em; margin-top: 2em; border-bottom: 1px solid #ccc; }
 table { border-collapse: collapse; margin: 1em 0; font-variant-numeric: tabular-nums; }
 th, td { border: 1px solid #ccc; padding: 0.3em 0.6em; text-align: right; }
 th { background: #f3f3f3; } td.name { text-align: left; }
 td.best { font-weight: bold; background: #e8f5e9; }
-.row { display: flex; flex-wrap: wrap; gap: 0.8em; }
+.row { display: flex; flex-wrap: wrap; gap: 0.8em; align-items: flex-start; }
+.grid { display: grid; grid-template-columns: repeat(4, minmax(0, 1fr)); gap: 0.8em; margin-bottom: 0.8em; }
+.grid img { width: 100%; } svg { max-width: 100%; height: auto; }
 figure { margin: 0; } figcaption { font-size: 0.9em; text-align: center; color: #555; }
 img { image-rendering: pixelated; max-width: 100%; }
 .failed { color: #b00020; } .note { color: #555; font-size: 0.9em; }
@@ -147,7 +149,7 @@ fn map_section(html: &mut String, map: &MapReport, out: &Path) -> anyhow::Result
             format!("rendered in {:.1} s", map.reference_seconds)
         }
     );
-    html.push_str("<div class=\"row\">");
+    html.push_str("<div class=\"grid\">");
     figure(
         html,
         &embedded_png(&dir.join("reference.png"))?,
@@ -157,7 +159,11 @@ fn map_section(html: &mut String, map: &MapReport, out: &Path) -> anyhow::Result
         let png = dir.join(format!("{}.png", method.file_stem()));
         figure(html, &embedded_png(&png)?, method.name());
     }
-    html.push_str("</div><div class=\"row\">");
+    html.push_str(
+        "</div><div class=\"grid\"><p class=\"note\">Below each method: its error against the \
+         reference, |ΔY| after tone mapping. One scale per map (the 99th percentile of PRT's \
+         errors; larger errors saturate); grey pixels see no geometry.</p>",
+    );
     for method in Method::ALL {
         let png = dir.join(format!("error-{}.png", method.file_stem()));
         figure(
@@ -171,7 +177,10 @@ fn map_section(html: &mut String, map: &MapReport, out: &Path) -> anyhow::Result
     let svg_path = dir.join("threshold.svg");
     let svg = std::fs::read_to_string(&svg_path)
         .with_context(|| format!("cannot read {}", svg_path.display()))?;
-    let _ = write!(html, "<div class=\"row\"><div>{svg}</div><div>");
+    let _ = write!(
+        html,
+        "<div class=\"row\"><div style=\"flex: 0 1 600px\">{svg}</div><div>"
+    );
     sweep_table(html, map);
     html.push_str("</div></div>");
     Ok(())
