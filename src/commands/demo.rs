@@ -2,8 +2,8 @@
 //! writes the error report for every bundled environment map, at settings that finish in a few
 //! minutes on two CPU cores without a GPU; a second run reuses bake and references.
 
-use super::load_scene;
 use super::report::{ReportOptions, write};
+use super::{ImageSizeArgs, load_scene};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -47,8 +47,10 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         bake: None,
         spp: args.spp,
         bounces: None,
-        width: Some(args.width),
-        height: Some(args.height),
+        size: ImageSizeArgs {
+            width: Some(args.width),
+            height: Some(args.height),
+        },
         seed: 0,
         thresholds: vec![0.0, 0.02, 0.05, 0.1, 0.2, 0.4],
         frames: 5,

@@ -1,9 +1,8 @@
 //! `hprt export`: the scene as hprt sees it, for Mitsuba 3.
 
-use super::{choose_environment, load_scene};
+use super::{EnvironmentArgs, ImageSizeArgs, load_scene};
 use anyhow::Context;
 use clap::Args;
-use precompute::envmap::Layout;
 use precompute::export::{ExportSettings, export_mitsuba, mitsuba_max_depth};
 use std::path::PathBuf;
 
@@ -11,25 +10,16 @@ use std::path::PathBuf;
 pub struct ExportArgs {
     /// Scene file (TOML).
     pub scene: PathBuf,
-    /// Environment map (default: the scene's).
-    #[arg(long)]
-    pub env: Option<PathBuf>,
-    /// Layout of the map (default: from the aspect ratio).
-    #[arg(long)]
-    pub layout: Option<Layout>,
-    /// Rotation of the map about +Y in degrees (default: the scene's).
-    #[arg(long, allow_negative_numbers = true)]
-    pub rotate: Option<f32>,
+    #[command(flatten)]
+    pub environment: EnvironmentArgs,
     /// Indirect bounces (Mitsuba's max_depth is bounces + 2).
     #[arg(long, default_value_t = 3)]
     pub bounces: u32,
     /// Samples per pixel.
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: u32,
-    #[arg(long)]
-    pub width: Option<u32>,
-    #[arg(long)]
-    pub height: Option<u32>,
+    #[command(flatten)]
+    pub size: ImageSizeArgs,
     /// Output folder (scene.xml, envmap.exr, meshes/).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -37,11 +27,8 @@ pub struct ExportArgs {
 
 pub fn run(args: ExportArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
-    let env = choose_environment(&scene, args.env.as_deref(), args.layout, args.rotate)?;
-    let camera = scene.camera.with_size(
-        args.width.unwrap_or(scene.camera.width),
-        args.height.unwrap_or(scene.camera.height),
-    );
+    let env = args.environment.choose(&scene)?;
+    let camera = args.size.camera(&scene);
     camera
         .validate()
         .map_err(|m| anyhow::anyhow!("invalid image size: {m}"))?;

@@ -48,6 +48,47 @@ pub fn progress_bar(length: u64, what: &str) -> ProgressBar {
     bar
 }
 
+/// `--env`, `--layout`, `--rotate`: the map a command lights the scene with.
+#[derive(clap::Args, Clone, Debug)]
+pub struct EnvironmentArgs {
+    /// Environment map (default: the scene's).
+    #[arg(long)]
+    pub env: Option<std::path::PathBuf>,
+    /// Layout of the map (default: from the aspect ratio).
+    #[arg(long)]
+    pub layout: Option<precompute::envmap::Layout>,
+    /// Rotation of the map about +Y in degrees (default: the scene's).
+    #[arg(long, allow_negative_numbers = true)]
+    pub rotate: Option<f32>,
+}
+
+impl EnvironmentArgs {
+    pub fn choose(&self, scene: &Scene) -> anyhow::Result<ChosenEnvironment> {
+        choose_environment(scene, self.env.as_deref(), self.layout, self.rotate)
+    }
+}
+
+/// `--width`, `--height`: the image size, by default the scene camera's.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct ImageSizeArgs {
+    /// Image width (default: the scene camera's).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height (default: the scene camera's).
+    #[arg(long)]
+    pub height: Option<u32>,
+}
+
+impl ImageSizeArgs {
+    /// The scene's camera at this size (not yet validated).
+    pub fn camera(&self, scene: &Scene) -> precompute::camera::Camera {
+        scene.camera.with_size(
+            self.width.unwrap_or(scene.camera.width),
+            self.height.unwrap_or(scene.camera.height),
+        )
+    }
+}
+
 /// The environment a command lights a scene with: `--env` or the scene's default map, and
 /// `--rotate` or the scene's rotation.
 pub struct ChosenEnvironment {

@@ -1,10 +1,11 @@
 //! `hprt reference`: the CPU path-traced ground truth.
 
-use super::{choose_environment, default_exposure, load_scene, progress_bar, with_threads};
+use super::{
+    EnvironmentArgs, ImageSizeArgs, default_exposure, load_scene, progress_bar, with_threads,
+};
 use anyhow::Context;
 use clap::Args;
 use precompute::bvh::SceneBvh;
-use precompute::envmap::Layout;
 use precompute::image_io::{RgbImageF32, exr_bytes, write_exr, write_png};
 use precompute::reference::{self, EnvironmentLight, ReferenceImage, ReferenceSettings};
 use precompute::{Rgb, atomic_file::AtomicOutput};
@@ -14,21 +15,10 @@ use std::path::{Path, PathBuf};
 pub struct ReferenceArgs {
     /// Scene file (TOML).
     pub scene: PathBuf,
-    /// Environment map (default: the scene's).
-    #[arg(long)]
-    pub env: Option<PathBuf>,
-    /// Layout of the map (default: from the aspect ratio).
-    #[arg(long)]
-    pub layout: Option<Layout>,
-    /// Rotation of the map about +Y in degrees (default: the scene's).
-    #[arg(long, allow_negative_numbers = true)]
-    pub rotate: Option<f32>,
-    /// Image width (default: the scene camera's).
-    #[arg(long)]
-    pub width: Option<u32>,
-    /// Image height (default: the scene camera's).
-    #[arg(long)]
-    pub height: Option<u32>,
+    #[command(flatten)]
+    pub environment: EnvironmentArgs,
+    #[command(flatten)]
+    pub size: ImageSizeArgs,
     /// Light paths per pixel.
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: u32,
@@ -79,11 +69,8 @@ pub fn write_grey(
 
 pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
-    let env = choose_environment(&scene, args.env.as_deref(), args.layout, args.rotate)?;
-    let camera = scene.camera.with_size(
-        args.width.unwrap_or(scene.camera.width),
-        args.height.unwrap_or(scene.camera.height),
-    );
+    let env = args.environment.choose(&scene)?;
+    let camera = args.size.camera(&scene);
     camera
         .validate()
         .map_err(|m| anyhow::anyhow!("invalid image size: {m}"))?;

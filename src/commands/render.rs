@@ -1,13 +1,12 @@
 //! `hprt render`: the hybrid (or plain PRT) image of a baked scene, on the GPU.
 
 use super::decompose::DecomposeOptions;
-use super::{choose_environment, default_exposure, load_scene};
+use super::{EnvironmentArgs, ImageSizeArgs, default_exposure, load_scene};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use precompute::atomic_file::AtomicOutput;
 use precompute::bake::Transfer;
 use precompute::bakefile;
-use precompute::envmap::Layout;
 use precompute::image_io::{RgbImageF32, exr_bytes, png_bytes, to_display_rgb8};
 use precompute::scene::Scene;
 use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
@@ -69,15 +68,8 @@ pub struct RenderArgs {
     /// Bake of the scene (from `hprt bake`).
     #[arg(long)]
     pub bake: PathBuf,
-    /// Environment map (default: the scene's).
-    #[arg(long)]
-    pub env: Option<PathBuf>,
-    /// Layout of the map (default: from the aspect ratio).
-    #[arg(long)]
-    pub layout: Option<Layout>,
-    /// Rotation of the map about +Y in degrees (default: the scene's).
-    #[arg(long, allow_negative_numbers = true)]
-    pub rotate: Option<f32>,
+    #[command(flatten)]
+    pub environment: EnvironmentArgs,
     #[command(flatten)]
     pub render: RenderOptions,
     /// How the decomposition forms lights (thesis or consistent).
@@ -85,10 +77,8 @@ pub struct RenderArgs {
     pub decompose_mode: DecomposeMode,
     #[command(flatten)]
     pub decompose: DecomposeOptions,
-    #[arg(long)]
-    pub width: Option<u32>,
-    #[arg(long)]
-    pub height: Option<u32>,
+    #[command(flatten)]
+    pub size: ImageSizeArgs,
     /// Camera position "x,y,z" (default: the scene's).
     #[arg(long, value_parser = parse_vec3_arg, allow_hyphen_values = true)]
     pub camera_position: Option<glam::Vec3>,
@@ -173,11 +163,8 @@ pub fn decompose_map(
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let transfer = load_bake(&scene, &args.bake, args.decompose.order)?;
-    let env = choose_environment(&scene, args.env.as_deref(), args.layout, args.rotate)?;
-    let mut camera = scene.camera.with_size(
-        args.width.unwrap_or(scene.camera.width),
-        args.height.unwrap_or(scene.camera.height),
-    );
+    let env = args.environment.choose(&scene)?;
+    let mut camera = args.size.camera(&scene);
     camera.position = args.camera_position.unwrap_or(camera.position);
     camera.target = args.camera_target.unwrap_or(camera.target);
     camera.fov_y_deg = args.fov.unwrap_or(camera.fov_y_deg);

@@ -1,7 +1,7 @@
 //! `hprt report`: error statistics of plain PRT and the hybrid against the path-traced
 //! reference, for one scene under several environment maps (thesis chapter 5).
 
-use super::load_scene;
+use super::{ImageSizeArgs, load_scene};
 use crate::report::{self, ReportSettings};
 use clap::Args;
 use runtime::render::Backend;
@@ -19,12 +19,8 @@ pub struct ReportOptions {
     /// Indirect bounces of the reference (default: the bake's, so both see the same light).
     #[arg(long)]
     pub bounces: Option<u32>,
-    /// Image width (default: the scene camera's).
-    #[arg(long)]
-    pub width: Option<u32>,
-    /// Image height (default: the scene camera's).
-    #[arg(long)]
-    pub height: Option<u32>,
+    #[command(flatten)]
+    pub size: ImageSizeArgs,
     /// Seed of the reference.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -84,9 +80,10 @@ pub fn write(
     }
     anyhow::ensure!(!envs.is_empty(), "no environment maps to report on");
     let (bake_path, transfer) = report::bake_for(scene, options.bake.as_deref())?;
+    let camera = options.size.camera(scene);
     let settings = ReportSettings {
-        width: options.width.unwrap_or(scene.camera.width),
-        height: options.height.unwrap_or(scene.camera.height),
+        width: camera.width,
+        height: camera.height,
         spp: options.spp,
         bounces: options.bounces.unwrap_or(transfer.settings.bounces),
         seed: options.seed,
