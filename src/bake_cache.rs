@@ -1,6 +1,9 @@
-//! Bakes cached per scene and settings, so the viewer and the demo reuse them.
+//! Bakes cached per scene and settings, so the viewer, the reports and the demo reuse them.
 
-use precompute::bake::BakeSettings;
+use anyhow::Context;
+use indicatif::ProgressBar;
+use precompute::bake::{BakeSettings, BakeStats, Transfer};
+use precompute::bvh::SceneBvh;
 use precompute::scene::Scene;
 use std::path::PathBuf;
 
@@ -28,4 +31,28 @@ pub fn bake_path(scene: &Scene, settings: &BakeSettings) -> PathBuf {
         "{}-{hash}-o{}-s{}-b{}-seed{}.bake",
         scene.name, settings.order, settings.samples, settings.bounces, settings.seed
     ))
+}
+
+/// The cached bake of `scene` with `settings`, if there is a usable one.
+pub fn load_cached(scene: &Scene, settings: &BakeSettings) -> Option<(PathBuf, Transfer)> {
+    let path = bake_path(scene, settings);
+    let transfer = crate::commands::render::load_bake(scene, &path, None).ok()?;
+    Some((path, transfer))
+}
+
+/// Bakes `scene` with `settings` into the cache (atomically), reporting on `progress`.
+pub fn bake_into_cache(
+    scene: &Scene,
+    settings: &BakeSettings,
+    progress: &ProgressBar,
+) -> anyhow::Result<(PathBuf, Transfer, BakeStats)> {
+    let path = bake_path(scene, settings);
+    let bvh = SceneBvh::build(&scene.geometry.mesh);
+    let (transfer, stats) = precompute::bake::bake(&scene.geometry, &bvh, settings, progress)
+        .map_err(anyhow::Error::msg)?;
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    precompute::bakefile::write(&path, &transfer, &scene.geometry.content_hash())?;
+    Ok((path, transfer, stats))
 }

@@ -31,6 +31,15 @@ impl RgbImageF32 {
         }
     }
 
+    /// A grey image of a single-channel one (coverage, visibility), for EXR output.
+    pub fn from_grey(width: usize, height: usize, values: &[f32]) -> Self {
+        Self::new(
+            width,
+            height,
+            values.iter().map(|v| Rgb::splat(*v)).collect(),
+        )
+    }
+
     pub fn filled(width: usize, height: usize, value: Rgb) -> Self {
         Self::new(width, height, vec![value; width * height])
     }

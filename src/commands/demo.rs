@@ -42,7 +42,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let Some(environment) = &scene.environment else {
         anyhow::bail!("{} names no [environment]", scene.path.display());
     };
-    let envs = crate::report::maps_beside(&environment.map);
+    let envs = super::maps_beside(&environment.map);
     let options = ReportOptions {
         bake: None,
         spp: args.spp,

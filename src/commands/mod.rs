@@ -125,3 +125,22 @@ pub fn choose_environment(
 pub fn default_exposure(map: &precompute::envmap::EnvMap) -> f32 {
     0.5 / map.mean_luminance().max(1e-6)
 }
+
+/// The maps next to `map` (its folder's `.exr` and `.hdr` files), sorted: the choices the
+/// viewer offers and the maps a report covers by default.
+pub fn maps_beside(map: &Path) -> Vec<std::path::PathBuf> {
+    let dir = match map.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut maps: Vec<std::path::PathBuf> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
+                .collect()
+        })
+        .unwrap_or_default();
+    maps.sort();
+    maps
+}

@@ -5,10 +5,10 @@ use super::{
 };
 use anyhow::Context;
 use clap::Args;
+use precompute::atomic_file::AtomicOutput;
 use precompute::bvh::SceneBvh;
 use precompute::image_io::{RgbImageF32, exr_bytes, write_exr, write_png};
 use precompute::reference::{self, EnvironmentLight, ReferenceImage, ReferenceSettings};
-use precompute::{Rgb, atomic_file::AtomicOutput};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -52,11 +52,7 @@ pub fn write_grey(
     height: usize,
     values: &[f32],
 ) -> anyhow::Result<()> {
-    let image = RgbImageF32::new(
-        width,
-        height,
-        values.iter().map(|v| Rgb::splat(*v)).collect(),
-    );
+    let image = RgbImageF32::from_grey(width, height, values);
     write_exr(&dir.join(format!("{name}.exr")), &image)?;
     // Linear 0..1 shown directly (exposure chosen so that tonemap(1) is near white).
     let rgb: Vec<u8> = values

@@ -58,7 +58,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
                 scene.path.display()
             );
         };
-        report::maps_beside(&environment.map)
+        super::maps_beside(&environment.map)
     } else {
         args.envs.clone()
     };
@@ -114,7 +114,11 @@ pub fn write(
         }
     }
     println!("\nwrote {}", output.join("report.html").display());
-    let failed = report.maps.iter().filter(|m| m.status != "ok").count();
+    let failed = report
+        .maps
+        .iter()
+        .filter(|m| m.status == report::MapStatus::Failed)
+        .count();
     if failed == report.maps.len() {
         anyhow::bail!("every map failed; see the messages above");
     }

@@ -1,7 +1,7 @@
 //! `report.html`: one self-contained page (PNGs embedded as base64, plots as inline SVG), so
 //! it can be mailed or archived on its own.
 
-use super::{MapReport, Method, MethodResult, Report};
+use super::{MapReport, MapStatus, Method, MethodResult, Report};
 use anyhow::Context;
 use base64::Engine;
 use std::fmt::Write;
@@ -214,8 +214,16 @@ pub fn page(report: &Report, out: &Path) -> anyhow::Result<String> {
         adapter = escape(&report.adapter),
         frames = s.frames,
     );
-    let ok: Vec<&MapReport> = report.maps.iter().filter(|m| m.status == "ok").collect();
-    let failed: Vec<&MapReport> = report.maps.iter().filter(|m| m.status != "ok").collect();
+    let ok: Vec<&MapReport> = report
+        .maps
+        .iter()
+        .filter(|m| m.status == MapStatus::Ok)
+        .collect();
+    let failed: Vec<&MapReport> = report
+        .maps
+        .iter()
+        .filter(|m| m.status == MapStatus::Failed)
+        .collect();
     if !ok.is_empty() {
         html.push_str("<h2>Summary</h2>");
         summary_table(&mut html, &ok);

@@ -7,9 +7,10 @@ pub mod figures;
 mod html;
 pub mod stats;
 
-use crate::bake_cache::cache_dir;
+use crate::bake_cache::{self, cache_dir};
 use anyhow::Context;
 use figures::Curve;
+use precompute::atomic_file::write_atomic;
 use precompute::bake::Transfer;
 use precompute::bvh::SceneBvh;
 use precompute::camera::Camera;
@@ -17,7 +18,6 @@ use precompute::envmap::EnvMap;
 use precompute::image_io::{RgbImageF32, read_exr, write_exr, write_png};
 use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
 use precompute::scene::Scene;
-use precompute::{Rgb, atomic_file::write_atomic};
 use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
 use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer};
 use stats::{ErrorStats, Masks, error_stats};
@@ -94,12 +94,28 @@ pub struct SweepPoint {
     pub shadow_mean: f64,
 }
 
+/// Whether a map's section was written (`"ok"`) or the map failed (`"failed"`, see `error`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MapStatus {
+    Ok,
+    Failed,
+}
+
+impl MapStatus {
+    pub fn name(self) -> &'static str {
+        match self {
+            MapStatus::Ok => "ok",
+            MapStatus::Failed => "failed",
+        }
+    }
+}
+
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct MapReport {
     pub name: String,
     pub path: String,
-    /// "ok" or "failed".
-    pub status: String,
+    pub status: MapStatus,
     pub error: Option<String>,
     pub exposure: f32,
     pub reference_cached: bool,
@@ -134,14 +150,6 @@ fn reference_key(
     hasher.update(&rotation_deg.to_le_bytes());
     hasher.update(serde_json::to_string(settings)?.as_bytes());
     Ok(hasher.finalize().to_hex()[..24].to_owned())
-}
-
-fn grey(values: &[f32], width: usize, height: usize) -> RgbImageF32 {
-    RgbImageF32::new(
-        width,
-        height,
-        values.iter().map(|v| Rgb::splat(*v)).collect(),
-    )
 }
 
 /// The reference with its coverage and visibility, from the cache or rendered (then cached).
@@ -188,8 +196,8 @@ fn reference_images(
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let (w, h) = (camera.width as usize, camera.height as usize);
     write_exr(&paths[0], &image.radiance)?;
-    write_exr(&paths[1], &grey(&image.coverage, w, h))?;
-    write_exr(&paths[2], &grey(&image.visibility, w, h))?;
+    write_exr(&paths[1], &RgbImageF32::from_grey(w, h, &image.coverage))?;
+    write_exr(&paths[2], &RgbImageF32::from_grey(w, h, &image.visibility))?;
     Ok(ReferenceImages {
         radiance: image.radiance,
         coverage: image.coverage,
@@ -285,11 +293,11 @@ fn write_reference(dir: &Path, reference: &ReferenceImages, exposure: f32) -> an
     write_png(&dir.join("reference.png"), &reference.radiance, exposure)?;
     write_exr(
         &dir.join("reference-coverage.exr"),
-        &grey(&reference.coverage, w, h),
+        &RgbImageF32::from_grey(w, h, &reference.coverage),
     )?;
     write_exr(
         &dir.join("reference-visibility.exr"),
-        &grey(&reference.visibility, w, h),
+        &RgbImageF32::from_grey(w, h, &reference.visibility),
     )?;
     Ok(())
 }
@@ -414,7 +422,7 @@ fn report_map(job: &mut MapJob, env: &Path) -> anyhow::Result<MapReport> {
     Ok(MapReport {
         name,
         path: env.display().to_string(),
-        status: "ok".into(),
+        status: MapStatus::Ok,
         error: None,
         exposure,
         reference_cached: reference.cached,
@@ -461,7 +469,7 @@ pub fn run_report(
             MapReport {
                 name: map_name(env),
                 path: env.display().to_string(),
-                status: "failed".into(),
+                status: MapStatus::Failed,
                 error: Some(format!("{e:#}")),
                 exposure: 0.0,
                 reference_cached: false,
@@ -513,7 +521,7 @@ fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
         if map.methods.is_empty() {
             writer.write_record([
                 map.name.as_str(),
-                map.status.as_str(),
+                map.status.name(),
                 "",
                 "",
                 "",
@@ -531,7 +539,7 @@ fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
             let s = &m.stats;
             writer.write_record([
                 map.name.clone(),
-                map.status.clone(),
+                map.status.name().to_owned(),
                 m.method.clone(),
                 format!("{:.6}", s.mean),
                 format!("{:.6}", s.std),
@@ -549,21 +557,6 @@ fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
     writer.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
 }
 
-/// The maps next to `map` (its folder's `.exr` and `.hdr` files), sorted.
-pub fn maps_beside(map: &Path) -> Vec<PathBuf> {
-    let dir = map.parent().unwrap_or(Path::new("."));
-    let mut maps: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map(|entries| {
-            entries
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
-                .collect()
-        })
-        .unwrap_or_default();
-    maps.sort();
-    maps
-}
-
 /// Uses `bake` if given, else the cached bake of the scene's settings, baking it if missing.
 pub fn bake_for(scene: &Scene, bake: Option<&Path>) -> anyhow::Result<(PathBuf, Transfer)> {
     if let Some(path) = bake {
@@ -572,21 +565,15 @@ pub fn bake_for(scene: &Scene, bake: Option<&Path>) -> anyhow::Result<(PathBuf, 
             crate::commands::render::load_bake(scene, path, None)?,
         ));
     }
-    let path = crate::bake_cache::bake_path(scene, &scene.bake);
-    if let Ok(transfer) = crate::commands::render::load_bake(scene, &path, None) {
+    if let Some((path, transfer)) = bake_cache::load_cached(scene, &scene.bake) {
         println!("using the cached bake {}", path.display());
         return Ok((path, transfer));
     }
-    println!("baking {} into {}", scene.name, path.display());
-    let bvh = SceneBvh::build(&scene.geometry.mesh);
-    let progress =
-        crate::commands::progress_bar(scene.geometry.mesh.vertex_count() as u64, "baking");
-    let (transfer, stats) = precompute::bake::bake(&scene.geometry, &bvh, &scene.bake, &progress)
-        .map_err(anyhow::Error::msg)?;
+    println!("baking {} into the cache", scene.name);
+    let vertices = scene.geometry.mesh.vertex_count() as u64;
+    let progress = crate::commands::progress_bar(vertices, "baking");
+    let (path, transfer, stats) = bake_cache::bake_into_cache(scene, &scene.bake, &progress)?;
     crate::commands::bake::print_stats(&stats);
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    }
-    precompute::bakefile::write(&path, &transfer, &scene.geometry.content_hash())?;
+    println!("wrote {}", path.display());
     Ok((path, transfer))
 }

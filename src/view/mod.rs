@@ -12,7 +12,7 @@ use crate::commands::{default_exposure, load_scene};
 use anyhow::Context;
 use clap::Args;
 use orbit::Orbit;
-use precompute::bake::{BakeSettings, Transfer};
+use precompute::bake::Transfer;
 use precompute::envmap::EnvMap;
 use precompute::scene::Scene;
 use runtime::render::{Backend, FrameLighting, RenderMode, Renderer, ShadowSettings};
@@ -132,15 +132,11 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
             let transfer = crate::commands::render::load_bake(&scene, path, None)?;
             (path.clone(), Some(Arc::new(transfer)))
         }
-        None => {
-            let path = bake_cache::bake_path(&scene, &bake_settings);
-            let transfer = path
-                .exists()
-                .then(|| crate::commands::render::load_bake(&scene, &path, None).ok())
-                .flatten()
-                .map(Arc::new);
-            (path, transfer)
-        }
+        None => match bake_cache::load_cached(&scene, &bake_settings) {
+            Some((path, transfer)) => (path, Some(Arc::new(transfer))),
+            // Offered in the window, with progress.
+            None => (bake_cache::bake_path(&scene, &bake_settings), None),
+        },
     };
     let env = match (&args.env, &scene.environment) {
         (Some(p), _) => p.clone(),
@@ -159,16 +155,7 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         }
         None => VecDeque::new(),
     };
-    let env_dir = env.parent().map(Path::to_path_buf).unwrap_or_default();
-    let mut env_choices: Vec<PathBuf> = std::fs::read_dir(&env_dir)
-        .map(|entries| {
-            entries
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
-                .collect()
-        })
-        .unwrap_or_default();
-    env_choices.sort();
+    let env_choices = crate::commands::maps_beside(&env);
     let order = transfer
         .as_ref()
         .map_or(bake_settings.order, |t| t.settings.order);
@@ -272,23 +259,12 @@ impl App {
 
     fn start_bake(&mut self) {
         let scene = self.scene.clone();
-        let path = self.bake_path.clone();
-        let settings: BakeSettings = scene.bake;
         let progress = indicatif::ProgressBar::hidden();
         let bar = progress.clone();
         let (sender, receiver) = std::sync::mpsc::channel();
         std::thread::spawn(move || {
-            let result = (|| -> anyhow::Result<Transfer> {
-                let bvh = precompute::bvh::SceneBvh::build(&scene.geometry.mesh);
-                let (transfer, _) = precompute::bake::bake(&scene.geometry, &bvh, &settings, &bar)
-                    .map_err(anyhow::Error::msg)?;
-                if let Some(dir) = path.parent() {
-                    std::fs::create_dir_all(dir)
-                        .with_context(|| format!("cannot create {}", dir.display()))?;
-                }
-                precompute::bakefile::write(&path, &transfer, &scene.geometry.content_hash())?;
-                Ok(transfer)
-            })();
+            let result = bake_cache::bake_into_cache(&scene, &scene.bake, &bar)
+                .map(|(_, transfer, _)| transfer);
             let _ = sender.send(result);
         });
         self.bake_job = Some(BakeJob {
