@@ -123,108 +123,72 @@ fn file_name_for(name: &str, index: usize) -> String {
 pub fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
     let c = &settings.camera;
     let v = |v: glam::Vec3| format!("{}, {}, {}", v.x, v.y, v.z);
-    let mut xml = String::new();
-    let _ = writeln!(xml, "<?xml version=\"1.0\" encoding=\"utf-8\"?>");
-    let _ = writeln!(
-        xml,
-        "<!-- Exported by hprt; see its README, \"Cross-checking with Mitsuba 3\". -->"
+    let mut xml = format!(
+        r#"<?xml version="1.0" encoding="utf-8"?>
+<!-- Exported by hprt; see its README, "Cross-checking with Mitsuba 3". -->
+<scene version="3.0.0">
+    <integrator type="path">
+        <!-- hprt bounces = {bounces} -->
+        <integer name="max_depth" value="{max_depth}"/>
+        <integer name="rr_depth" value="{rr_depth}"/>
+    </integrator>
+    <sensor type="perspective">
+        <float name="fov" value="{fov}"/>
+        <string name="fov_axis" value="y"/>
+        <transform name="to_world">
+            <lookat origin="{origin}" target="{target}" up="{up}"/>
+        </transform>
+        <sampler type="independent">
+            <integer name="sample_count" value="{spp}"/>
+        </sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="{width}"/>
+            <integer name="height" value="{height}"/>
+            <string name="pixel_format" value="rgb"/>
+            <rfilter type="box"/>
+        </film>
+    </sensor>
+    <emitter type="envmap">
+        <string name="filename" value="envmap.exr"/>
+        <transform name="to_world">
+            <rotate y="1" angle="{rotation}"/>
+        </transform>
+    </emitter>
+"#,
+        bounces = settings.bounces,
+        max_depth = mitsuba_max_depth(settings.bounces),
+        rr_depth = mitsuba_max_depth(settings.bounces) + 1,
+        fov = c.fov_y_deg,
+        origin = v(c.position),
+        target = v(c.target),
+        up = v(c.up),
+        spp = settings.spp,
+        width = c.width,
+        height = c.height,
+        rotation = settings.rotation_deg,
     );
-    let _ = writeln!(xml, "<scene version=\"3.0.0\">");
-    let _ = writeln!(xml, "    <integrator type=\"path\">");
-    let _ = writeln!(
-        xml,
-        "        <!-- hprt bounces = {} -->\n        <integer name=\"max_depth\" value=\"{}\"/>",
-        settings.bounces,
-        mitsuba_max_depth(settings.bounces)
-    );
-    let _ = writeln!(
-        xml,
-        "        <integer name=\"rr_depth\" value=\"{}\"/>",
-        mitsuba_max_depth(settings.bounces) + 1
-    );
-    let _ = writeln!(xml, "    </integrator>");
-    let _ = writeln!(xml, "    <sensor type=\"perspective\">");
-    let _ = writeln!(
-        xml,
-        "        <float name=\"fov\" value=\"{}\"/>",
-        c.fov_y_deg
-    );
-    let _ = writeln!(xml, "        <string name=\"fov_axis\" value=\"y\"/>");
-    let _ = writeln!(xml, "        <transform name=\"to_world\">");
-    let _ = writeln!(
-        xml,
-        "            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>",
-        v(c.position),
-        v(c.target),
-        v(c.up)
-    );
-    let _ = writeln!(xml, "        </transform>");
-    let _ = writeln!(xml, "        <sampler type=\"independent\">");
-    let _ = writeln!(
-        xml,
-        "            <integer name=\"sample_count\" value=\"{}\"/>",
-        settings.spp
-    );
-    let _ = writeln!(xml, "        </sampler>");
-    let _ = writeln!(xml, "        <film type=\"hdrfilm\">");
-    let _ = writeln!(
-        xml,
-        "            <integer name=\"width\" value=\"{}\"/>",
-        c.width
-    );
-    let _ = writeln!(
-        xml,
-        "            <integer name=\"height\" value=\"{}\"/>",
-        c.height
-    );
-    let _ = writeln!(
-        xml,
-        "            <string name=\"pixel_format\" value=\"rgb\"/>"
-    );
-    let _ = writeln!(xml, "            <rfilter type=\"box\"/>");
-    let _ = writeln!(xml, "        </film>");
-    let _ = writeln!(xml, "    </sensor>");
-    let _ = writeln!(xml, "    <emitter type=\"envmap\">");
-    let _ = writeln!(
-        xml,
-        "        <string name=\"filename\" value=\"envmap.exr\"/>"
-    );
-    let _ = writeln!(xml, "        <transform name=\"to_world\">");
-    let _ = writeln!(
-        xml,
-        "            <rotate y=\"1\" angle=\"{}\"/>",
-        settings.rotation_deg
-    );
-    let _ = writeln!(xml, "        </transform>");
-    let _ = writeln!(xml, "    </emitter>");
     for (i, o) in geometry.objects.iter().enumerate() {
         let a = o.albedo;
-        let _ = writeln!(
+        let _ = write!(
             xml,
-            "    <shape type=\"ply\" id=\"{}\">",
-            xml_escape(&o.name)
+            r#"    <shape type="ply" id="{id}">
+        <string name="filename" value="meshes/{file}"/>
+        <boolean name="face_normals" value="false"/>
+        <bsdf type="twosided">
+            <bsdf type="diffuse">
+                <rgb name="reflectance" value="{r}, {g}, {b}"/>
+            </bsdf>
+        </bsdf>
+    </shape>
+"#,
+            id = xml_escape(&o.name),
+            file = file_name_for(&o.name, i),
+            r = a.x,
+            g = a.y,
+            b = a.z,
         );
-        let _ = writeln!(
-            xml,
-            "        <string name=\"filename\" value=\"meshes/{}\"/>",
-            file_name_for(&o.name, i)
-        );
-        let _ = writeln!(
-            xml,
-            "        <boolean name=\"face_normals\" value=\"false\"/>"
-        );
-        let _ = writeln!(xml, "        <bsdf type=\"twosided\">");
-        let _ = writeln!(xml, "            <bsdf type=\"diffuse\">");
-        let _ = writeln!(
-            xml,
-            "                <rgb name=\"reflectance\" value=\"{}, {}, {}\"/>",
-            a.x, a.y, a.z
-        );
-        let _ = writeln!(xml, "            </bsdf>");
-        let _ = writeln!(xml, "        </bsdf>");
-        let _ = writeln!(xml, "    </shape>");
     }
-    let _ = writeln!(xml, "</scene>");
+    xml.push_str("</scene>\n");
     xml
 }
 

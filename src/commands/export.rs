@@ -28,10 +28,7 @@ pub struct ExportArgs {
 pub fn run(args: ExportArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let env = args.environment.choose(&scene)?;
-    let camera = args.size.camera(&scene);
-    camera
-        .validate()
-        .map_err(|m| anyhow::anyhow!("invalid image size: {m}"))?;
+    let camera = args.size.camera(&scene)?;
     let settings = ExportSettings {
         camera,
         rotation_deg: env.rotation_deg,

@@ -80,12 +80,16 @@ pub struct ImageSizeArgs {
 }
 
 impl ImageSizeArgs {
-    /// The scene's camera at this size (not yet validated).
-    pub fn camera(&self, scene: &Scene) -> precompute::camera::Camera {
-        scene.camera.with_size(
+    /// The scene's camera at this size.
+    pub fn camera(&self, scene: &Scene) -> anyhow::Result<precompute::camera::Camera> {
+        let camera = scene.camera.with_size(
             self.width.unwrap_or(scene.camera.width),
             self.height.unwrap_or(scene.camera.height),
-        )
+        );
+        camera
+            .validate()
+            .map_err(|m| anyhow::anyhow!("invalid image size: {m}"))?;
+        Ok(camera)
     }
 }
 

@@ -66,10 +66,7 @@ pub fn write_grey(
 pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let env = args.environment.choose(&scene)?;
-    let camera = args.size.camera(&scene);
-    camera
-        .validate()
-        .map_err(|m| anyhow::anyhow!("invalid image size: {m}"))?;
+    let camera = args.size.camera(&scene)?;
     let output = AtomicOutput::create(&args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     if let Some(dir) = &args.aux {

@@ -164,7 +164,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let transfer = load_bake(&scene, &args.bake, args.decompose.order)?;
     let env = args.environment.choose(&scene)?;
-    let mut camera = args.size.camera(&scene);
+    let mut camera = args.size.camera(&scene)?;
     camera.position = args.camera_position.unwrap_or(camera.position);
     camera.target = args.camera_target.unwrap_or(camera.target);
     camera.fov_y_deg = args.fov.unwrap_or(camera.fov_y_deg);

@@ -80,7 +80,7 @@ pub fn write(
     }
     anyhow::ensure!(!envs.is_empty(), "no environment maps to report on");
     let (bake_path, transfer) = report::bake_for(scene, options.bake.as_deref())?;
-    let camera = options.size.camera(scene);
+    let camera = options.size.camera(scene)?;
     let settings = ReportSettings {
         width: camera.width,
         height: camera.height,
