@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use precompute::bake::{self, BakeSettings};
+use precompute::bake::BakeSettings;
 use precompute::bakefile;
 use precompute::bvh::SceneBvh;
 use precompute::scene::Scene;
@@ -51,13 +51,7 @@ fn python_reads_the_bake_as_documented() {
         seed: 11,
     };
     let bvh = SceneBvh::build(&scene.geometry.mesh);
-    let (transfer, _) = bake::bake(
-        &scene.geometry,
-        &bvh,
-        &settings,
-        &indicatif::ProgressBar::hidden(),
-    )
-    .unwrap();
+    let transfer = bake_quietly(&scene.geometry, &bvh, &settings);
     let bake_path = dir.path().join("box.bake");
     bakefile::write(&bake_path, &transfer, &scene.geometry.content_hash()).unwrap();
 

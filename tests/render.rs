@@ -5,7 +5,7 @@ mod common;
 use common::*;
 use glam::Vec3;
 use indicatif::ProgressBar;
-use precompute::bake::{self, BakeSettings, Transfer};
+use precompute::bake::{BakeSettings, Transfer};
 use precompute::bvh::SceneBvh;
 use precompute::camera::Camera;
 use precompute::envmap::EnvMap;
@@ -31,9 +31,7 @@ fn bake_of(geometry: &SceneMesh, order: usize, samples: u32, bounces: u32) -> Tr
         bounces,
         seed: 0,
     };
-    bake::bake(geometry, &bvh, &settings, &ProgressBar::hidden())
-        .unwrap()
-        .0
+    bake_quietly(geometry, &bvh, &settings)
 }
 
 fn sphere_on_plane() -> SceneMesh {

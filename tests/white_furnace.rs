@@ -4,7 +4,8 @@
 
 mod common;
 
-use precompute::bake::{self, BakeSettings};
+use common::bake_quietly;
+use precompute::bake::BakeSettings;
 use precompute::bvh::SceneBvh;
 use precompute::color::Rgb;
 use precompute::scene::Scene;
@@ -27,13 +28,7 @@ fn teapot_scene_deficit_shrinks_with_every_bounce() {
             bounces,
             seed: 0,
         };
-        let (transfer, _) = bake::bake(
-            &scene.geometry,
-            &bvh,
-            &settings,
-            &indicatif::ProgressBar::hidden(),
-        )
-        .unwrap();
+        let transfer = bake_quietly(&scene.geometry, &bvh, &settings);
         let full = transfer.full();
         let n = full.vertex_count();
         let deficits: Vec<f32> = (0..n).map(|v| 1.0 - full.radiance(v, &white).y).collect();

@@ -66,3 +66,15 @@ pub fn write_scene(dir: &Path, name: &str, object: &str) -> PathBuf {
     .expect("write scene");
     path
 }
+
+/// Bakes `geometry` without a progress bar.
+pub fn bake_quietly(
+    geometry: &precompute::scene::SceneMesh,
+    bvh: &precompute::bvh::SceneBvh,
+    settings: &precompute::bake::BakeSettings,
+) -> precompute::bake::Transfer {
+    let progress = indicatif::ProgressBar::hidden();
+    precompute::bake::bake(geometry, bvh, settings, &progress)
+        .expect("valid bake settings")
+        .0
+}
