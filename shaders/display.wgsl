@@ -11,12 +11,6 @@ struct Display {
 @group(0) @binding(0) var<uniform> display: Display;
 @group(0) @binding(1) var image: texture_2d<f32>;
 
-@vertex
-fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
-
 fn srgb(x: f32) -> f32 {
     let c = clamp(x, 0.0, 1.0);
     if c <= 0.0031308 {

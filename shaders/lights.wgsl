@@ -3,7 +3,7 @@
 // shadow map. Pixels that see no geometry show the environment map.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<uniform> lights: array<Light, 32>;
+@group(0) @binding(1) var<uniform> lights: array<Light, MAX_LIGHTS>;
 @group(0) @binding(2) var depth_buffer: texture_2d<f32>;
 @group(0) @binding(3) var normal_buffer: texture_2d<f32>;
 @group(0) @binding(4) var albedo_buffer: texture_2d<f32>;
@@ -21,13 +21,6 @@ const PI: f32 = 3.14159265358979;
 override SHADOWED: bool = true;
 // Whether PCF kernels are sized from the light's angular radius (blocker search).
 override KERNEL_FROM_RADIUS: bool = true;
-
-@vertex
-fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
-    // One triangle covering the screen.
-    let uv = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
 
 // Equirectangular lookup, constant per texel (CONVENTIONS.md).
 fn environment_radiance(w_world: vec3<f32>) -> vec3<f32> {

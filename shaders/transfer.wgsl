@@ -12,8 +12,8 @@ struct Lighting {
     _pad0: u32,
     _pad1: u32,
     // RGB coefficient k in sh[k].xyz.
-    sh: array<vec4<f32>, 64>,
-    lights_sh: array<vec4<f32>, 64>,
+    sh: array<vec4<f32>, MAX_SH_COEFFS>,
+    lights_sh: array<vec4<f32>, MAX_SH_COEFFS>,
 };
 
 @group(0) @binding(0) var<uniform> lighting: Lighting;
@@ -22,7 +22,7 @@ struct Lighting {
 @group(0) @binding(2) var<storage, read> indirect_transfer: array<f32>;
 @group(0) @binding(3) var<storage, read_write> radiance: array<vec4<f32>>;
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(TRANSFER_WORKGROUP)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let v = id.x;
     if v >= lighting.vertex_count {

@@ -1,11 +1,14 @@
-//! Bakes cached per scene and settings, so the viewer, the reports and the demo reuse them.
+//! Bakes for the commands: reading a given bake (checked against the scene), and bakes cached
+//! per scene and settings, so the viewer, the reports and the demo reuse them.
 
+use crate::support::TerminalProgress;
 use anyhow::Context;
-use indicatif::ProgressBar;
 use precompute::bake::{BakeSettings, BakeStats, Transfer};
+use precompute::bakefile;
 use precompute::bvh::SceneBvh;
+use precompute::progress::Progress;
 use precompute::scene::Scene;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The cache folder: `$HPRT_CACHE`, else `$XDG_CACHE_HOME/hprt`, else `~/.cache/hprt`.
 pub fn cache_dir() -> PathBuf {
@@ -18,6 +21,24 @@ pub fn cache_dir() -> PathBuf {
     std::env::var_os("HOME")
         .map(|home| PathBuf::from(home).join(".cache").join("hprt"))
         .unwrap_or_else(|| std::env::temp_dir().join("hprt-cache"))
+}
+
+/// Reads the scene's bake, refusing one of another mesh, or one whose SH order is below the
+/// lighting order asked (a lower lighting order than the bake's just drops bands).
+pub fn load_bake(scene: &Scene, path: &Path, order: Option<usize>) -> anyhow::Result<Transfer> {
+    let transfer = bakefile::read_for_mesh(path, &scene.geometry.content_hash())
+        .context("cannot use the bake")?;
+    if let Some(order) = order.filter(|o| *o > transfer.settings.order || *o == 0) {
+        anyhow::bail!(
+            "{} was baked at SH order {}, but order {order} was asked; re-bake with \
+             `hprt bake {} --order {order}` or ask for an order from 1 to {}",
+            path.display(),
+            transfer.settings.order,
+            scene.path.display(),
+            transfer.settings.order
+        );
+    }
+    Ok(transfer)
 }
 
 /// Where the bake of `scene` with `settings` is cached: the name carries the scene's mesh hash
@@ -36,7 +57,7 @@ pub fn bake_path(scene: &Scene, settings: &BakeSettings) -> PathBuf {
 /// The cached bake of `scene` with `settings`, if there is a usable one.
 pub fn load_cached(scene: &Scene, settings: &BakeSettings) -> Option<(PathBuf, Transfer)> {
     let path = bake_path(scene, settings);
-    let transfer = crate::commands::render::load_bake(scene, &path, None).ok()?;
+    let transfer = load_bake(scene, &path, None).ok()?;
     Some((path, transfer))
 }
 
@@ -44,15 +65,52 @@ pub fn load_cached(scene: &Scene, settings: &BakeSettings) -> Option<(PathBuf, T
 pub fn bake_into_cache(
     scene: &Scene,
     settings: &BakeSettings,
-    progress: &ProgressBar,
+    progress: &dyn Progress,
 ) -> anyhow::Result<(PathBuf, Transfer, BakeStats)> {
     let path = bake_path(scene, settings);
     let bvh = SceneBvh::build(&scene.geometry.mesh);
-    let (transfer, stats) = precompute::bake::bake(&scene.geometry, &bvh, settings, progress)
-        .map_err(anyhow::Error::msg)?;
+    let (transfer, stats) = precompute::bake::bake(&scene.geometry, &bvh, settings, progress)?;
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     precompute::bakefile::write(&path, &transfer, &scene.geometry.content_hash())?;
     Ok((path, transfer, stats))
+}
+
+/// `bake` if given, else the cached bake of the scene's settings, baking it if missing.
+pub fn bake_for(scene: &Scene, bake: Option<&Path>) -> anyhow::Result<(PathBuf, Transfer)> {
+    if let Some(path) = bake {
+        return Ok((path.to_owned(), load_bake(scene, path, None)?));
+    }
+    if let Some((path, transfer)) = load_cached(scene, &scene.bake) {
+        println!("using the cached bake {}", path.display());
+        return Ok((path, transfer));
+    }
+    println!("baking {} into the cache", scene.name);
+    let progress = TerminalProgress::new("baking");
+    let (path, transfer, stats) = bake_into_cache(scene, &scene.bake, &progress)?;
+    print_bake_stats(&stats);
+    println!("wrote {}", path.display());
+    Ok((path, transfer))
+}
+
+pub fn print_bake_stats(stats: &BakeStats) {
+    println!(
+        "traced {} rays in {:.2} s: {:.2} M rays/s",
+        stats.rays,
+        stats.direct_seconds,
+        stats.rays_per_second() / 1e6
+    );
+    for (b, s) in stats.bounce_seconds.iter().enumerate() {
+        println!(
+            "bounce {}: {:.3} s ({:.1}% of the direct pass)",
+            b + 1,
+            s,
+            100.0 * s / stats.direct_seconds.max(1e-9)
+        );
+    }
+    println!(
+        "bake time {:.2} s ({} operator entries)",
+        stats.total_seconds, stats.operator_entries
+    );
 }

@@ -2,8 +2,11 @@
 //! scenes under distant HDR environment lighting.
 
 mod bake_cache;
+mod cli;
 mod commands;
+mod environment;
 mod report;
+mod support;
 mod view;
 
 use clap::{Parser, Subcommand};

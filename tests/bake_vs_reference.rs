@@ -7,10 +7,10 @@
 mod common;
 
 use glam::Vec3;
-use indicatif::ProgressBar;
 use precompute::bake::{self, BakeSettings, TransferVectors};
 use precompute::bvh::SceneBvh;
 use precompute::envmap::{EnvMap, rotate_y};
+use precompute::progress::NoProgress;
 use precompute::reference::{EnvironmentLight, Integrator, estimate_vertex};
 use precompute::scene::Scene;
 use precompute::sh::{ShBasis, ShCoeffs};
@@ -65,8 +65,7 @@ fn reference_agrees_with_the_bake_at_vertices() {
                 bounces: 3,
                 seed,
             };
-            let traced =
-                bake::trace(&scene.geometry, &bvh, &settings, &ProgressBar::hidden()).unwrap();
+            let traced = bake::trace(&scene.geometry, &bvh, &settings, &NoProgress).unwrap();
             inside = traced.inside.clone();
             let indirect: Vec<TransferVectors> = traced
                 .cumulative_indirect(&scene.geometry.albedo, 3)

@@ -19,12 +19,30 @@ fn golden_dir() -> PathBuf {
 /// (file stem, extra `hprt render` arguments).
 const CASES: [(&str, &[&str]); 7] = [
     ("prt", &["--mode", "prt"]),
-    ("hybrid-consistent", &["--mode", "hybrid", "--decompose-mode", "consistent"]),
-    ("hybrid-thesis", &["--mode", "hybrid", "--decompose-mode", "thesis"]),
-    ("lights-consistent", &["--mode", "lights", "--decompose-mode", "consistent"]),
-    ("lights-thesis", &["--mode", "lights", "--decompose-mode", "thesis"]),
-    ("unshadowed-consistent", &["--mode", "unshadowed", "--decompose-mode", "consistent"]),
-    ("unshadowed-thesis", &["--mode", "unshadowed", "--decompose-mode", "thesis"]),
+    (
+        "hybrid-consistent",
+        &["--mode", "hybrid", "--decompose-mode", "consistent"],
+    ),
+    (
+        "hybrid-thesis",
+        &["--mode", "hybrid", "--decompose-mode", "thesis"],
+    ),
+    (
+        "lights-consistent",
+        &["--mode", "lights", "--decompose-mode", "consistent"],
+    ),
+    (
+        "lights-thesis",
+        &["--mode", "lights", "--decompose-mode", "thesis"],
+    ),
+    (
+        "unshadowed-consistent",
+        &["--mode", "unshadowed", "--decompose-mode", "consistent"],
+    ),
+    (
+        "unshadowed-thesis",
+        &["--mode", "unshadowed", "--decompose-mode", "thesis"],
+    ),
 ];
 
 #[test]
@@ -35,7 +53,16 @@ fn teapot_renders_match_the_committed_images_in_every_mode() {
     let scene = scene.to_str().unwrap();
     let out = hprt(
         dir.path(),
-        &["bake", scene, "--samples", "64", "--bounces", "1", "-o", bake.to_str().unwrap()],
+        &[
+            "bake",
+            scene,
+            "--samples",
+            "64",
+            "--bounces",
+            "1",
+            "-o",
+            bake.to_str().unwrap(),
+        ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
     let hall = repo().join("scenes/env/hall.exr");
@@ -80,7 +107,10 @@ fn teapot_renders_match_the_committed_images_in_every_mode() {
         }
         let expected = read_exr(&golden).unwrap_or_else(|e| panic!("{}: {e}", golden.display()));
         let actual = read_exr(&exr).unwrap();
-        assert_eq!((actual.width, actual.height), (expected.width, expected.height));
+        assert_eq!(
+            (actual.width, actual.height),
+            (expected.width, expected.height)
+        );
         // Bit for bit: the same software adapter, inputs and arithmetic give the same image.
         let differing = actual
             .pixels
@@ -95,7 +125,9 @@ fn teapot_renders_match_the_committed_images_in_every_mode() {
             .map(|(a, e)| (*a - *e).abs().max_element())
             .fold(0.0f32, f32::max);
         if differing > 0 {
-            failures.push(format!("{stem}: {differing} pixels differ, by up to {worst}"));
+            failures.push(format!(
+                "{stem}: {differing} pixels differ, by up to {worst}"
+            ));
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");

@@ -4,13 +4,13 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use indicatif::ProgressBar;
 use precompute::bake::{BakeSettings, Transfer};
 use precompute::bvh::SceneBvh;
 use precompute::camera::Camera;
 use precompute::envmap::EnvMap;
 use precompute::image_io::{RgbImageF32, tonemap};
 use precompute::mesh::{box_mesh, sphere_mesh};
+use precompute::progress::NoProgress;
 use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
 use precompute::scene::{Scene, SceneMesh};
 use precompute::sh::ShCoeffs;
@@ -235,14 +235,7 @@ fn hybrid_beats_prt_in_the_shadows_against_the_reference() {
         bounces: 2,
         seed: 1,
     };
-    let truth = reference::render(
-        &teapot.geometry,
-        &bvh,
-        &light,
-        &cam,
-        &settings,
-        &ProgressBar::hidden(),
-    );
+    let truth = reference::render(&teapot.geometry, &bvh, &light, &cam, &settings, &NoProgress);
 
     let decompose = DecomposeSettings::default();
     let cube = CubeSource::new(&map, decompose.face_size).cube(rotation.to_radians());

@@ -129,94 +129,66 @@ impl SceneBvh {
         }
     }
 
-    /// Closest hit along `origin + t·direction`, `t` in `[tmin, tmax]`.
-    pub fn intersect(&self, origin: Vec3, direction: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
-        let ray = Self::ray(origin, direction, tmin, tmax);
-        let mut hit = RayHit::none();
-        self.bvh
-            .ray_traverse(ray, &mut hit, |r, slot| self.triangles[slot].intersect(r))
-            .then(|| self.finish(&ray, hit))
-    }
-
-    /// Closest hit ignoring one scene triangle (the one the ray leaves from).
-    pub fn intersect_excluding(
-        &self,
-        origin: Vec3,
-        direction: Vec3,
-        tmin: f32,
-        exclude_triangle: u32,
-    ) -> Option<Hit> {
-        let ray = Self::ray(origin, direction, tmin, f32::INFINITY);
-        let mut hit = RayHit::none();
-        self.bvh
-            .ray_traverse(ray, &mut hit, |r, slot| {
-                if self.ids[slot] == exclude_triangle {
-                    f32::INFINITY
-                } else {
-                    self.triangles[slot].intersect(r)
-                }
-            })
-            .then(|| self.finish(&ray, hit))
-    }
-
-    /// Whether anything blocks the ray, ignoring one scene triangle.
-    pub fn occluded_excluding(
+    /// Closest hit along `origin + t·direction`, `t` in `[tmin, tmax]`, ignoring `skip`.
+    pub fn closest_hit(
         &self,
         origin: Vec3,
         direction: Vec3,
         tmin: f32,
         tmax: f32,
-        exclude_triangle: u32,
-    ) -> bool {
-        let ray = Self::ray(origin, direction, tmin, tmax);
-        !self.bvh.ray_traverse_miss(ray, |r, slot| {
-            if self.ids[slot] == exclude_triangle {
-                f32::INFINITY
-            } else {
-                self.triangles[slot].intersect(r)
-            }
-        })
-    }
-
-    /// Closest hit from a vertex, ignoring the triangles that share it (a vertex never
-    /// shadows itself).
-    pub fn intersect_from_vertex(
-        &self,
-        vertex: u32,
-        origin: Vec3,
-        direction: Vec3,
-        tmin: f32,
+        skip: Skip,
     ) -> Option<Hit> {
-        let ray = Self::ray(origin, direction, tmin, f32::INFINITY);
+        let ray = Self::ray(origin, direction, tmin, tmax);
         let mut hit = RayHit::none();
         self.bvh
-            .ray_traverse(ray, &mut hit, |r, slot| {
-                if self.corners[slot].contains(&vertex) {
-                    f32::INFINITY
-                } else {
-                    self.triangles[slot].intersect(r)
-                }
-            })
+            .ray_traverse(ray, &mut hit, |r, slot| self.test(r, slot, skip))
             .then(|| self.finish(&ray, hit))
     }
 
-    /// Whether anything blocks a ray leaving a vertex, ignoring the vertex's own triangles.
-    pub fn occluded_from_vertex(
+    /// Whether anything but `skip` blocks `origin + t·direction`, `t` in `[tmin, tmax]`.
+    pub fn occluded(
         &self,
-        vertex: u32,
         origin: Vec3,
         direction: Vec3,
         tmin: f32,
+        tmax: f32,
+        skip: Skip,
     ) -> bool {
-        let ray = Self::ray(origin, direction, tmin, f32::INFINITY);
-        !self.bvh.ray_traverse_miss(ray, |r, slot| {
-            if self.corners[slot].contains(&vertex) {
-                f32::INFINITY
-            } else {
-                self.triangles[slot].intersect(r)
-            }
-        })
+        let ray = Self::ray(origin, direction, tmin, tmax);
+        !self
+            .bvh
+            .ray_traverse_miss(ray, |r, slot| self.test(r, slot, skip))
     }
+
+    /// Closest hit along `origin + t·direction`, `t` in `[tmin, tmax]`.
+    pub fn intersect(&self, origin: Vec3, direction: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
+        self.closest_hit(origin, direction, tmin, tmax, Skip::Nothing)
+    }
+
+    /// The ray's distance to the triangle in leaf `slot` (infinity on a miss or if skipped).
+    #[inline(always)]
+    fn test(&self, ray: &Ray, slot: usize, skip: Skip) -> f32 {
+        let skipped = match skip {
+            Skip::Nothing => false,
+            Skip::Triangle(t) => self.ids[slot] == t,
+            Skip::VertexTriangles(v) => self.corners[slot].contains(&v),
+        };
+        if skipped {
+            f32::INFINITY
+        } else {
+            self.triangles[slot].intersect(ray)
+        }
+    }
+}
+
+/// Triangles a ray ignores: those at its origin, which it would otherwise hit at `t ≈ 0`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Skip {
+    Nothing,
+    /// One scene triangle (the one a ray leaves from).
+    Triangle(u32),
+    /// Every triangle sharing a vertex (a vertex never shadows itself).
+    VertexTriangles(u32),
 }
 
 #[cfg(test)]
@@ -266,10 +238,18 @@ mod tests {
         let up = Vec3::new(0.1, 1.0, 0.03).normalize();
         let own = bvh.intersect(p, up, 0.0, f32::INFINITY).unwrap();
         assert!(mesh.triangles[own.triangle as usize].contains(&v));
-        assert!(!bvh.occluded_from_vertex(v, p, up, 0.0));
-        assert!(bvh.intersect_from_vertex(v, p, up, 0.0).is_none());
+        let skip = Skip::VertexTriangles(v);
+        assert!(bvh.occluded(p, up, 0.0, f32::INFINITY, Skip::Nothing));
+        assert!(!bvh.occluded(p, up, 0.0, f32::INFINITY, skip));
+        assert!(bvh.closest_hit(p, up, 0.0, f32::INFINITY, skip).is_none());
         // Shooting down through the box hits the bottom face.
-        let hit = bvh.intersect_from_vertex(v, p, -Vec3::Y, 0.0).unwrap();
+        let hit = bvh
+            .closest_hit(p, -Vec3::Y, 0.0, f32::INFINITY, skip)
+            .unwrap();
         assert!((hit.t - 2.0).abs() < 1e-3);
+        // Skipping the triangle a ray leaves from.
+        let own_triangle = Skip::Triangle(own.triangle);
+        let next = bvh.closest_hit(p, up, 0.0, f32::INFINITY, own_triangle);
+        assert!(next.is_none_or(|h| h.triangle != own.triangle));
     }
 }

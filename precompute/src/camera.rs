@@ -1,5 +1,6 @@
 //! The pinhole camera shared by the reference renderer, the GPU renderer and the reports.
 
+use crate::settings::InvalidSettings;
 use glam::{Mat4, Vec3};
 
 /// A pinhole camera; pixel `(i, j)`, `j` counted from the top row, is seen through its centre.
@@ -41,22 +42,23 @@ impl Camera {
     }
 
     /// Checks the camera can form an image; the message says what is wrong.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidSettings> {
+        let invalid = |reason: String| Err(InvalidSettings::new("camera", reason));
         if self.width == 0 || self.height == 0 {
-            return Err(format!(
+            return invalid(format!(
                 "image size {}x{} is empty",
                 self.width, self.height
             ));
         }
         if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 179.0) {
-            return Err(format!("fov_y_deg {} is outside (0, 179)", self.fov_y_deg));
+            return invalid(format!("fov_y_deg {} is outside (0, 179)", self.fov_y_deg));
         }
         let forward = self.target - self.position;
         if !forward.is_finite() || forward.length() < 1e-6 {
-            return Err("camera position and target coincide".into());
+            return invalid("camera position and target coincide".into());
         }
         if forward.cross(self.up).length() < 1e-6 * forward.length() * self.up.length() {
-            return Err("camera up vector is parallel to the viewing direction".into());
+            return invalid("camera up vector is parallel to the viewing direction".into());
         }
         Ok(())
     }

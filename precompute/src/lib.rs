@@ -5,6 +5,8 @@
 //! in a [`bakefile`]. The [`reference`] path tracer renders the same scene as ground truth.
 
 pub mod color;
+#[macro_use]
+pub mod named_enum;
 pub mod envmap;
 pub mod export;
 pub mod image_io;
@@ -17,7 +19,10 @@ pub mod sh;
 pub use color::{Rgb, luminance};
 pub mod atomic_file;
 pub mod bake;
+pub mod bake_settings;
 pub mod bakefile;
 pub mod bvh;
 pub mod camera;
+pub mod progress;
 pub mod scene;
+pub mod settings;

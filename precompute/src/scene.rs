@@ -1,7 +1,7 @@
 //! Scene files (TOML): objects with transforms and albedos, the camera, the default
 //! environment map and the default bake settings. See `docs/scene-format.md`.
 
-use crate::bake::BakeSettings;
+use crate::bake_settings::BakeSettings;
 use crate::camera::Camera;
 use crate::color::Rgb;
 use crate::mesh::{

@@ -1,11 +1,16 @@
 //! The per-frame half of hprt: the environment map becomes an SH polynomial plus directional
-//! lights ([`decompose`]), which the renderer draws through the baked transfer and shadow maps.
+//! lights ([`decompose`]); [`lighting`] is the one path from a map to a frame's lighting, which
+//! the [`render`]er draws through the baked transfer and shadow maps.
 
 pub mod cubemap;
 pub mod decompose;
 pub mod light;
+pub mod lighting;
+pub mod render;
 
 pub use cubemap::{CubeGeometry, CubeMap, CubeResampler, CubeSource};
-pub use decompose::{DecomposeMode, DecomposeSettings, Decomposer, Decomposition, Window};
+pub use decompose::{
+    DecomposeError, DecomposeMode, DecomposeSettings, Decomposer, Decomposition, Window,
+};
 pub use light::DirectionalLight;
-pub mod render;
+pub use lighting::{EnvironmentLighting, FrameLighting, LitFrame, RenderMode};

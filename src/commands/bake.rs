@@ -1,10 +1,11 @@
 //! `hprt bake`: the offline transfer bake.
 
-use super::{load_scene, progress_bar, with_threads};
+use crate::bake_cache::print_bake_stats;
+use crate::support::{TerminalProgress, load_scene, with_threads};
 use anyhow::Context;
 use clap::Args;
 use precompute::atomic_file::AtomicOutput;
-use precompute::bake::{self, BakeSettings, BakeStats};
+use precompute::bake::{self, BakeSettings};
 use precompute::bakefile;
 use precompute::bvh::SceneBvh;
 use precompute::scene::Scene;
@@ -43,9 +44,7 @@ pub fn settings_for(scene: &Scene, args: &BakeArgs) -> anyhow::Result<BakeSettin
         bounces: args.bounces.unwrap_or(scene.bake.bounces),
         seed: args.seed.unwrap_or(scene.bake.seed),
     };
-    settings
-        .validate()
-        .map_err(|m| anyhow::anyhow!("invalid bake settings: {m}"))?;
+    settings.validate()?;
     Ok(settings)
 }
 
@@ -55,6 +54,15 @@ pub fn run(args: BakeArgs) -> anyhow::Result<()> {
     // Fail on an unwritable destination before spending minutes baking.
     let output = AtomicOutput::create(&args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
+    if settings.order > runtime::render::MAX_GPU_ORDER {
+        log::warn!(
+            "SH order {} is above the GPU renderer's maximum ({}): this bake can be used by the \
+             CPU code (the reference comparisons, the numpy reader) but not by `hprt render`, \
+             `hprt view` or `hprt report`",
+            settings.order,
+            runtime::render::MAX_GPU_ORDER
+        );
+    }
     let mesh = &scene.geometry.mesh;
     println!(
         "{}: {} vertices, {} triangles; order {}, {} samples, {} bounces",
@@ -65,48 +73,24 @@ pub fn run(args: BakeArgs) -> anyhow::Result<()> {
         settings.samples,
         settings.bounces
     );
-    let (transfer, stats) = with_threads(args.threads, || {
+    let baked = with_threads(args.threads, || {
         let start = Instant::now();
         let bvh = SceneBvh::build(mesh);
         let bvh_seconds = start.elapsed().as_secs_f64();
-        let progress = progress_bar(mesh.vertex_count() as u64, "baking");
+        let progress = TerminalProgress::new("baking");
         bake::bake(&scene.geometry, &bvh, &settings, &progress).map(|r| (r, bvh_seconds))
-    })?
-    .map_err(|m| anyhow::anyhow!(m))
-    .map(|((t, s), bvh_seconds)| {
-        println!("BVH built in {bvh_seconds:.2} s");
-        (t, s)
-    })?;
+    })??;
+    let ((transfer, stats), bvh_seconds) = baked;
+    println!("BVH built in {bvh_seconds:.2} s");
     let bytes = bakefile::encode(&transfer, &scene.geometry.content_hash());
     output
         .commit(&bytes)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
-    print_stats(&stats);
+    print_bake_stats(&stats);
     println!(
         "wrote {} ({:.1} MB)",
         args.output.display(),
         bytes.len() as f64 / 1e6
     );
     Ok(())
-}
-
-pub fn print_stats(stats: &BakeStats) {
-    println!(
-        "traced {} rays in {:.2} s: {:.2} M rays/s",
-        stats.rays,
-        stats.direct_seconds,
-        stats.rays_per_second() / 1e6
-    );
-    for (b, s) in stats.bounce_seconds.iter().enumerate() {
-        println!(
-            "bounce {}: {:.3} s ({:.1}% of the direct pass)",
-            b + 1,
-            s,
-            100.0 * s / stats.direct_seconds.max(1e-9)
-        );
-    }
-    println!(
-        "bake time {:.2} s ({} operator entries)",
-        stats.total_seconds, stats.operator_entries
-    );
 }

@@ -1,10 +1,12 @@
 //! `hprt bench`: benchmarks anyone can rerun; they print medians over repeats.
 
-use super::{load_scene, with_threads};
+use crate::cli::Switch;
+use crate::environment::{self, load_map};
+use crate::support::{load_scene, median, with_threads};
 use clap::{Args, Subcommand};
-use indicatif::ProgressBar;
 use precompute::bake::{self, BakeSettings};
 use precompute::bvh::SceneBvh;
+use precompute::progress::NoProgress;
 use runtime::render::ShadowSettings;
 use std::path::PathBuf;
 
@@ -41,7 +43,7 @@ pub struct BenchRenderArgs {
     pub pcf: u32,
     /// Size the PCF kernel from each light's angular radius (blocker search).
     #[arg(long, value_enum, default_value = "on")]
-    pub pcf_from_radius: super::render::Switch,
+    pub pcf_from_radius: Switch,
     /// Frames timed per configuration (after one warm-up frame); medians are reported.
     #[arg(long, default_value_t = 20)]
     pub frames: usize,
@@ -101,17 +103,6 @@ pub fn run(command: BenchCommand) -> anyhow::Result<()> {
     }
 }
 
-/// Median of a non-empty sample.
-pub fn median(mut xs: Vec<f64>) -> f64 {
-    xs.sort_by(f64::total_cmp);
-    let n = xs.len();
-    if n % 2 == 1 {
-        xs[n / 2]
-    } else {
-        0.5 * (xs[n / 2 - 1] + xs[n / 2])
-    }
-}
-
 fn bench_bake(args: BenchBakeArgs) -> anyhow::Result<()> {
     let settings = BakeSettings {
         order: args.order,
@@ -119,9 +110,7 @@ fn bench_bake(args: BenchBakeArgs) -> anyhow::Result<()> {
         bounces: args.bounces,
         seed: 0,
     };
-    settings
-        .validate()
-        .map_err(|m| anyhow::anyhow!("invalid bake settings: {m}"))?;
+    settings.validate()?;
     println!(
         "bake benchmark: order {}, {} samples, {} bounces, {} threads, median of {}",
         args.order,
@@ -139,10 +128,9 @@ fn bench_bake(args: BenchBakeArgs) -> anyhow::Result<()> {
         let runs = with_threads(args.threads, || {
             let bvh = SceneBvh::build(&scene.geometry.mesh);
             (0..args.repeat.max(1))
-                .map(|_| bake::bake(&scene.geometry, &bvh, &settings, &ProgressBar::hidden()))
+                .map(|_| bake::bake(&scene.geometry, &bvh, &settings, &NoProgress))
                 .collect::<Result<Vec<_>, _>>()
-        })?
-        .map_err(|m| anyhow::anyhow!(m))?;
+        })??;
         let stats: Vec<_> = runs.into_iter().map(|(_, s)| s).collect();
         let bounce_ratio = median(
             stats
@@ -171,11 +159,9 @@ const MITSUBA_SCALAR_SECONDS_PER_MEGAPIXEL_SAMPLE: f64 = 1.0;
 fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
     use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
     let scene = load_scene(&args.scene)?;
-    let env = super::choose_environment(&scene, None, None, None)?;
+    let env = environment::choose(&scene, None, None, None)?;
     let camera = scene.camera.with_size(args.width, args.height);
-    camera
-        .validate()
-        .map_err(|m| anyhow::anyhow!("invalid image size: {m}"))?;
+    camera.validate()?;
     let settings = ReferenceSettings {
         spp: args.spp,
         bounces: args.bounces,
@@ -192,7 +178,7 @@ fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
                     &light,
                     &camera,
                     &settings,
-                    &ProgressBar::hidden(),
+                    &NoProgress,
                 )
                 .stats
             })
@@ -237,9 +223,9 @@ fn time_frames(
 }
 
 fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
-    use runtime::render::{FrameLighting, GpuContext, RenderMode, Renderer};
-    use runtime::{CubeSource, DecomposeSettings, Decomposer};
-    let map = super::decompose::load_map(&args.env, None)?.map;
+    use runtime::render::{GpuContext, RenderMode, Renderer};
+    use runtime::{DecomposeSettings, EnvironmentLighting};
+    let map = load_map(&args.env, None)?.map;
     let gpu = GpuContext::headless(args.backend)?;
     println!(
         "render benchmark on {}: {}x{}, {} lights, {}² shadow maps, PCF {}x{}{}, median of {} frames",
@@ -250,7 +236,7 @@ fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
         args.shadow_res,
         args.pcf,
         args.pcf,
-        if args.pcf_from_radius == super::render::Switch::On {
+        if args.pcf_from_radius.is_on() {
             " sized from the light radius"
         } else {
             ""
@@ -278,38 +264,29 @@ fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
             seed: 0,
         };
         let bvh = SceneBvh::build(&scene.geometry.mesh);
-        let (transfer, _) = bake::bake(&scene.geometry, &bvh, &settings, &ProgressBar::hidden())
-            .map_err(|m| anyhow::anyhow!(m))?;
+        let (transfer, _) = bake::bake(&scene.geometry, &bvh, &settings, &NoProgress)?;
         let decompose = DecomposeSettings {
             threshold: 0.0,
             max_lights: args.lights,
             ..Default::default()
         };
-        let source = CubeSource::new(&map, decompose.face_size);
-        let mut cube = source.cube(0.0);
-        let mut decomposer = Decomposer::new(decompose).map_err(|m| anyhow::anyhow!(m))?;
+        let mut lighting = EnvironmentLighting::new(&map, decompose)?;
         let camera = scene.camera.with_size(args.width, args.height);
         let shadow = ShadowSettings {
             resolution: args.shadow_res,
             pcf_taps: args.pcf,
-            from_angular_radius: args.pcf_from_radius == super::render::Switch::On,
+            from_angular_radius: args.pcf_from_radius.is_on(),
         };
         let mut renderer = Renderer::new(&gpu, &scene.geometry, &transfer, &camera, shadow)?;
         renderer.set_environment(&map, 0.0);
-        let decomposition = decomposer.decompose(&cube);
-        let projection = decomposer.project(&cube);
-        if decomposition.lights.len() != args.lights {
-            println!("note: the map gives {} lights", decomposition.lights.len());
+        let lights = lighting.decompose().lights.len();
+        if lights != args.lights {
+            println!("note: the map gives {lights} lights");
         }
         let mut results = Vec::new();
         // Static lighting: shadow maps and vertex radiance are computed once.
         for mode in [RenderMode::Prt, RenderMode::Hybrid, RenderMode::Unshadowed] {
-            renderer.set_lighting(&FrameLighting::for_mode(
-                mode,
-                &projection,
-                &decomposition,
-                true,
-            ))?;
+            renderer.set_lighting(&lighting.frame(mode, None).lighting)?;
             results.push(time_frames(args.frames, || {
                 renderer.render()?;
                 renderer.wait();
@@ -323,14 +300,10 @@ fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
             results.push(time_frames(args.frames, || {
                 let start = std::time::Instant::now();
                 angle += 1.0;
-                source.cube_into(angle.to_radians(), &mut cube);
-                let lighting = if mode == RenderMode::Prt {
-                    FrameLighting::prt(decomposer.project(&cube))
-                } else {
-                    FrameLighting::for_mode(mode, &projection, &decomposer.decompose(&cube), true)
-                };
+                lighting.set_rotation(angle);
+                let frame = lighting.frame(mode, None);
                 renderer.set_environment_rotation(angle);
-                renderer.set_lighting(&lighting)?;
+                renderer.set_lighting(&frame.lighting)?;
                 if mode == RenderMode::Hybrid {
                     cpu_ms.push(start.elapsed().as_secs_f64() * 1e3);
                 }

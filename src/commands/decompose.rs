@@ -1,69 +1,17 @@
 //! `hprt decompose`: an environment map into an SH polynomial plus directional lights.
 
+use crate::cli::DecomposeOptions;
+use crate::environment::load_map;
+use crate::support::median;
 use anyhow::Context;
 use clap::Args;
-use precompute::envmap::{self, Layout, LoadedEnvMap};
+use precompute::envmap::Layout;
 use precompute::image_io::write_png_rgb8;
 use precompute::{Rgb, luminance};
-use runtime::decompose::visualize::decomposition_picture;
-use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer, Decomposition, Window};
-use std::path::{Path, PathBuf};
+use runtime::decompose::visualize::{decomposition_picture, describe};
+use runtime::{DecomposeMode, DecomposeSettings, Decomposition, EnvironmentLighting};
+use std::path::PathBuf;
 use std::time::Instant;
-
-/// Options shared by every command that decomposes a map (defaults: `DecomposeSettings`).
-#[derive(Args, Clone, Debug)]
-pub struct DecomposeOptions {
-    /// SH order of the polynomial part (default: 5, or the bake's order when rendering).
-    #[arg(long)]
-    pub order: Option<usize>,
-    /// Weber fraction: keep lights while each adds more than this share of the luminance of
-    /// the brighter ones.
-    #[arg(long, default_value_t = DecomposeSettings::default().threshold)]
-    pub threshold: f32,
-    /// Radius of the SRBF / light caps in degrees (default: 8 for consistent, √2 × the
-    /// smoothing for thesis, which keeps a point source's power under the thesis' formula).
-    #[arg(long)]
-    pub radius: Option<f32>,
-    /// Cube-map face resolution.
-    #[arg(long, default_value_t = DecomposeSettings::default().face_size)]
-    pub face: usize,
-    /// Most lights kept.
-    #[arg(long, default_value_t = DecomposeSettings::default().max_lights)]
-    pub max_lights: usize,
-    /// Icosahedron subdivision level of the peak search.
-    #[arg(long, default_value_t = DecomposeSettings::default().ico_level)]
-    pub ico_level: u32,
-    /// Standard deviation of the smoothing Gaussian, in degrees.
-    #[arg(long, default_value_t = DecomposeSettings::default().smoothing_deg)]
-    pub smoothing: f32,
-    /// Window of the SH part (none, hanning, lanczos); default: hanning for thesis, none for
-    /// consistent.
-    #[arg(long)]
-    pub window: Option<Window>,
-    /// A peak must exceed this multiple of the map's mean luminance to become a light.
-    #[arg(long, default_value_t = DecomposeSettings::default().min_contrast)]
-    pub min_contrast: f32,
-}
-
-impl DecomposeOptions {
-    /// The settings for `mode`, with `default_order` unless `--order` was given.
-    pub fn settings(&self, mode: DecomposeMode, default_order: usize) -> DecomposeSettings {
-        DecomposeSettings {
-            mode,
-            order: self.order.unwrap_or(default_order),
-            face_size: self.face,
-            ico_level: self.ico_level,
-            smoothing_deg: self.smoothing,
-            radius_deg: self
-                .radius
-                .unwrap_or_else(|| DecomposeSettings::default_radius(mode, self.smoothing)),
-            threshold: self.threshold,
-            max_lights: self.max_lights,
-            min_contrast: self.min_contrast,
-            window: self.window,
-        }
-    }
-}
 
 #[derive(Args)]
 pub struct DecomposeArgs {
@@ -90,11 +38,6 @@ pub struct DecomposeArgs {
     /// Decompose this many times (for timing from outside); the JSON reports the median.
     #[arg(long, default_value_t = 1)]
     pub repeat: usize,
-}
-
-/// Loads a map with the file named in any error, and reports sanitised texels.
-pub fn load_map(path: &Path, layout: Option<Layout>) -> anyhow::Result<LoadedEnvMap> {
-    envmap::load(path, layout).context("cannot load the environment map")
 }
 
 #[derive(serde::Serialize)]
@@ -127,26 +70,24 @@ pub fn run(args: DecomposeArgs) -> anyhow::Result<()> {
     let settings = args
         .options
         .settings(args.mode, DecomposeSettings::default().order);
-    settings
-        .validate()
-        .map_err(|m| anyhow::anyhow!("invalid decomposition settings: {m}"))?;
+    settings.validate()?;
     if args.repeat == 0 {
         anyhow::bail!("--repeat must be at least 1");
     }
     let loaded = load_map(&args.env, args.layout)?;
-    let rotation = args.rotate.to_radians();
-    let cube = CubeSource::new(&loaded.map, settings.face_size).cube(rotation);
-    let mut decomposer = Decomposer::new(settings.clone()).map_err(|m| anyhow::anyhow!(m))?;
+    let mut lighting = EnvironmentLighting::new(&loaded.map, settings.clone())?;
+    lighting.set_rotation(args.rotate);
+    lighting.cube();
     let mut times = Vec::with_capacity(args.repeat);
     let mut result: Option<Decomposition> = None;
     for _ in 0..args.repeat {
         let start = Instant::now();
-        let d = decomposer.decompose(&cube);
+        let d = lighting.decompose();
         times.push(start.elapsed().as_secs_f64() * 1e3);
         result = Some(d);
     }
     let result = result.expect("at least one run");
-    let median = crate::commands::bench::median(times.clone());
+    let median = median(times.clone());
     let json = DecompositionJson {
         map: args.env.display().to_string(),
         layout: loaded.layout.name(),
@@ -175,7 +116,7 @@ pub fn run(args: DecomposeArgs) -> anyhow::Result<()> {
     precompute::atomic_file::write_atomic(&args.output, text.as_bytes())
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     if let Some(png) = &args.png {
-        let picture = decomposition_picture(&loaded.map, rotation, &result, 1024);
+        let picture = decomposition_picture(&loaded.map, args.rotate.to_radians(), &result, 1024);
         write_png_rgb8(png, picture.width, picture.height, &picture.rgb)?;
     }
     println!(
@@ -183,7 +124,7 @@ pub fn run(args: DecomposeArgs) -> anyhow::Result<()> {
         args.env.display(),
         result.lights.len(),
         100.0 * json.lights_share,
-        runtime::decompose::visualize::describe(&result),
+        describe(&result),
         median,
         args.repeat
     );

@@ -2,8 +2,10 @@
 //! writes the error report for every bundled environment map, at settings that finish in a few
 //! minutes on two CPU cores without a GPU; a second run reuses bake and references.
 
-use super::report::{ReportOptions, write};
-use super::{ImageSizeArgs, load_scene};
+use crate::cli::{ImageSizeArgs, ReportOptions};
+use crate::environment::maps_beside;
+use crate::report::write_report;
+use crate::support::load_scene;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -42,7 +44,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let Some(environment) = &scene.environment else {
         anyhow::bail!("{} names no [environment]", scene.path.display());
     };
-    let envs = super::maps_beside(&environment.map);
+    let envs = maps_beside(&environment.map);
     let options = ReportOptions {
         bake: None,
         spp: args.spp,
@@ -56,5 +58,5 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         frames: 5,
         backend: args.backend,
     };
-    write(&scene, &envs, &options, &args.output)
+    write_report(&scene, &envs, &options, &args.output)
 }

@@ -1,6 +1,7 @@
 //! `hprt export`: the scene as hprt sees it, for Mitsuba 3.
 
-use super::{EnvironmentArgs, ImageSizeArgs, load_scene};
+use crate::cli::{EnvironmentArgs, ImageSizeArgs};
+use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
 use precompute::export::{ExportSettings, export_mitsuba, mitsuba_max_depth};

@@ -1,8 +1,8 @@
 //! `hprt reference`: the CPU path-traced ground truth.
 
-use super::{
-    EnvironmentArgs, ImageSizeArgs, default_exposure, load_scene, progress_bar, with_threads,
-};
+use crate::cli::{EnvironmentArgs, ImageSizeArgs};
+use crate::environment::default_exposure;
+use crate::support::{TerminalProgress, load_scene, with_threads};
 use anyhow::Context;
 use clap::Args;
 use precompute::atomic_file::AtomicOutput;
@@ -90,7 +90,7 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
     let image: ReferenceImage = with_threads(args.threads, || {
         let bvh = SceneBvh::build(&scene.geometry.mesh);
         let light = EnvironmentLight::new(&env.loaded.map, env.rotation_deg);
-        let progress = progress_bar(camera.height as u64, "rendering rows");
+        let progress = TerminalProgress::new("rendering rows");
         reference::render(&scene.geometry, &bvh, &light, &camera, &settings, &progress)
     })?;
     let exr =

@@ -1,65 +1,16 @@
 //! `hprt render`: the hybrid (or plain PRT) image of a baked scene, on the GPU.
 
-use super::decompose::DecomposeOptions;
-use super::{EnvironmentArgs, ImageSizeArgs, default_exposure, load_scene};
+use crate::bake_cache::load_bake;
+use crate::cli::{DecomposeOptions, EnvironmentArgs, ImageSizeArgs, RenderOptions, parse_vec3};
+use crate::environment::default_exposure;
+use crate::support::load_scene;
 use anyhow::Context;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use precompute::atomic_file::AtomicOutput;
-use precompute::bake::Transfer;
-use precompute::bakefile;
 use precompute::image_io::{RgbImageF32, exr_bytes, png_bytes, to_display_rgb8};
-use precompute::scene::Scene;
-use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
-use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer, Decomposition};
-use std::path::{Path, PathBuf};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Switch {
-    On,
-    Off,
-}
-
-#[derive(Args, Clone, Debug)]
-pub struct RenderOptions {
-    /// prt: the SH projection of the whole map (the thesis' baseline); hybrid: SH part +
-    /// shadow-mapped lights; lights / unshadowed: debug views.
-    #[arg(long, default_value = "hybrid")]
-    pub mode: RenderMode,
-    /// Shadow-map resolution.
-    #[arg(long, default_value_t = 2048)]
-    pub shadow_res: u32,
-    /// PCF taps per side (odd).
-    #[arg(long, default_value_t = 3)]
-    pub pcf: u32,
-    /// Size each light's PCF kernel from its angular radius and the occluder distance
-    /// (off: a fixed kernel of --pcf taps one texel apart).
-    #[arg(long, value_enum, default_value = "on")]
-    pub pcf_from_radius: Switch,
-    /// Send the lights through the bake's indirect transfer too (their bounce light);
-    /// default: on in consistent mode, off in thesis mode.
-    #[arg(long, value_enum)]
-    pub lights_indirect: Option<Switch>,
-    /// Graphics backend: auto, vulkan or gl.
-    #[arg(long, default_value = "auto")]
-    pub backend: Backend,
-}
-
-impl RenderOptions {
-    pub fn shadow_settings(&self) -> ShadowSettings {
-        ShadowSettings {
-            resolution: self.shadow_res,
-            pcf_taps: self.pcf,
-            from_angular_radius: self.pcf_from_radius == Switch::On,
-        }
-    }
-
-    pub fn lights_indirect(&self, mode: DecomposeMode) -> bool {
-        match self.lights_indirect {
-            Some(s) => s == Switch::On,
-            None => mode == DecomposeMode::Consistent,
-        }
-    }
-}
+use runtime::render::{GpuContext, Renderer};
+use runtime::{DecomposeMode, EnvironmentLighting};
+use std::path::PathBuf;
 
 #[derive(Args)]
 pub struct RenderArgs {
@@ -80,10 +31,10 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub size: ImageSizeArgs,
     /// Camera position "x,y,z" (default: the scene's).
-    #[arg(long, value_parser = parse_vec3_arg, allow_hyphen_values = true)]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub camera_position: Option<glam::Vec3>,
     /// Camera target "x,y,z" (default: the scene's).
-    #[arg(long, value_parser = parse_vec3_arg, allow_hyphen_values = true)]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub camera_target: Option<glam::Vec3>,
     /// Vertical field of view in degrees (default: the scene's).
     #[arg(long)]
@@ -99,67 +50,6 @@ pub struct RenderArgs {
     pub exr: Option<PathBuf>,
 }
 
-fn parse_vec3_arg(text: &str) -> Result<glam::Vec3, String> {
-    parse_vec3(text)
-}
-
-/// A vector written "x,y,z".
-pub fn parse_vec3(text: &str) -> Result<glam::Vec3, String> {
-    let parts: Vec<f32> = text
-        .split(',')
-        .map(|p| p.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("expected \"x,y,z\", got {text:?}"))?;
-    match parts[..] {
-        [x, y, z] => Ok(glam::Vec3::new(x, y, z)),
-        _ => Err(format!("expected three numbers \"x,y,z\", got {text:?}")),
-    }
-}
-
-/// Reads the scene's bake, refusing one of another mesh, or one whose SH order is below the
-/// lighting order asked (a lower lighting order than the bake's just drops bands).
-pub fn load_bake(scene: &Scene, path: &Path, order: Option<usize>) -> anyhow::Result<Transfer> {
-    let transfer = bakefile::read_for_mesh(path, &scene.geometry.content_hash())
-        .context("cannot use the bake")?;
-    if let Some(order) = order.filter(|o| *o > transfer.settings.order || *o == 0) {
-        anyhow::bail!(
-            "{} was baked at SH order {}, but order {order} was asked; re-bake with \
-             `hprt bake {} --order {order}` or ask for an order from 1 to {}",
-            path.display(),
-            transfer.settings.order,
-            scene.path.display(),
-            transfer.settings.order
-        );
-    }
-    Ok(transfer)
-}
-
-/// The lighting of `mode` for a map: its decomposition and its plain projection.
-pub struct MapLighting {
-    pub decomposition: Decomposition,
-    pub projection: precompute::sh::ShCoeffs<precompute::Rgb>,
-    pub decomposition_ms: f64,
-}
-
-pub fn decompose_map(
-    map: &precompute::envmap::EnvMap,
-    rotation_deg: f32,
-    settings: DecomposeSettings,
-) -> anyhow::Result<MapLighting> {
-    let mut decomposer = Decomposer::new(settings.clone())
-        .map_err(|m| anyhow::anyhow!("invalid decomposition settings: {m}"))?;
-    let cube = CubeSource::new(map, settings.face_size).cube(rotation_deg.to_radians());
-    let start = std::time::Instant::now();
-    let decomposition = decomposer.decompose(&cube);
-    let decomposition_ms = start.elapsed().as_secs_f64() * 1e3;
-    let projection = decomposer.project(&cube);
-    Ok(MapLighting {
-        decomposition,
-        projection,
-        decomposition_ms,
-    })
-}
-
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let transfer = load_bake(&scene, &args.bake, args.decompose.order)?;
@@ -168,9 +58,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     camera.position = args.camera_position.unwrap_or(camera.position);
     camera.target = args.camera_target.unwrap_or(camera.target);
     camera.fov_y_deg = args.fov.unwrap_or(camera.fov_y_deg);
-    camera
-        .validate()
-        .map_err(|m| anyhow::anyhow!("invalid camera or image size: {m}"))?;
+    camera.validate()?;
     let output = AtomicOutput::create(&args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     let exr_output = match &args.exr {
@@ -182,13 +70,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let settings = args
         .decompose
         .settings(args.decompose_mode, transfer.settings.order);
-    let lighting = decompose_map(&env.loaded.map, env.rotation_deg, settings)?;
-    let frame = FrameLighting::for_mode(
-        args.render.mode,
-        &lighting.projection,
-        &lighting.decomposition,
-        args.render.lights_indirect(args.decompose_mode),
-    );
+    let mut lighting = EnvironmentLighting::new(&env.loaded.map, settings)?;
+    lighting.set_rotation(env.rotation_deg);
+    let frame = lighting.frame(args.render.mode, args.render.lights_indirect());
     let gpu = GpuContext::headless(args.render.backend)?;
     println!("adapter: {}", gpu.description());
     let mut renderer = Renderer::new(
@@ -199,7 +83,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         args.render.shadow_settings(),
     )?;
     renderer.set_environment(&env.loaded.map, env.rotation_deg);
-    renderer.set_lighting(&frame)?;
+    renderer.set_lighting(&frame.lighting)?;
     renderer.render()?;
     let image: RgbImageF32 = renderer.read_back()?;
     let exposure = args
@@ -219,10 +103,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         exr.commit(&bytes).context("cannot write the EXR")?;
     }
     println!(
-        "{} mode, {} light(s), decomposition {:.2} ms; wrote {}",
+        "{} mode, {} light(s), {} {:.2} ms; wrote {}",
         args.render.mode.name(),
-        frame.lights.len(),
-        lighting.decomposition_ms,
+        frame.lighting.lights.len(),
+        if args.render.mode.uses_lights() {
+            "decomposition"
+        } else {
+            "projection"
+        },
+        frame.ms,
         args.output.display()
     );
     Ok(())

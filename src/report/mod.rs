@@ -8,6 +8,9 @@ mod html;
 pub mod stats;
 
 use crate::bake_cache::{self, cache_dir};
+use crate::cli::ReportOptions;
+use crate::environment::{default_exposure, load_map, scene_rotation};
+use crate::support::{TerminalProgress, median};
 use anyhow::Context;
 use figures::Curve;
 use precompute::atomic_file::write_atomic;
@@ -19,7 +22,7 @@ use precompute::image_io::{RgbImageF32, read_exr, write_exr, write_png};
 use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
 use precompute::scene::Scene;
 use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
-use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer};
+use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
 use stats::{ErrorStats, Masks, error_stats};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -191,7 +194,7 @@ fn reference_images(
     let start = Instant::now();
     let bvh = SceneBvh::build(&scene.geometry.mesh);
     let light = EnvironmentLight::new(map, rotation_deg);
-    let progress = crate::commands::progress_bar(camera.height as u64, "reference rows");
+    let progress = TerminalProgress::new("reference rows");
     let image = reference::render(&scene.geometry, &bvh, &light, camera, settings, &progress);
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let (w, h) = (camera.width as usize, camera.height as usize);
@@ -223,7 +226,7 @@ fn render_timed(
         renderer.wait();
         times.push(start.elapsed().as_secs_f64() * 1e3);
     }
-    Ok((image, crate::commands::bench::median(times)))
+    Ok((image, median(times)))
 }
 
 fn map_name(path: &Path) -> String {
@@ -240,50 +243,25 @@ struct MapJob<'a> {
     out: &'a Path,
 }
 
-/// A map's lighting for each method, from its cube map (resampled once).
-struct LightingSource {
-    cube: runtime::CubeMap,
+/// The lighting of `method` at Weber `threshold` (each mode's own defaults otherwise), its
+/// number of lights and the decomposition (or projection) time in milliseconds.
+fn method_lighting(
+    lighting: &mut EnvironmentLighting,
     order: usize,
-}
-
-impl LightingSource {
-    /// The lighting of `method` at Weber `threshold`, its number of lights and the
-    /// decomposition (or projection) time in milliseconds.
-    fn lighting(
-        &self,
-        method: Method,
-        threshold: f32,
-    ) -> anyhow::Result<(FrameLighting, usize, f64)> {
-        let defaults = DecomposeSettings::default();
-        let mode = match method {
-            Method::Prt => defaults.mode,
-            Method::Hybrid(mode) => mode,
-        };
-        let settings = DecomposeSettings {
-            mode,
-            order: self.order,
-            threshold,
-            radius_deg: DecomposeSettings::default_radius(mode, defaults.smoothing_deg),
-            ..defaults
-        };
-        let mut decomposer = Decomposer::new(settings).map_err(anyhow::Error::msg)?;
-        let start = Instant::now();
-        Ok(match method {
-            Method::Prt => {
-                let sh = decomposer.project(&self.cube);
-                let ms = start.elapsed().as_secs_f64() * 1e3;
-                (FrameLighting::prt(sh), 0, ms)
-            }
-            Method::Hybrid(mode) => {
-                let d = decomposer.decompose(&self.cube);
-                let ms = start.elapsed().as_secs_f64() * 1e3;
-                // The consistent mode's lights carry their bounce light; the thesis' do not.
-                let indirect = mode == DecomposeMode::Consistent;
-                let lighting = FrameLighting::for_mode(RenderMode::Hybrid, &d.sh, &d, indirect);
-                (lighting, d.lights.len(), ms)
-            }
-        })
-    }
+    method: Method,
+    threshold: f32,
+) -> anyhow::Result<(FrameLighting, usize, f64)> {
+    let (mode, render_mode) = match method {
+        Method::Prt => (DecomposeMode::Consistent, RenderMode::Prt),
+        Method::Hybrid(mode) => (mode, RenderMode::Hybrid),
+    };
+    lighting.set_settings(DecomposeSettings {
+        threshold,
+        ..DecomposeSettings::for_mode(mode, order)
+    })?;
+    let frame = lighting.frame(render_mode, None);
+    let lights = frame.lighting.lights.len();
+    Ok((frame.lighting, lights, frame.ms))
 }
 
 /// The reference's images, written into the map's folder.
@@ -327,13 +305,9 @@ fn write_heat_maps(
 /// One map's section; an error is reported as a failed map by the caller.
 fn report_map(job: &mut MapJob, env: &Path) -> anyhow::Result<MapReport> {
     let name = map_name(env);
-    let map = crate::commands::decompose::load_map(env, None)?.map;
-    let rotation = job
-        .scene
-        .environment
-        .as_ref()
-        .map_or(0.0, |e| e.rotation_deg);
-    let exposure = crate::commands::default_exposure(&map);
+    let map = load_map(env, None)?.map;
+    let rotation = scene_rotation(job.scene, None);
+    let exposure = default_exposure(&map);
     let dir = job.out.join(&name);
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
 
@@ -362,16 +336,15 @@ fn report_map(job: &mut MapJob, env: &Path) -> anyhow::Result<MapReport> {
     let masks = Masks::new(&reference.coverage, &reference.visibility);
 
     job.renderer.set_environment(&map, rotation);
-    let lighting = LightingSource {
-        cube: CubeSource::new(&map, DecomposeSettings::default().face_size)
-            .cube(rotation.to_radians()),
-        order: job.renderer.order(),
-    };
+    let order = job.renderer.order();
+    let mut lighting = EnvironmentLighting::new(&map, DecomposeSettings::default())?;
+    lighting.set_rotation(rotation);
     let default_threshold = DecomposeSettings::default().threshold;
     let mut methods = Vec::new();
     let mut images = Vec::new();
     for method in Method::ALL {
-        let (frame, lights, decomposition_ms) = lighting.lighting(method, default_threshold)?;
+        let (frame, lights, decomposition_ms) =
+            method_lighting(&mut lighting, order, method, default_threshold)?;
         let (image, frame_ms) = render_timed(job.renderer, &frame, job.settings.frames)?;
         write_exr(&dir.join(format!("{}.exr", method.file_stem())), &image)?;
         write_png(
@@ -396,7 +369,7 @@ fn report_map(job: &mut MapJob, env: &Path) -> anyhow::Result<MapReport> {
     for method in &Method::ALL[1..] {
         let mut points = Vec::new();
         for &threshold in &job.settings.thresholds {
-            let (frame, lights, _) = lighting.lighting(*method, threshold)?;
+            let (frame, lights, _) = method_lighting(&mut lighting, order, *method, threshold)?;
             job.renderer.set_lighting(&frame)?;
             job.renderer.render()?;
             let image = job.renderer.read_back()?;
@@ -443,9 +416,7 @@ pub fn run_report(
 ) -> anyhow::Result<Report> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let camera = scene.camera.with_size(settings.width, settings.height);
-    camera
-        .validate()
-        .map_err(|m| anyhow::anyhow!("invalid image size: {m}"))?;
+    camera.validate()?;
     let gpu = GpuContext::headless(settings.backend)?;
     println!("adapter: {}", gpu.description());
     let mut renderer = Renderer::new(
@@ -557,23 +528,62 @@ fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
     writer.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
 }
 
-/// Uses `bake` if given, else the cached bake of the scene's settings, baking it if missing.
-pub fn bake_for(scene: &Scene, bake: Option<&Path>) -> anyhow::Result<(PathBuf, Transfer)> {
-    if let Some(path) = bake {
-        return Ok((
-            path.to_owned(),
-            crate::commands::render::load_bake(scene, path, None)?,
-        ));
+/// Checks the options, bakes (or reuses) the transfer, writes the report and prints a summary.
+pub fn write_report(
+    scene: &Scene,
+    envs: &[PathBuf],
+    options: &ReportOptions,
+    output: &Path,
+) -> anyhow::Result<()> {
+    for t in &options.thresholds {
+        anyhow::ensure!(
+            (0.0..=1.0).contains(t),
+            "--thresholds: {t} is outside [0, 1]"
+        );
     }
-    if let Some((path, transfer)) = bake_cache::load_cached(scene, &scene.bake) {
-        println!("using the cached bake {}", path.display());
-        return Ok((path, transfer));
+    anyhow::ensure!(!envs.is_empty(), "no environment maps to report on");
+    let (bake_path, transfer) = bake_cache::bake_for(scene, options.bake.as_deref())?;
+    let camera = options.size.camera(scene)?;
+    let settings = ReportSettings {
+        width: camera.width,
+        height: camera.height,
+        spp: options.spp,
+        bounces: options.bounces.unwrap_or(transfer.settings.bounces),
+        seed: options.seed,
+        thresholds: options.thresholds.clone(),
+        frames: options.frames as usize,
+        backend: options.backend,
+    };
+    let report = run_report(scene, &transfer, &bake_path, envs, &settings, output)?;
+    println!();
+    println!(
+        "{:<12} {:<18} {:>8} {:>8} {:>8} {:>6}",
+        "map", "method", "mean", "shadow", "rel.rmse", "lights"
+    );
+    for map in &report.maps {
+        if map.methods.is_empty() {
+            println!("{:<12} failed", map.name);
+        }
+        for m in &map.methods {
+            println!(
+                "{:<12} {:<18} {:>8.4} {:>8.4} {:>8.4} {:>6}",
+                map.name,
+                m.method,
+                m.stats.mean,
+                m.stats.shadow_mean,
+                m.stats.relative_rmse,
+                m.lights
+            );
+        }
     }
-    println!("baking {} into the cache", scene.name);
-    let vertices = scene.geometry.mesh.vertex_count() as u64;
-    let progress = crate::commands::progress_bar(vertices, "baking");
-    let (path, transfer, stats) = bake_cache::bake_into_cache(scene, &scene.bake, &progress)?;
-    crate::commands::bake::print_stats(&stats);
-    println!("wrote {}", path.display());
-    Ok((path, transfer))
+    println!("\nwrote {}", output.join("report.html").display());
+    let failed = report
+        .maps
+        .iter()
+        .filter(|m| m.status == MapStatus::Failed)
+        .count();
+    if failed == report.maps.len() {
+        anyhow::bail!("every map failed; see the messages above");
+    }
+    Ok(())
 }

@@ -8,15 +8,17 @@ mod ui;
 mod window;
 
 use crate::bake_cache;
-use crate::commands::{default_exposure, load_scene};
+use crate::environment::{default_exposure, maps_beside, scene_rotation};
+use crate::support::{load_scene, median};
 use anyhow::Context;
 use clap::Args;
 use orbit::Orbit;
 use precompute::bake::Transfer;
-use precompute::envmap::EnvMap;
+use precompute::progress::SharedProgress;
 use precompute::scene::Scene;
-use runtime::render::{Backend, FrameLighting, RenderMode, Renderer, ShadowSettings};
-use runtime::{CubeMap, CubeSource, DecomposeMode, Decomposer, Decomposition};
+use runtime::lighting::lights_indirect_default;
+use runtime::render::{Backend, RenderMode, Renderer, ShadowSettings};
+use runtime::{DecomposeMode, Decomposition, EnvironmentLighting};
 use settings::ViewSettings;
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -54,15 +56,8 @@ pub struct ViewArgs {
 
 /// A bake running in the background for the viewer.
 struct BakeJob {
-    progress: indicatif::ProgressBar,
+    progress: Arc<SharedProgress>,
     result: std::sync::mpsc::Receiver<anyhow::Result<Transfer>>,
-}
-
-/// The environment in use.
-struct Environment {
-    map: EnvMap,
-    source: CubeSource,
-    cube: CubeMap,
 }
 
 /// Everything the UI shows about the last decomposition.
@@ -88,8 +83,7 @@ pub struct App {
     lit_for: Option<(ViewSettings, usize)>,
     env_path_text: String,
     env_choices: Vec<PathBuf>,
-    environment: Option<Environment>,
-    decomposer: Option<(runtime::DecomposeSettings, Decomposer)>,
+    environment: Option<EnvironmentLighting>,
     orbit: Orbit,
     initial_orbit: Orbit,
     window: Option<Arc<Window>>,
@@ -129,7 +123,7 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
     let bake_settings = scene.bake;
     let (bake_path, transfer) = match &args.bake {
         Some(path) => {
-            let transfer = crate::commands::render::load_bake(&scene, path, None)?;
+            let transfer = bake_cache::load_bake(&scene, path, None)?;
             (path.clone(), Some(Arc::new(transfer)))
         }
         None => match bake_cache::load_cached(&scene, &bake_settings) {
@@ -146,7 +140,7 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
             scene.path.display()
         ),
     };
-    let rotation = scene.environment.as_ref().map_or(0.0, |e| e.rotation_deg);
+    let rotation = scene_rotation(&scene, None);
     let script = match &args.script {
         Some(path) => {
             let text = std::fs::read_to_string(path)
@@ -155,7 +149,7 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         }
         None => VecDeque::new(),
     };
-    let env_choices = crate::commands::maps_beside(&env);
+    let env_choices = maps_beside(&env);
     let order = transfer
         .as_ref()
         .map_or(bake_settings.order, |t| t.settings.order);
@@ -170,7 +164,7 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         threshold: runtime::DecomposeSettings::default().threshold,
         order,
         shadow: ShadowSettings::default(),
-        lights_indirect: true,
+        lights_indirect: lights_indirect_default(DecomposeMode::Consistent),
         exposure: 1.0,
     };
     let event_loop = EventLoop::new().map_err(|e| {
@@ -190,7 +184,6 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         lit_for: None,
         env_choices,
         environment: None,
-        decomposer: None,
         orbit,
         initial_orbit: orbit,
         window: None,
@@ -222,48 +215,50 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
 
 impl App {
     fn load_environment(&mut self) {
-        match precompute::envmap::load(&self.settings.env, None) {
-            Ok(loaded) => {
-                let source =
-                    CubeSource::new(&loaded.map, runtime::DecomposeSettings::default().face_size);
-                let cube = source.cube(self.settings.rotation_deg.to_radians());
-                if self.settings.exposure == 1.0 && self.environment.is_none() {
-                    self.settings.exposure = default_exposure(&loaded.map);
-                }
-                self.environment = Some(Environment {
-                    map: loaded.map,
-                    source,
-                    cube,
-                });
-                self.lit_for = None;
-                self.thumbnail_for = None;
-                self.stats.message = if loaded.sanitized > 0 {
-                    format!(
-                        "{} texels with negative or invalid radiance set to 0",
-                        loaded.sanitized
-                    )
-                } else {
-                    String::new()
-                };
-                if let Some(r) = self.renderer.as_mut() {
-                    let map = &self.environment.as_ref().expect("just set").map;
-                    r.set_environment(map, self.settings.rotation_deg);
-                    if let Some(gpu) = self.gpu.as_mut() {
-                        gpu.renderer_changed();
-                    }
-                }
+        let loaded = match precompute::envmap::load(&self.settings.env, None) {
+            Ok(loaded) => loaded,
+            Err(e) => {
+                self.stats.message = format!("cannot load the map: {e}");
+                return;
             }
-            Err(e) => self.stats.message = format!("cannot load the map: {e}"),
+        };
+        let lighting =
+            match EnvironmentLighting::new(&loaded.map, self.settings.decompose_settings()) {
+                Ok(lighting) => lighting,
+                Err(e) => {
+                    self.stats.message = format!("cannot light the scene with the map: {e}");
+                    return;
+                }
+            };
+        if self.settings.exposure == 1.0 && self.environment.is_none() {
+            self.settings.exposure = default_exposure(&loaded.map);
         }
+        self.lit_for = None;
+        self.thumbnail_for = None;
+        self.stats.message = if loaded.sanitized > 0 {
+            format!(
+                "{} texels with negative or invalid radiance set to 0",
+                loaded.sanitized
+            )
+        } else {
+            String::new()
+        };
+        if let Some(r) = self.renderer.as_mut() {
+            r.set_environment(lighting.map(), self.settings.rotation_deg);
+            if let Some(gpu) = self.gpu.as_mut() {
+                gpu.renderer_changed();
+            }
+        }
+        self.environment = Some(lighting);
     }
 
     fn start_bake(&mut self) {
         let scene = self.scene.clone();
-        let progress = indicatif::ProgressBar::hidden();
+        let progress = Arc::new(SharedProgress::default());
         let bar = progress.clone();
         let (sender, receiver) = std::sync::mpsc::channel();
         std::thread::spawn(move || {
-            let result = bake_cache::bake_into_cache(&scene, &scene.bake, &bar)
+            let result = bake_cache::bake_into_cache(&scene, &scene.bake, bar.as_ref())
                 .map(|(_, transfer, _)| transfer);
             let _ = sender.send(result);
         });
@@ -311,30 +306,16 @@ impl App {
         if !needs {
             return Ok(());
         }
-        let wanted = self.settings.decompose_settings();
-        if self.decomposer.as_ref().is_none_or(|(s, _)| *s != wanted) {
-            self.decomposer = Some((
-                wanted.clone(),
-                Decomposer::new(wanted).map_err(anyhow::Error::msg)?,
-            ));
-        }
-        let (_, decomposer) = self.decomposer.as_mut().expect("just set");
-        let start = Instant::now();
-        env.source
-            .cube_into(self.settings.rotation_deg.to_radians(), &mut env.cube);
-        let decomposition = decomposer.decompose(&env.cube);
-        let lighting = if self.settings.mode == RenderMode::Prt {
-            FrameLighting::prt(decomposer.project(&env.cube))
-        } else {
-            FrameLighting::for_mode(
-                self.settings.mode,
-                &decomposition.sh,
-                &decomposition,
-                self.settings.lights_indirect,
-            )
+        env.set_settings(self.settings.decompose_settings())?;
+        env.set_rotation(self.settings.rotation_deg);
+        let frame = env.frame(self.settings.mode, Some(self.settings.lights_indirect));
+        self.stats.decomposition_ms = frame.ms;
+        // The panel shows the lights in every mode, plain PRT included.
+        let decomposition = match frame.decomposition {
+            Some(d) => d,
+            None => env.decompose(),
         };
-        self.stats.decomposition_ms = start.elapsed().as_secs_f64() * 1e3;
-        renderer.set_lighting(&lighting)?;
+        renderer.set_lighting(&frame.lighting)?;
         renderer.set_environment_rotation(self.settings.rotation_deg);
         self.stats.decomposition = Some(decomposition);
         self.lit_for = Some(key);
@@ -357,7 +338,7 @@ impl App {
             self.settings.shadow,
         )?;
         if let Some(env) = &self.environment {
-            renderer.set_environment(&env.map, self.settings.rotation_deg);
+            renderer.set_environment(env.map(), self.settings.rotation_deg);
         }
         gpu.renderer_changed();
         self.renderer = Some(renderer);
@@ -435,7 +416,7 @@ impl App {
             .as_ref()
             .context("nothing rendered yet (no bake)")?;
         let image = renderer.read_back()?;
-        let rgb = window::display_bytes(&image, self.settings.exposure);
+        let rgb = precompute::image_io::to_display_rgb8(&image, self.settings.exposure);
         precompute::image_io::write_png_rgb8(path, image.width, image.height, &rgb)?;
         self.stats.message = format!("saved {}", path.display());
         Ok(())
@@ -457,11 +438,7 @@ impl App {
 
     fn state_json(&self) -> serde_json::Value {
         let times: Vec<f64> = self.stats.frame_ms.iter().copied().collect();
-        let frame_ms = if times.is_empty() {
-            0.0
-        } else {
-            crate::commands::bench::median(times)
-        };
+        let frame_ms = if times.is_empty() { 0.0 } else { median(times) };
         let lights: Vec<f32> = self
             .stats
             .decomposition
@@ -593,12 +570,10 @@ impl ApplicationHandler for App {
                     .create_window(attributes)
                     .context("cannot create a window")?,
             );
-            let mut descriptor = wgpu::InstanceDescriptor::new_with_display_handle(Box::new(
+            let descriptor = wgpu::InstanceDescriptor::new_with_display_handle(Box::new(
                 event_loop.owned_display_handle(),
             ));
-            descriptor.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL;
-            let instance = wgpu::Instance::new(descriptor);
-            let gpu = WindowGpu::new(window.clone(), self.backend, instance)?;
+            let gpu = WindowGpu::new(window.clone(), self.backend, descriptor)?;
             self.stats.adapter = gpu.gpu.description().to_string();
             println!("adapter: {}", self.stats.adapter);
             self.egui_state = Some(egui_winit::State::new(

@@ -45,8 +45,7 @@ fn bake_section(app: &mut App, ui: &mut egui::Ui) {
     heading(app, ui, "Bake");
     match &app.bake_job {
         Some(job) => {
-            let total = job.progress.length().unwrap_or(1).max(1);
-            let done = job.progress.position() as f32 / total as f32;
+            let done = job.progress.fraction();
             ui.label("baking the scene's transfer…");
             ui.add(egui::ProgressBar::new(done).show_percentage());
         }
@@ -130,7 +129,7 @@ fn thumbnail(app: &mut App, ui: &mut egui::Ui) {
                     (i as f32 + 0.5) / THUMBNAIL[0] as f32,
                     (j as f32 + 0.5) / THUMBNAIL[1] as f32,
                 );
-                let c = tonemap(env.map.radiance(rotate_y(w, -rotation)), exposure);
+                let c = tonemap(env.map().radiance(rotate_y(w, -rotation)), exposure);
                 rgb.extend(c.to_array().map(|x| (srgb_encode(x) * 255.0) as u8));
             }
         }
@@ -235,7 +234,7 @@ fn lights_section(app: &mut App, ui: &mut egui::Ui) {
     heading(app, ui, "Lights");
     let frame_ms: Vec<f64> = app.stats.frame_ms.iter().copied().collect();
     if !frame_ms.is_empty() {
-        let ms = crate::commands::bench::median(frame_ms);
+        let ms = crate::support::median(frame_ms);
         ui.label(format!("frame {ms:.1} ms ({:.1} fps)", 1000.0 / ms));
     }
     ui.label(format!(

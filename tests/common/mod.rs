@@ -73,7 +73,7 @@ pub fn bake_quietly(
     bvh: &precompute::bvh::SceneBvh,
     settings: &precompute::bake::BakeSettings,
 ) -> precompute::bake::Transfer {
-    let progress = indicatif::ProgressBar::hidden();
+    let progress = precompute::progress::NoProgress;
     precompute::bake::bake(geometry, bvh, settings, &progress)
         .expect("valid bake settings")
         .0

@@ -17,60 +17,12 @@ pub use inside::{VertexNeighbours, fill_inside};
 pub use transfer::TransferVectors;
 pub use visibility::INSIDE_BACKFACE_FRACTION;
 
+pub use crate::bake_settings::{BakeSettings, MAX_BOUNCES, MAX_SAMPLES};
 use crate::bvh::SceneBvh;
+use crate::progress::Progress;
 use crate::scene::SceneMesh;
-use crate::sh;
-use indicatif::ProgressBar;
+use crate::settings::InvalidSettings;
 use std::time::Instant;
-
-/// Settings of a bake; a scene file's `[bake]` table gives the defaults.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct BakeSettings {
-    /// SH order (bands `0..order`).
-    pub order: usize,
-    /// Hemisphere samples (rays) per vertex.
-    pub samples: u32,
-    /// Indirect bounces of the Neumann series (0 = shadowed direct lighting only).
-    pub bounces: u32,
-    /// Seed of the per-vertex sample rotations.
-    pub seed: u64,
-}
-
-impl Default for BakeSettings {
-    fn default() -> Self {
-        Self {
-            order: 5,
-            samples: 1024,
-            bounces: 3,
-            seed: 0,
-        }
-    }
-}
-
-/// Most rays per vertex a bake accepts.
-pub const MAX_SAMPLES: u32 = 1 << 20;
-/// Most bounces a bake accepts.
-pub const MAX_BOUNCES: u32 = 256;
-
-impl BakeSettings {
-    pub fn validate(&self) -> Result<(), String> {
-        sh::check_order(self.order).map_err(|e| e.to_string())?;
-        if self.samples == 0 || self.samples > MAX_SAMPLES {
-            return Err(format!(
-                "samples must be between 1 and {MAX_SAMPLES}, got {}",
-                self.samples
-            ));
-        }
-        if self.bounces > MAX_BOUNCES {
-            return Err(format!(
-                "bounces must be at most {MAX_BOUNCES}, got {}",
-                self.bounces
-            ));
-        }
-        Ok(())
-    }
-}
 
 /// Direct and interreflected transfer of every vertex.
 #[derive(Debug, Clone, PartialEq)]
@@ -150,11 +102,11 @@ pub fn trace(
     geometry: &SceneMesh,
     bvh: &SceneBvh,
     settings: &BakeSettings,
-    progress: &ProgressBar,
-) -> Result<TracedScene, String> {
+    progress: &dyn Progress,
+) -> Result<TracedScene, InvalidSettings> {
     settings.validate()?;
     let start = Instant::now();
-    progress.set_length(geometry.mesh.vertex_count() as u64);
+    progress.start(geometry.mesh.vertex_count() as u64);
     let traced = visibility::trace_vertices(geometry, bvh, settings, progress);
     let mut direct = traced.direct_transfer(&geometry.albedo, settings.order);
     let neighbours = VertexNeighbours::new(&geometry.mesh);
@@ -169,13 +121,13 @@ pub fn trace(
 }
 
 /// Bakes the transfer of every vertex of `geometry`. `progress` counts vertices of the
-/// tracing pass (pass `ProgressBar::hidden()` for none).
+/// tracing pass (pass [`crate::progress::NoProgress`] for none).
 pub fn bake(
     geometry: &SceneMesh,
     bvh: &SceneBvh,
     settings: &BakeSettings,
-    progress: &ProgressBar,
-) -> Result<(Transfer, BakeStats), String> {
+    progress: &dyn Progress,
+) -> Result<(Transfer, BakeStats), InvalidSettings> {
     let start = Instant::now();
     let traced = trace(geometry, bvh, settings, progress)?;
     let vertex_count = geometry.mesh.vertex_count();
@@ -195,12 +147,12 @@ pub fn bake(
         stats
             .bounce_seconds
             .push(bounce_start.elapsed().as_secs_f64());
-        progress.set_message(format!("bounce {}/{}", bounce + 1, settings.bounces));
+        progress.status(&format!("bounce {}/{}", bounce + 1, settings.bounces));
         indirect = sum;
         bounce_start = Instant::now();
     }
     stats.total_seconds = start.elapsed().as_secs_f64();
-    progress.finish_and_clear();
+    progress.finish();
     Ok((
         Transfer {
             settings: *settings,

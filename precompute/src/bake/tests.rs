@@ -21,7 +21,7 @@ fn scene_of(mesh: &TriangleMesh, albedo: Rgb) -> SceneMesh {
 
 fn run(geometry: &SceneMesh, settings: BakeSettings) -> (Transfer, BakeStats) {
     let bvh = SceneBvh::build(&geometry.mesh);
-    bake(geometry, &bvh, &settings, &ProgressBar::hidden()).unwrap()
+    bake(geometry, &bvh, &settings, &crate::progress::NoProgress).unwrap()
 }
 
 /// An open box (five inward-facing walls, no lid): a concave mesh where every vertex is
@@ -183,6 +183,6 @@ fn rejects_bad_settings() {
             ..Default::default()
         },
     ] {
-        assert!(bake(&geometry, &bvh, &settings, &ProgressBar::hidden()).is_err());
+        assert!(bake(&geometry, &bvh, &settings, &crate::progress::NoProgress).is_err());
     }
 }

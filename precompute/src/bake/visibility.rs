@@ -2,15 +2,15 @@
 
 use super::bounce::OperatorBlock;
 use super::{BakeSettings, InterreflectionOperator, RAY_OFFSET_FRACTION, TransferVectors};
-use crate::bvh::SceneBvh;
+use crate::bvh::{SceneBvh, Skip};
 use crate::color::Rgb;
+use crate::progress::Progress;
 use crate::sampling::{
     Frame, cosine_hemisphere, cranley_patterson, hammersley, hash_to_unit2, mix64,
 };
 use crate::scene::SceneMesh;
 use crate::sh::{ShBasis, num_coeffs};
 use glam::{Vec2, Vec3};
-use indicatif::ProgressBar;
 use rayon::prelude::*;
 
 /// What the tracing pass found.
@@ -87,7 +87,7 @@ pub(super) fn trace_vertices(
     geometry: &SceneMesh,
     bvh: &SceneBvh,
     settings: &BakeSettings,
-    progress: &ProgressBar,
+    progress: &dyn Progress,
 ) -> TracedVertices {
     let mesh = &geometry.mesh;
     let order = settings.order;
@@ -127,7 +127,13 @@ pub(super) fn trace_vertices(
                     for u in &samples {
                         let direction =
                             frame.to_world(cosine_hemisphere(cranley_patterson(*u, rotation)));
-                        match bvh.intersect_from_vertex(v as u32, origin, direction, 0.0) {
+                        match bvh.closest_hit(
+                            origin,
+                            direction,
+                            0.0,
+                            f32::INFINITY,
+                            Skip::VertexTriangles(v as u32),
+                        ) {
                             None => {
                                 accumulate_basis(&basis, direction, &mut scratch.basis, visibility)
                             }
@@ -157,7 +163,7 @@ pub(super) fn trace_vertices(
                     chunk.operator.push_sorted_row(&scratch.hits);
                 }
                 chunk.operator.shrink_to_fit();
-                progress.inc(vertices.len() as u64);
+                progress.advance(vertices.len() as u64);
                 chunk
             },
         )

@@ -5,51 +5,27 @@ use super::cube::{ALL_FACES, CubeFace, horizontal_cross_cell, vertical_cross_cel
 use crate::color::Rgb;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
-use std::str::FromStr;
 
-/// How the pixels of an input image map to directions.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Layout {
-    /// Latitude-longitude, 2:1.
-    Equirect,
-    /// Horizontal cube cross, 4:3.
-    CrossHorizontal,
-    /// Vertical cube cross, 3:4.
-    CrossVertical,
-    /// Six square face files; the path contains `{face}`, replaced by px, nx, py, ny, pz, nz.
-    Faces,
-    /// Debevec's angular "light probe" map, 1:1.
-    Probe,
-}
-
-impl FromStr for Layout {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "equirect" => Ok(Layout::Equirect),
-            "cross-horizontal" => Ok(Layout::CrossHorizontal),
-            "cross-vertical" => Ok(Layout::CrossVertical),
-            "faces" => Ok(Layout::Faces),
-            "probe" => Ok(Layout::Probe),
-            _ => Err(format!(
-                "unknown layout {s:?} (equirect, cross-horizontal, cross-vertical, faces, probe)"
-            )),
-        }
+crate::named_enum! {
+    /// How the pixels of an input image map to directions.
+    #[derive(serde::Serialize, serde::Deserialize)]
+    #[serde(rename_all = "kebab-case")]
+    pub enum Layout ("layout") {
+        /// Latitude-longitude, 2:1.
+        Equirect = "equirect",
+        /// Horizontal cube cross, 4:3.
+        CrossHorizontal = "cross-horizontal",
+        /// Vertical cube cross, 3:4.
+        CrossVertical = "cross-vertical",
+        /// Six square face files; the path contains `{face}`, replaced by px, nx, py, ny, pz,
+        /// nz.
+        Faces = "faces",
+        /// Debevec's angular "light probe" map, 1:1.
+        Probe = "probe",
     }
 }
 
 impl Layout {
-    pub fn name(self) -> &'static str {
-        match self {
-            Layout::Equirect => "equirect",
-            Layout::CrossHorizontal => "cross-horizontal",
-            Layout::CrossVertical => "cross-vertical",
-            Layout::Faces => "faces",
-            Layout::Probe => "probe",
-        }
-    }
-
     /// The layout implied by an image's aspect ratio.
     pub fn from_aspect(width: usize, height: usize) -> Option<Layout> {
         match (width, height) {

@@ -3,21 +3,13 @@
 
 use super::environment::EnvironmentLight;
 use crate::bake::RAY_OFFSET_FRACTION;
-use crate::bvh::{Hit, SceneBvh};
+use crate::bvh::{Hit, SceneBvh, Skip};
 use crate::color::{Rgb, luminance};
 use crate::sampling::{Frame, cosine_hemisphere};
 use crate::scene::SceneMesh;
 use glam::{Vec2, Vec3};
 use rand_core::Rng;
 use std::f32::consts::FRAC_1_PI;
-
-/// Which triangles a ray leaving a surface point must not hit: the one it leaves, or, for a
-/// ray leaving a vertex, every triangle sharing the vertex (as in the bake).
-#[derive(Debug, Clone, Copy)]
-pub enum Leaving {
-    Triangle(u32),
-    Vertex(u32),
-}
 
 /// A shading point.
 #[derive(Debug, Clone, Copy)]
@@ -28,7 +20,9 @@ pub struct SurfacePoint {
     /// Geometric normal on the front side: rays leave from this side.
     pub front_normal: Vec3,
     pub albedo: Rgb,
-    pub leaving: Leaving,
+    /// Which triangles a ray leaving the point must not hit: the one it leaves, or, for a ray
+    /// leaving a vertex, every triangle sharing the vertex (as in the bake).
+    pub leaving: Skip,
 }
 
 /// Light reaching the first shading point directly from the environment, in luminance: what
@@ -106,7 +100,7 @@ impl<'a> Integrator<'a> {
             shading_normal: normal.try_normalize().unwrap_or(front),
             front_normal: front,
             albedo,
-            leaving: Leaving::Triangle(hit.triangle),
+            leaving: Skip::Triangle(hit.triangle),
         }
     }
 
@@ -119,7 +113,7 @@ impl<'a> Integrator<'a> {
             shading_normal: normal,
             front_normal: normal,
             albedo: self.geometry.albedo[v as usize],
-            leaving: Leaving::Vertex(v),
+            leaving: Skip::VertexTriangles(v),
         }
     }
 
@@ -130,22 +124,14 @@ impl<'a> Integrator<'a> {
 
     #[inline]
     fn trace(&self, p: &SurfacePoint, w: Vec3) -> Option<Hit> {
-        let origin = self.origin(p);
-        match p.leaving {
-            Leaving::Triangle(t) => self.bvh.intersect_excluding(origin, w, 0.0, t),
-            Leaving::Vertex(v) => self.bvh.intersect_from_vertex(v, origin, w, 0.0),
-        }
+        self.bvh
+            .closest_hit(self.origin(p), w, 0.0, f32::INFINITY, p.leaving)
     }
 
     #[inline]
     fn occluded(&self, p: &SurfacePoint, w: Vec3) -> bool {
-        let origin = self.origin(p);
-        match p.leaving {
-            Leaving::Triangle(t) => self
-                .bvh
-                .occluded_excluding(origin, w, 0.0, f32::INFINITY, t),
-            Leaving::Vertex(v) => self.bvh.occluded_from_vertex(v, origin, w, 0.0),
-        }
+        self.bvh
+            .occluded(self.origin(p), w, 0.0, f32::INFINITY, p.leaving)
     }
 
     /// One estimate of the radiance leaving `start` (toward any direction: Lambertian), with

@@ -11,15 +11,15 @@ mod environment;
 mod integrator;
 
 pub use environment::EnvironmentLight;
-pub use integrator::{DirectVisibility, Integrator, Leaving, SurfacePoint};
+pub use integrator::{DirectVisibility, Integrator, SurfacePoint};
 
 use crate::bvh::SceneBvh;
 use crate::camera::Camera;
 use crate::color::Rgb;
 use crate::image_io::RgbImageF32;
+use crate::progress::Progress;
 use crate::sampling::mix64;
 use crate::scene::SceneMesh;
-use indicatif::ProgressBar;
 use rand_pcg::Pcg32;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -73,13 +73,13 @@ pub fn render(
     light: &EnvironmentLight,
     camera: &Camera,
     settings: &ReferenceSettings,
-    progress: &ProgressBar,
+    progress: &dyn Progress,
 ) -> ReferenceImage {
     let start = Instant::now();
     let (width, height) = (camera.width as usize, camera.height as usize);
     let basis = camera.basis();
     let integrator = Integrator::new(geometry, bvh, light, settings.bounces);
-    progress.set_length(height as u64);
+    progress.start(height as u64);
     let rows: Vec<RowResult> = (0..height)
         .into_par_iter()
         .map(|j| {
@@ -117,11 +117,11 @@ pub fn render(
                     1.0
                 });
             }
-            progress.inc(1);
+            progress.advance(1);
             row
         })
         .collect();
-    progress.finish_and_clear();
+    progress.finish();
     let mut pixels = Vec::with_capacity(width * height);
     let mut image = ReferenceImage {
         radiance: RgbImageF32::filled(0, 0, Rgb::ZERO),

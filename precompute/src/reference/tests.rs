@@ -40,7 +40,7 @@ fn render_simple(
         &light,
         cam,
         &ReferenceSettings { spp, bounces, seed },
-        &ProgressBar::hidden(),
+        &crate::progress::NoProgress,
     )
 }
 

@@ -23,6 +23,7 @@ use crate::cubemap::{CubeGeometry, CubeMap};
 use crate::light::DirectionalLight;
 use glam::Vec3;
 use icosphere::Icosphere;
+use precompute::settings::InvalidSettings;
 use precompute::sh::{ShCoeffs, clamped_cosine_bands};
 use precompute::{Rgb, luminance};
 use projection::{BasisTable, ShProjector};
@@ -30,40 +31,25 @@ use smoothing::GaussianSmoothing;
 use std::f32::consts::PI;
 pub use window::Window;
 
-/// How light power and the SH part are formed from the peaks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum DecomposeMode {
-    /// Exactly as the thesis: the SH part is the windowed projection of the whole map and a
-    /// light's power is `2π(1 − cos R)(λ_i − P(Ξ_i))`.
-    Thesis,
-    /// Energy-consistent: a light's power is the map's excess over the SH part inside its cap,
-    /// and the SH part is fitted to the map with that excess removed, so the two integrate to
-    /// the map's total.
-    Consistent,
-}
-
-impl std::str::FromStr for DecomposeMode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "thesis" => Ok(DecomposeMode::Thesis),
-            "consistent" => Ok(DecomposeMode::Consistent),
-            _ => Err(format!(
-                "unknown decomposition mode {s:?} (thesis, consistent)"
-            )),
-        }
+precompute::named_enum! {
+    /// How light power and the SH part are formed from the peaks.
+    #[derive(serde::Serialize, serde::Deserialize)]
+    #[serde(rename_all = "lowercase")]
+    pub enum DecomposeMode ("decomposition mode") {
+        /// Exactly as the thesis: the SH part is the windowed projection of the whole map and a
+        /// light's power is `2π(1 − cos R)(λ_i − P(Ξ_i))`.
+        Thesis = "thesis",
+        /// Energy-consistent: a light's power is the map's excess over the SH part inside its
+        /// cap, and the SH part is fitted to the map with that excess removed, so the two
+        /// integrate to the map's total.
+        Consistent = "consistent",
     }
 }
 
-impl DecomposeMode {
-    pub fn name(self) -> &'static str {
-        match self {
-            DecomposeMode::Thesis => "thesis",
-            DecomposeMode::Consistent => "consistent",
-        }
-    }
-}
+/// Settings the decomposer cannot work with.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(transparent)]
+pub struct DecomposeError(#[from] pub InvalidSettings);
 
 /// Parameters of the decomposition.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -91,50 +77,72 @@ pub struct DecomposeSettings {
     pub window: Option<Window>,
 }
 
+/// Consistent mode at order 5: `DecomposeSettings::for_mode(DecomposeMode::Consistent, 5)`.
 impl Default for DecomposeSettings {
     fn default() -> Self {
-        Self {
-            mode: DecomposeMode::Consistent,
-            order: 5,
-            face_size: 64,
-            ico_level: 4,
-            smoothing_deg: 2.0,
-            radius_deg: 8.0,
-            threshold: 0.05,
-            max_lights: 8,
-            min_contrast: 1.0,
-            window: None,
-        }
+        Self::for_mode(DecomposeMode::Consistent, 5)
     }
 }
 
 /// Most peaks considered per frame (the brightest residual maxima).
-const MAX_CANDIDATES: usize = 24;
+pub const MAX_CANDIDATES: usize = 24;
 /// Fixed-point iterations of the consistent mode's refit.
 const CONSISTENT_ITERATIONS: usize = 3;
 /// The window used to find peaks (and for the thesis' SH part).
 const DETECTION_WINDOW: Window = Window::Hanning;
 
 impl DecomposeSettings {
-    pub fn validate(&self) -> Result<(), String> {
-        precompute::sh::check_order(self.order).map_err(|e| e.to_string())?;
+    /// The defaults of `mode` at SH order `order`: every mode's rules start here.
+    pub fn for_mode(mode: DecomposeMode, order: usize) -> Self {
+        const SMOOTHING_DEG: f32 = 2.0;
+        Self {
+            mode,
+            order,
+            face_size: 64,
+            ico_level: 4,
+            smoothing_deg: SMOOTHING_DEG,
+            radius_deg: Self::default_radius(mode, SMOOTHING_DEG),
+            threshold: 0.05,
+            max_lights: 8,
+            min_contrast: 1.0,
+            window: None,
+        }
+    }
+
+    pub fn validate(&self) -> Result<(), DecomposeError> {
+        let invalid = |reason: String| {
+            Err(DecomposeError(InvalidSettings::new(
+                "decomposition settings",
+                reason,
+            )))
+        };
+        if let Err(e) = precompute::sh::check_order(self.order) {
+            return invalid(e.to_string());
+        }
         if !(4..=1024).contains(&self.face_size) {
-            return Err(format!("face size {} outside 4..=1024", self.face_size));
+            return invalid(format!("face size {} outside 4..=1024", self.face_size));
         }
         if self.ico_level > 7 {
-            return Err(format!("icosahedron level {} above 7", self.ico_level));
+            return invalid(format!("icosahedron level {} above 7", self.ico_level));
         }
         if !(self.radius_deg > 0.0 && self.radius_deg <= 45.0) {
-            return Err(format!("radius {}° outside (0, 45]", self.radius_deg));
+            return invalid(format!("radius {}° outside (0, 45]", self.radius_deg));
         }
         if !(self.smoothing_deg > 0.0 && self.smoothing_deg <= 30.0) {
-            return Err(format!("smoothing {}° outside (0, 30]", self.smoothing_deg));
+            return invalid(format!("smoothing {}° outside (0, 30]", self.smoothing_deg));
         }
         if !(0.0..=1.0).contains(&self.threshold) {
-            return Err(format!("threshold {} outside [0, 1]", self.threshold));
+            return invalid(format!("threshold {} outside [0, 1]", self.threshold));
         }
         if self.min_contrast.is_nan() || self.min_contrast < 0.0 {
-            return Err(format!("min contrast {} is negative", self.min_contrast));
+            return invalid(format!("min contrast {} is negative", self.min_contrast));
+        }
+        if self.max_lights > MAX_CANDIDATES {
+            return invalid(format!(
+                "at most {MAX_CANDIDATES} lights can be kept (the peaks considered per frame), \
+                 {} asked",
+                self.max_lights
+            ));
         }
         Ok(())
     }
@@ -227,7 +235,7 @@ pub struct Decomposer {
 }
 
 impl Decomposer {
-    pub fn new(settings: DecomposeSettings) -> Result<Self, String> {
+    pub fn new(settings: DecomposeSettings) -> Result<Self, DecomposeError> {
         settings.validate()?;
         let geometry = CubeGeometry::new(settings.face_size);
         let n = settings.face_size;
@@ -254,7 +262,12 @@ impl Decomposer {
         Ok(Self {
             analysis_map: CubeMap::uniform(a, Rgb::ZERO),
             downsample,
-            basis: precompute::sh::ShBasis::new(settings.order).map_err(|e| e.to_string())?,
+            basis: precompute::sh::ShBasis::new(settings.order).map_err(|e| {
+                DecomposeError(InvalidSettings::new(
+                    "decomposition settings",
+                    e.to_string(),
+                ))
+            })?,
             member_basis: Vec::new(),
             detection_window: DETECTION_WINDOW.factors(settings.order),
             sh_window: settings.sh_window().factors(settings.order),

@@ -118,10 +118,7 @@ fn consistent_mode_conserves_energy_and_irradiance() {
 #[test]
 fn thesis_mode_uses_the_thesis_power_formula() {
     let map = three_suns().env_map();
-    let settings = DecomposeSettings {
-        mode: DecomposeMode::Thesis,
-        ..Default::default()
-    };
+    let settings = DecomposeSettings::for_mode(DecomposeMode::Thesis, 5);
     let result = decompose(&map, 0.0, settings.clone());
     assert!(!result.lights.is_empty());
     let cap = 2.0 * PI * (1.0 - settings.radius_deg.to_radians().cos());
@@ -139,14 +136,7 @@ fn thesis_mode_uses_the_thesis_power_formula() {
 fn uniform_map_has_no_lights_and_an_exact_sh_part() {
     let map = EnvMap::uniform(256, 128, Rgb::new(0.7, 1.0, 1.3));
     for mode in [DecomposeMode::Thesis, DecomposeMode::Consistent] {
-        let result = decompose(
-            &map,
-            0.3,
-            DecomposeSettings {
-                mode,
-                ..Default::default()
-            },
-        );
+        let result = decompose(&map, 0.3, DecomposeSettings::for_mode(mode, 5));
         assert!(result.lights.is_empty(), "{mode:?}: {:?}", result.lights);
         for w in [Vec3::Y, Vec3::new(0.6, -0.3, 0.74).normalize()] {
             let value = result.sh.eval(w);
@@ -208,10 +198,7 @@ fn lights_move_continuously_in_one_degree_steps() {
     };
     let map = EnvMap::from_fn(1024, 512, 2, |w| scene.radiance(w));
     for mode in [DecomposeMode::Consistent, DecomposeMode::Thesis] {
-        let settings = DecomposeSettings {
-            mode,
-            ..Default::default()
-        };
+        let settings = DecomposeSettings::for_mode(mode, 5);
         let source = CubeSource::new(&map, settings.face_size);
         let mut decomposer = Decomposer::new(settings).unwrap();
         let mut previous: Option<Vec3> = None;
@@ -252,4 +239,28 @@ fn rejects_bad_settings() {
     ] {
         assert!(Decomposer::new(s).is_err());
     }
+}
+
+/// Each mode's defaults come from one place: thesis mode's radius keeps a point source's power
+/// (`R = √2 σ`), consistent mode's cap is 8°; `Default` is consistent mode at order 5.
+#[test]
+fn each_mode_gets_its_own_defaults() {
+    let thesis = DecomposeSettings::for_mode(DecomposeMode::Thesis, 3);
+    assert_eq!(thesis.order, 3);
+    assert!((thesis.radius_deg - std::f32::consts::SQRT_2 * thesis.smoothing_deg).abs() < 1e-6);
+    assert_eq!(thesis.sh_window(), Window::Hanning);
+    let consistent = DecomposeSettings::for_mode(DecomposeMode::Consistent, 5);
+    assert_eq!(consistent.radius_deg, 8.0);
+    assert_eq!(consistent.sh_window(), Window::None);
+    assert_eq!(consistent, DecomposeSettings::default());
+}
+
+#[test]
+fn more_lights_than_peaks_considered_is_an_error() {
+    let settings = DecomposeSettings {
+        max_lights: super::MAX_CANDIDATES + 1,
+        ..Default::default()
+    };
+    let message = Decomposer::new(settings).err().unwrap().to_string();
+    assert!(message.contains("at most 24 lights"), "{message}");
 }

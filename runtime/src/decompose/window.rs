@@ -1,39 +1,21 @@
 //! Windows that damp the ringing of a truncated SH expansion (thesis 4.3.3, "windowing").
 
-/// A band-wise window `w_l` applied to SH coefficients.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Window {
-    /// No windowing.
-    None,
-    /// Hann (Hanning) window `w_l = (1 + cos(π l / n)) / 2` for order `n` (Sloan, "Stupid
-    /// Spherical Harmonics Tricks"): strong damping of the top bands.
-    Hanning,
-    /// Lanczos σ-factors `w_l = sinc(l / n)`: milder damping.
-    Lanczos,
-}
-
-impl std::str::FromStr for Window {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "none" => Ok(Window::None),
-            "hanning" => Ok(Window::Hanning),
-            "lanczos" => Ok(Window::Lanczos),
-            _ => Err(format!("unknown window {s:?} (none, hanning, lanczos)")),
-        }
+precompute::named_enum! {
+    /// A band-wise window `w_l` applied to SH coefficients.
+    #[derive(serde::Serialize, serde::Deserialize)]
+    #[serde(rename_all = "lowercase")]
+    pub enum Window ("window") {
+        /// No windowing.
+        None = "none",
+        /// Hann (Hanning) window `w_l = (1 + cos(π l / n)) / 2` for order `n` (Sloan, "Stupid
+        /// Spherical Harmonics Tricks"): strong damping of the top bands.
+        Hanning = "hanning",
+        /// Lanczos σ-factors `w_l = sinc(l / n)`: milder damping.
+        Lanczos = "lanczos",
     }
 }
 
 impl Window {
-    pub fn name(self) -> &'static str {
-        match self {
-            Window::None => "none",
-            Window::Hanning => "hanning",
-            Window::Lanczos => "lanczos",
-        }
-    }
-
     /// Factor of each band `l = 0 .. order-1`.
     pub fn factors(self, order: usize) -> Vec<f32> {
         let n = order as f32;

@@ -2,34 +2,32 @@
 
 use std::fmt;
 
-/// Which graphics API to use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Backend {
-    /// Vulkan if any adapter offers it, else OpenGL.
-    #[default]
-    Auto,
-    Vulkan,
-    Gl,
-}
-
-impl std::str::FromStr for Backend {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "auto" => Ok(Backend::Auto),
-            "vulkan" => Ok(Backend::Vulkan),
-            "gl" => Ok(Backend::Gl),
-            _ => Err(format!("unknown backend {s:?} (auto, vulkan, gl)")),
-        }
+precompute::named_enum! {
+    /// Which graphics API to use.
+    #[derive(Default)]
+    pub enum Backend ("graphics backend") {
+        /// Vulkan if any adapter offers it, else OpenGL.
+        #[default]
+        Auto = "auto",
+        Vulkan = "vulkan",
+        Gl = "gl",
     }
 }
 
 impl Backend {
-    fn backends(self) -> wgpu::Backends {
+    pub fn backends(self) -> wgpu::Backends {
         match self {
             Backend::Auto => wgpu::Backends::VULKAN | wgpu::Backends::GL,
             Backend::Vulkan => wgpu::Backends::VULKAN,
             Backend::Gl => wgpu::Backends::GL,
+        }
+    }
+
+    fn description(self) -> &'static str {
+        match self {
+            Backend::Auto => "Vulkan or OpenGL",
+            Backend::Vulkan => "Vulkan",
+            Backend::Gl => "OpenGL",
         }
     }
 }
@@ -37,12 +35,18 @@ impl Backend {
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
     #[error(
-        "no {backend} graphics adapter found. On a machine without a GPU install a software \
+        "no {backend} graphics adapter found{}. On a machine without a GPU install a software \
          driver: for Vulkan `apt-get install mesa-vulkan-drivers libvulkan1` (lavapipe), for \
-         OpenGL `apt-get install libegl1 libgl1-mesa-dri` (llvmpipe); then retry, or pass \
-         --backend to pick one"
+         OpenGL `apt-get install libegl1 libgl1-mesa-dri` (llvmpipe); then retry with another \
+         backend or this one",
+        if *for_window { " that can draw into the window" } else { "" }
     )]
-    NoAdapter { backend: String },
+    NoAdapter {
+        backend: &'static str,
+        for_window: bool,
+    },
+    #[error("cannot draw into the window: {0}")]
+    Surface(String),
     #[error("the adapter {adapter} could not open a device: {message}")]
     Device { adapter: String, message: String },
 }
@@ -84,26 +88,58 @@ fn preference(info: &wgpu::AdapterInfo) -> u8 {
 impl GpuContext {
     /// Opens the best adapter of `backend` without a window.
     pub fn headless(backend: Backend) -> Result<Self, GpuError> {
-        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
-        descriptor.backends = backend.backends();
-        let instance = wgpu::Instance::new(descriptor);
-        let adapters = pollster::block_on(instance.enumerate_adapters(backend.backends()));
-        let adapter = adapters
-            .into_iter()
-            .min_by_key(|a| preference(&a.get_info()))
-            .ok_or_else(|| GpuError::NoAdapter {
-                backend: match backend {
-                    Backend::Auto => "Vulkan or OpenGL".into(),
-                    Backend::Vulkan => "Vulkan".into(),
-                    Backend::Gl => "OpenGL".into(),
-                },
+        let instance = Self::instance(
+            backend,
+            wgpu::InstanceDescriptor::new_without_display_handle(),
+        );
+        let adapter =
+            Self::best_adapter(&instance, backend, |_| true).ok_or(GpuError::NoAdapter {
+                backend: backend.description(),
+                for_window: false,
             })?;
         Self::open(instance, adapter)
     }
 
+    /// Opens the best adapter of `backend` that can present to `target` (a window), with the
+    /// surface for it.
+    pub fn for_surface(
+        backend: Backend,
+        descriptor: wgpu::InstanceDescriptor,
+        target: impl Into<wgpu::SurfaceTarget<'static>>,
+    ) -> Result<(Self, wgpu::Surface<'static>), GpuError> {
+        let instance = Self::instance(backend, descriptor);
+        let surface = instance
+            .create_surface(target)
+            .map_err(|e| GpuError::Surface(e.to_string()))?;
+        let adapter = Self::best_adapter(&instance, backend, |a| a.is_surface_supported(&surface))
+            .ok_or(GpuError::NoAdapter {
+                backend: backend.description(),
+                for_window: true,
+            })?;
+        Ok((Self::open(instance, adapter)?, surface))
+    }
+
+    fn instance(backend: Backend, mut descriptor: wgpu::InstanceDescriptor) -> wgpu::Instance {
+        descriptor.backends = backend.backends();
+        wgpu::Instance::new(descriptor)
+    }
+
+    /// The adapter policy, one for windows and headless work: a real GPU before a software
+    /// one, Vulkan before OpenGL on the same kind of device.
+    fn best_adapter(
+        instance: &wgpu::Instance,
+        backend: Backend,
+        usable: impl Fn(&wgpu::Adapter) -> bool,
+    ) -> Option<wgpu::Adapter> {
+        pollster::block_on(instance.enumerate_adapters(backend.backends()))
+            .into_iter()
+            .filter(|a| usable(a))
+            .min_by_key(|a| preference(&a.get_info()))
+    }
+
     /// Opens a device on `adapter`, asking for the adapter's own limits (large scenes need
     /// big storage buffers).
-    pub fn open(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self, GpuError> {
+    fn open(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self, GpuError> {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("hprt"),
             required_features: wgpu::Features::empty(),

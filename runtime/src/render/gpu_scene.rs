@@ -2,16 +2,14 @@
 //! radiance computed from them every time the lighting changes (`shaders/transfer.wgsl`).
 
 use super::RenderError;
-use crate::render::lighting::FrameLighting;
+use super::shaders::{MAX_GPU_COEFFS, MAX_GPU_ORDER, Shader, TRANSFER_WORKGROUP};
+use crate::lighting::FrameLighting;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use precompute::bake::Transfer;
 use precompute::scene::SceneMesh;
 use precompute::sh::num_coeffs;
 use wgpu::util::DeviceExt;
-
-/// Highest SH order the GPU lighting buffers hold.
-pub const MAX_GPU_ORDER: usize = 8;
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -28,8 +26,8 @@ struct LightingUniform {
     vertex_count: u32,
     coeff_count: u32,
     _pad: [u32; 2],
-    sh: [[f32; 4]; 64],
-    lights_sh: [[f32; 4]; 64],
+    sh: [[f32; 4]; MAX_GPU_COEFFS],
+    lights_sh: [[f32; 4]; MAX_GPU_COEFFS],
 }
 
 pub struct GpuScene {
@@ -136,10 +134,7 @@ impl GpuScene {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("transfer.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("../../../shaders/transfer.wgsl").into()),
-        });
+        let module = Shader::Transfer.module(device);
         let transfer_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("transfer"),
             layout: None,
@@ -208,6 +203,24 @@ impl GpuScene {
         });
         pass.set_pipeline(&self.transfer_pipeline);
         pass.set_bind_group(0, &self.transfer_bind_group, &[]);
-        pass.dispatch_workgroups(self.vertex_count.div_ceil(64), 1, 1);
+        pass.dispatch_workgroups(self.vertex_count.div_ceil(TRANSFER_WORKGROUP), 1, 1);
+    }
+
+    /// Draws every triangle from its vertices alone (shadow maps).
+    pub fn draw_depth_only(&self, pass: &mut wgpu::RenderPass) {
+        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
+        self.draw_triangles(pass);
+    }
+
+    /// Draws every triangle with its vertices' PRT radiance (the PRT pass).
+    pub fn draw_with_radiance(&self, pass: &mut wgpu::RenderPass) {
+        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
+        pass.set_vertex_buffer(1, self.radiance_buffer.slice(..));
+        self.draw_triangles(pass);
+    }
+
+    fn draw_triangles(&self, pass: &mut wgpu::RenderPass) {
+        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..self.index_count, 0, 0..1);
     }
 }

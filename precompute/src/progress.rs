@@ -1,0 +1,69 @@
+//! How long-running library work (bakes, reference renders) reports its progress, without the
+//! library choosing how it is shown: the command line draws a terminal bar, the viewer a panel
+//! widget, tests nothing.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Receives progress from work that may run on many threads.
+pub trait Progress: Sync {
+    /// The work has `total` steps (vertices, image rows...).
+    fn start(&self, _total: u64) {}
+    /// `steps` more steps are done.
+    fn advance(&self, _steps: u64) {}
+    /// What the work is doing now ("bounce 2/3").
+    fn status(&self, _text: &str) {}
+    /// The work is over.
+    fn finish(&self) {}
+}
+
+/// Progress that goes nowhere.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoProgress;
+
+impl Progress for NoProgress {}
+
+/// Progress kept in two counters, for a reader on another thread (a window's progress bar).
+#[derive(Debug, Default)]
+pub struct SharedProgress {
+    total: AtomicU64,
+    done: AtomicU64,
+}
+
+impl SharedProgress {
+    /// The share of the work done, in `[0, 1]` (0 before the work starts).
+    pub fn fraction(&self) -> f32 {
+        let total = self.total.load(Ordering::Relaxed);
+        if total == 0 {
+            return 0.0;
+        }
+        (self.done.load(Ordering::Relaxed) as f64 / total as f64).min(1.0) as f32
+    }
+}
+
+impl Progress for SharedProgress {
+    fn start(&self, total: u64) {
+        self.total.store(total, Ordering::Relaxed);
+        self.done.store(0, Ordering::Relaxed);
+    }
+    fn advance(&self, steps: u64) {
+        self.done.fetch_add(steps, Ordering::Relaxed);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shared_progress_counts_from_many_threads() {
+        let progress = SharedProgress::default();
+        assert_eq!(progress.fraction(), 0.0);
+        progress.start(400);
+        std::thread::scope(|s| {
+            for _ in 0..4 {
+                s.spawn(|| (0..50).for_each(|_| progress.advance(1)));
+            }
+        });
+        assert_eq!(progress.fraction(), 0.5);
+    }
+}

@@ -1,0 +1,170 @@
+//! The light pass (thesis 4.4, one additive pass per light, fused): every light's Lambertian
+//! contribution with percentage-closer filtering of its shadow map, added onto the PRT pass's
+//! image, and the environment behind the scene (`shaders/lights.wgsl`). Summing the lights in
+//! one pass gives the same image as one pass per light and reads the G-buffer once.
+
+use super::environment::EnvironmentTexture;
+use super::pass_helpers::{FullscreenPass, begin_pass, color_attachment};
+use super::shaders::Shader;
+use super::shadow_maps::ShadowMaps;
+use super::targets::{COLOR_FORMAT, Targets};
+use super::uniforms::FrameBuffers;
+
+/// What the light pass reads.
+pub struct LightPassInputs<'a> {
+    pub buffers: &'a FrameBuffers,
+    pub targets: &'a Targets,
+    pub shadow_maps: &'a ShadowMaps,
+    pub environment: &'a EnvironmentTexture,
+}
+
+pub struct LightPass {
+    /// Indexed by `2 · shadowed + kernel from radius` (pipeline constants of the shader).
+    pipelines: Vec<wgpu::RenderPipeline>,
+    layout: wgpu::BindGroupLayout,
+    /// Made on first use after its inputs change (see [`Self::inputs_changed`]).
+    bind_group: Option<wgpu::BindGroup>,
+}
+
+impl LightPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("light pass"),
+            entries: &layout_entries(),
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("light pass"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = Shader::Lights.module(device);
+        let additive = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let pipelines = (0..4)
+            .map(|variant| {
+                FullscreenPass {
+                    label: "light pass",
+                    module: &module,
+                    layout: Some(&pipeline_layout),
+                    target: wgpu::ColorTargetState {
+                        format: COLOR_FORMAT,
+                        blend: Some(wgpu::BlendState {
+                            color: additive,
+                            alpha: additive,
+                        }),
+                        write_mask: wgpu::ColorWrites::ALL,
+                    },
+                    constants: &[
+                        ("SHADOWED", f64::from(variant >= 2)),
+                        ("KERNEL_FROM_RADIUS", f64::from(variant % 2 == 1)),
+                    ],
+                }
+                .pipeline(device)
+            })
+            .collect();
+        Self {
+            pipelines,
+            layout,
+            bind_group: None,
+        }
+    }
+
+    /// A texture the pass reads was re-created.
+    pub fn inputs_changed(&mut self) {
+        self.bind_group = None;
+    }
+
+    pub fn record(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &LightPassInputs,
+        shadows: bool,
+    ) {
+        let bind_group = self
+            .bind_group
+            .get_or_insert_with(|| bind_group(device, &self.layout, inputs));
+        let mut pass = begin_pass(
+            encoder,
+            "light pass",
+            &[color_attachment(&inputs.targets.color_view, None)],
+            None,
+        );
+        let kernel_from_radius = inputs.shadow_maps.settings().from_angular_radius;
+        let variant = usize::from(shadows) * 2 + usize::from(kernel_from_radius);
+        pass.set_pipeline(&self.pipelines[variant]);
+        pass.set_bind_group(0, &*bind_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+fn bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    inputs: &LightPassInputs,
+) -> wgpu::BindGroup {
+    let view = wgpu::BindingResource::TextureView;
+    let resources = [
+        inputs.buffers.frame.as_entire_binding(),
+        inputs.buffers.lights.as_entire_binding(),
+        view(&inputs.targets.depth_copy_view),
+        view(&inputs.targets.normal_view),
+        view(&inputs.targets.albedo_view),
+        view(inputs.shadow_maps.array_view()),
+        wgpu::BindingResource::Sampler(&inputs.shadow_maps.sampler),
+        view(&inputs.environment.view),
+        view(inputs.shadow_maps.depth_copy_array_view()),
+    ];
+    let entries: Vec<wgpu::BindGroupEntry> = resources
+        .into_iter()
+        .enumerate()
+        .map(|(binding, resource)| wgpu::BindGroupEntry {
+            binding: binding as u32,
+            resource,
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("light pass"),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// Bindings 0–8 of `shaders/lights.wgsl`, in order.
+fn layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+    use wgpu::{BindingType, TextureSampleType as S, TextureViewDimension as D};
+    let uniform = BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Uniform,
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    };
+    let texture = |sample_type, view_dimension| BindingType::Texture {
+        sample_type,
+        view_dimension,
+        multisampled: false,
+    };
+    let float = S::Float { filterable: false };
+    [
+        uniform,                                                    // frame
+        uniform,                                                    // lights
+        texture(float, D::D2),                                      // depth
+        texture(float, D::D2),                                      // normals
+        texture(float, D::D2),                                      // albedo
+        texture(S::Depth, D::D2Array),                              // shadow maps
+        BindingType::Sampler(wgpu::SamplerBindingType::Comparison), // shadow sampler
+        texture(float, D::D2),                                      // environment
+        texture(float, D::D2Array),                                 // shadow depths
+    ]
+    .into_iter()
+    .enumerate()
+    .map(|(binding, ty)| wgpu::BindGroupLayoutEntry {
+        binding: binding as u32,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty,
+        count: None,
+    })
+    .collect()
+}

@@ -1,0 +1,62 @@
+//! Copying a texture back to the CPU (the rendered image, window screenshots).
+
+use super::RenderError;
+
+/// The texel rows of a single-layer `texture` whose texels are `bytes_per_texel` bytes, tightly
+/// packed (the copy's 256-byte row alignment removed). Waits for the GPU.
+pub fn read_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    bytes_per_texel: u32,
+) -> Result<Vec<u8>, RenderError> {
+    let (width, height) = (texture.width(), texture.height());
+    let row_bytes = width * bytes_per_texel;
+    let padded_row_bytes =
+        row_bytes.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: padded_row_bytes as u64 * height as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded_row_bytes),
+                rows_per_image: Some(height),
+            },
+        },
+        wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+    );
+    queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    let (sender, receiver) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |result| {
+        let _ = sender.send(result);
+    });
+    let failed = |e: &dyn std::fmt::Display| RenderError::Readback(e.to_string());
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| failed(&e))?;
+    receiver
+        .recv()
+        .map_err(|e| failed(&e))?
+        .map_err(|e| failed(&e))?;
+    let data = slice.get_mapped_range().map_err(|e| failed(&e))?;
+    let mut texels = Vec::with_capacity((row_bytes * height) as usize);
+    for row in data.chunks_exact(padded_row_bytes as usize) {
+        texels.extend_from_slice(&row[..row_bytes as usize]);
+    }
+    drop(data);
+    buffer.unmap();
+    Ok(texels)
+}

@@ -1,0 +1,134 @@
+//! The WGSL of `shaders/`, loaded in one place. Every module is prefixed with the limits the
+//! Rust side sizes its buffers by, as WGSL constants, so the two cannot disagree; the render
+//! passes' modules also get `shaders/common.wgsl` (the uniform structs they share).
+
+use precompute::sh::num_coeffs;
+
+/// Most lights drawn per frame (the light pass's uniform array).
+pub const MAX_LIGHTS: usize = 32;
+/// Highest SH order the GPU lighting buffers hold; bakes of higher orders are CPU-only.
+pub const MAX_GPU_ORDER: usize = 8;
+/// SH coefficients per channel at [`MAX_GPU_ORDER`].
+pub const MAX_GPU_COEFFS: usize = MAX_GPU_ORDER * MAX_GPU_ORDER;
+/// Invocations per workgroup of the per-vertex transfer pass.
+pub const TRANSFER_WORKGROUP: u32 = 64;
+
+/// The shaders of `shaders/`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shader {
+    /// Per-vertex PRT radiance (compute).
+    Transfer,
+    /// The PRT pass writing the G-buffer.
+    Geometry,
+    /// Depth from a light.
+    Shadow,
+    /// The lights' full-screen pass.
+    Lights,
+    /// Tone mapping to a window.
+    Display,
+}
+
+impl Shader {
+    fn file_name(self) -> &'static str {
+        match self {
+            Shader::Transfer => "transfer.wgsl",
+            Shader::Geometry => "geometry.wgsl",
+            Shader::Shadow => "shadow.wgsl",
+            Shader::Lights => "lights.wgsl",
+            Shader::Display => "display.wgsl",
+        }
+    }
+
+    fn body(self) -> &'static str {
+        match self {
+            Shader::Transfer => include_str!("../../../shaders/transfer.wgsl"),
+            Shader::Geometry => include_str!("../../../shaders/geometry.wgsl"),
+            Shader::Shadow => include_str!("../../../shaders/shadow.wgsl"),
+            Shader::Lights => include_str!("../../../shaders/lights.wgsl"),
+            Shader::Display => include_str!("../../../shaders/display.wgsl"),
+        }
+    }
+
+    /// The shared WGSL the shader builds on: the structs of `shaders/common.wgsl` for the
+    /// render passes, the full-screen triangle of `shaders/fullscreen.wgsl` for full-screen
+    /// passes.
+    fn prelude(self) -> &'static [&'static str] {
+        const COMMON: &str = include_str!("../../../shaders/common.wgsl");
+        const FULLSCREEN: &str = include_str!("../../../shaders/fullscreen.wgsl");
+        match self {
+            Shader::Transfer => &[],
+            Shader::Geometry | Shader::Shadow => &[COMMON],
+            Shader::Lights => &[COMMON, FULLSCREEN],
+            Shader::Display => &[FULLSCREEN],
+        }
+    }
+
+    /// The complete WGSL source: constants, shared WGSL, the shader.
+    pub fn source(self) -> String {
+        let mut source = constants();
+        for part in self.prelude() {
+            source.push('\n');
+            source.push_str(part);
+        }
+        source.push('\n');
+        source.push_str(self.body());
+        source
+    }
+
+    /// Entry point of the vertex stage of a full-screen pass.
+    pub const FULLSCREEN_VERTEX: &'static str = "vs_fullscreen";
+
+    pub fn module(self, device: &wgpu::Device) -> wgpu::ShaderModule {
+        device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(self.file_name()),
+            source: wgpu::ShaderSource::Wgsl(self.source().into()),
+        })
+    }
+}
+
+/// The Rust limits as WGSL constants.
+fn constants() -> String {
+    format!(
+        "// Generated from runtime/src/render/shaders.rs.\n\
+         const MAX_LIGHTS: u32 = {MAX_LIGHTS}u;\n\
+         const MAX_SH_COEFFS: u32 = {}u;\n\
+         const TRANSFER_WORKGROUP: u32 = {TRANSFER_WORKGROUP}u;\n",
+        num_coeffs(MAX_GPU_ORDER)
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every shader parses and validates with the generated constants, and none writes a
+    /// limit by hand.
+    #[test]
+    fn shaders_validate_and_take_their_limits_from_rust() {
+        for shader in [
+            Shader::Transfer,
+            Shader::Geometry,
+            Shader::Shadow,
+            Shader::Lights,
+            Shader::Display,
+        ] {
+            let source = shader.source();
+            let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| {
+                panic!("{}: {}", shader.file_name(), e.emit_to_string(&source))
+            });
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::all(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{}: {e:?}", shader.file_name()));
+            for literal in [format!(", {MAX_LIGHTS}>"), format!(", {MAX_GPU_COEFFS}>")] {
+                assert!(
+                    !shader.body().contains(&literal),
+                    "{} sizes an array by hand ({literal})",
+                    shader.file_name()
+                );
+            }
+        }
+    }
+}

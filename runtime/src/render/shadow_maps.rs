@@ -1,0 +1,363 @@
+//! Shadow maps: one orthographic depth map per directional light, fitted to the scene's
+//! bounding sphere, kept in a texture array and re-rendered only when their light moves
+//! (`shaders/shadow.wgsl`).
+
+use super::RenderError;
+use super::gpu_scene::{self, GpuScene};
+use super::pass_helpers::{begin_pass, color_attachment, depth_attachment, texture};
+use super::shaders::Shader;
+use super::targets::{DEPTH_COPY_FORMAT, DEPTH_FORMAT};
+use glam::{Mat4, Vec3};
+
+/// How shadows are filtered.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ShadowSettings {
+    /// Shadow-map resolution (square).
+    pub resolution: u32,
+    /// PCF taps per side (odd); each tap is a hardware-filtered 2×2 comparison.
+    pub pcf_taps: u32,
+    /// Size the PCF kernel from each light's angular radius and the distance to the occluder
+    /// (found by a blocker search), so penumbrae widen away from the occluder.
+    pub from_angular_radius: bool,
+}
+
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        Self {
+            resolution: 2048,
+            pcf_taps: 3,
+            from_angular_radius: true,
+        }
+    }
+}
+
+impl ShadowSettings {
+    pub fn validate(&self) -> Result<(), RenderError> {
+        let invalid = |reason: String| {
+            Err(RenderError::Settings(
+                precompute::settings::InvalidSettings::new("shadow settings", reason),
+            ))
+        };
+        if !(16..=8192).contains(&self.resolution) {
+            return invalid(format!(
+                "shadow-map resolution {} outside 16..=8192",
+                self.resolution
+            ));
+        }
+        if self.pcf_taps == 0 || self.pcf_taps > 15 || self.pcf_taps.is_multiple_of(2) {
+            return invalid(format!("PCF taps {} must be odd, 1..=15", self.pcf_taps));
+        }
+        Ok(())
+    }
+}
+
+/// A sphere enclosing the scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundingSphere {
+    pub center: Vec3,
+    pub radius: f32,
+}
+
+impl BoundingSphere {
+    pub fn of_box(min: Vec3, max: Vec3) -> Self {
+        Self {
+            center: (min + max) * 0.5,
+            radius: ((max - min) * 0.5).length().max(1e-6),
+        }
+    }
+}
+
+/// World → shadow-map clip space for a light from `direction` (unit, toward the light): an
+/// orthographic view along the light fitted to the scene's bounding sphere, depth 0 at the
+/// sphere's side facing the light and 1 at the far side.
+pub fn shadow_matrix(direction: Vec3, bounds: &BoundingSphere) -> Mat4 {
+    let r = bounds.radius;
+    let eye = bounds.center + direction * r;
+    // Any up vector not parallel to the light.
+    let up = if direction.y.abs() < 0.99 {
+        Vec3::Y
+    } else {
+        Vec3::X
+    };
+    let view = glam::camera::rh::view::look_at_mat4(eye, bounds.center, up);
+    let projection = glam::camera::rh::proj::directx::orthographic(-r, r, -r, r, 0.0, 2.0 * r);
+    projection * view
+}
+
+/// World-space size of one shadow-map texel.
+pub fn shadow_texel_size(bounds: &BoundingSphere, resolution: u32) -> f32 {
+    2.0 * bounds.radius / resolution as f32
+}
+
+/// Shadow-map arrays have at least two layers: wgpu's OpenGL backend takes a one-layer texture
+/// for a plain 2D texture and refuses to view it as an array.
+const MIN_LAYERS: u32 = 2;
+/// Stride of the per-light shadow view matrices (uniform dynamic offsets must be 256-aligned).
+const VIEW_STRIDE: u64 = 256;
+
+/// The maps of one resolution and layer count.
+struct Layers {
+    count: u32,
+    array_view: wgpu::TextureView,
+    layer_views: Vec<wgpu::TextureView>,
+    /// The same depths as colour, for the blocker search.
+    depth_copy_array_view: wgpu::TextureView,
+    depth_copy_layer_views: Vec<wgpu::TextureView>,
+    view_buffer: wgpu::Buffer,
+    view_bind_group: wgpu::BindGroup,
+    /// Shadow matrices the maps were last rendered with.
+    rendered: Vec<Mat4>,
+}
+
+impl Layers {
+    fn new(
+        device: &wgpu::Device,
+        view_layout: &wgpu::BindGroupLayout,
+        resolution: u32,
+        count: u32,
+    ) -> Self {
+        use wgpu::TextureUsages as U;
+        let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING;
+        let size = (resolution, resolution, count);
+        let maps = texture(device, "shadow maps", size, DEPTH_FORMAT, usage);
+        let copies = texture(device, "shadow map depths", size, DEPTH_COPY_FORMAT, usage);
+        let array_view = |t: &wgpu::Texture| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        };
+        let layer_views = |t: &wgpu::Texture| -> Vec<wgpu::TextureView> {
+            (0..count)
+                .map(|layer| {
+                    t.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2),
+                        base_array_layer: layer,
+                        array_layer_count: Some(1),
+                        ..Default::default()
+                    })
+                })
+                .collect()
+        };
+        let view_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadow views"),
+            size: VIEW_STRIDE * count as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let view_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow view"),
+            layout: view_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &view_buffer,
+                    offset: 0,
+                    size: std::num::NonZeroU64::new(64),
+                }),
+            }],
+        });
+        Self {
+            count,
+            array_view: array_view(&maps),
+            layer_views: layer_views(&maps),
+            depth_copy_array_view: array_view(&copies),
+            depth_copy_layer_views: layer_views(&copies),
+            view_buffer,
+            view_bind_group,
+            rendered: Vec::new(),
+        }
+    }
+}
+
+/// The shadow maps, their pass and how the light pass samples them.
+pub struct ShadowMaps {
+    settings: ShadowSettings,
+    pipeline: wgpu::RenderPipeline,
+    view_layout: wgpu::BindGroupLayout,
+    /// Hardware 2×2 depth comparison for PCF.
+    pub sampler: wgpu::Sampler,
+    layers: Layers,
+}
+
+impl ShadowMaps {
+    pub fn new(device: &wgpu::Device, settings: ShadowSettings) -> Result<Self, RenderError> {
+        settings.validate()?;
+        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow view"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: std::num::NonZeroU64::new(64),
+                },
+                count: None,
+            }],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow pass"),
+            bind_group_layouts: &[Some(&view_layout)],
+            immediate_size: 0,
+        });
+        let module = Shader::Shadow.module(device);
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("shadow pass"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(gpu_scene::VERTEX_LAYOUT)],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                // Slope-scaled bias against shadow acne on surfaces grazing the light.
+                bias: wgpu::DepthBiasState {
+                    constant: 2,
+                    slope_scale: 2.0,
+                    clamp: 0.0,
+                },
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(DEPTH_COPY_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow comparison"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        let layers = Layers::new(device, &view_layout, settings.resolution, MIN_LAYERS);
+        Ok(Self {
+            settings,
+            pipeline,
+            view_layout,
+            sampler,
+            layers,
+        })
+    }
+
+    pub fn settings(&self) -> ShadowSettings {
+        self.settings
+    }
+
+    /// Changes the settings; returns whether the maps were re-created (their bindings change).
+    pub fn set_settings(
+        &mut self,
+        device: &wgpu::Device,
+        settings: ShadowSettings,
+    ) -> Result<bool, RenderError> {
+        settings.validate()?;
+        let recreate = settings.resolution != self.settings.resolution;
+        if recreate {
+            self.layers = Layers::new(
+                device,
+                &self.view_layout,
+                settings.resolution,
+                self.layers.count,
+            );
+        }
+        self.settings = settings;
+        Ok(recreate)
+    }
+
+    /// Makes room for `lights` maps; returns whether the maps were re-created.
+    pub fn reserve(&mut self, device: &wgpu::Device, lights: usize) -> bool {
+        if lights as u32 <= self.layers.count {
+            return false;
+        }
+        let count = (lights as u32).next_power_of_two().max(MIN_LAYERS);
+        self.layers = Layers::new(device, &self.view_layout, self.settings.resolution, count);
+        true
+    }
+
+    pub fn array_view(&self) -> &wgpu::TextureView {
+        &self.layers.array_view
+    }
+
+    pub fn depth_copy_array_view(&self) -> &wgpu::TextureView {
+        &self.layers.depth_copy_array_view
+    }
+
+    /// Records the shadow pass of every light whose matrix changed since its map was drawn
+    /// (call [`Self::reserve`] first).
+    pub fn render_stale(
+        &mut self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        matrices: &[Mat4],
+    ) {
+        let layers = &mut self.layers;
+        for (i, m) in matrices.iter().enumerate() {
+            if layers.rendered.get(i) == Some(m) {
+                continue;
+            }
+            let offset = i as u64 * VIEW_STRIDE;
+            queue.write_buffer(
+                &layers.view_buffer,
+                offset,
+                bytemuck::cast_slice(&m.to_cols_array()),
+            );
+            let mut pass = begin_pass(
+                encoder,
+                "shadow pass",
+                &[color_attachment(
+                    &layers.depth_copy_layer_views[i],
+                    Some(wgpu::Color::WHITE),
+                )],
+                depth_attachment(&layers.layer_views[i]),
+            );
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &layers.view_bind_group, &[offset as u32]);
+            scene.draw_depth_only(&mut pass);
+        }
+        layers.rendered = matrices.to_vec();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shadow_matrix_covers_the_sphere_and_orders_depth_toward_the_light() {
+        let bounds = BoundingSphere::of_box(Vec3::new(-2.0, 0.0, -1.0), Vec3::new(3.0, 2.0, 1.0));
+        for direction in [Vec3::Y, Vec3::new(0.3, 0.2, -0.9).normalize(), Vec3::NEG_Y] {
+            let m = shadow_matrix(direction, &bounds);
+            for corner in 0..8 {
+                let p = Vec3::new(
+                    if corner & 1 == 0 { -2.0 } else { 3.0 },
+                    if corner & 2 == 0 { 0.0 } else { 2.0 },
+                    if corner & 4 == 0 { -1.0 } else { 1.0 },
+                );
+                let c = m.project_point3(p);
+                assert!(c.x.abs() <= 1.0 + 1e-5 && c.y.abs() <= 1.0 + 1e-5, "{c}");
+                assert!((-1e-5..=1.0 + 1e-5).contains(&c.z), "{c}");
+            }
+            // Closer to the light means smaller depth.
+            let near = m.project_point3(bounds.center + direction * 0.5);
+            let far = m.project_point3(bounds.center - direction * 0.5);
+            assert!(near.z < far.z);
+        }
+    }
+}

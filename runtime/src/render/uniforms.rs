@@ -1,0 +1,121 @@
+//! The per-frame uniforms the passes share: the camera and environment (`Frame`) and the
+//! lights (`Light`), as laid out in `shaders/common.wgsl`.
+
+use super::pass_helpers::writable_buffer;
+use super::shaders::MAX_LIGHTS;
+use super::shadow_maps::{BoundingSphere, shadow_matrix, shadow_texel_size};
+use crate::light::DirectionalLight;
+use bytemuck::{Pod, Zeroable};
+use glam::Mat4;
+use precompute::camera::Camera;
+
+/// Matches `Frame` in `shaders/common.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct FrameUniform {
+    view_proj: [[f32; 4]; 4],
+    inv_view_proj: [[f32; 4]; 4],
+    viewport: [f32; 4],
+    env_rotation: [f32; 4],
+    light_count: u32,
+    flags: u32,
+    pcf_taps: u32,
+    _pad: u32,
+}
+
+/// Matches `Light` in `shaders/common.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct LightUniform {
+    direction: [f32; 4],
+    power: [f32; 4],
+    shadow_matrix: [[f32; 4]; 4],
+    params: [f32; 4],
+}
+
+impl LightUniform {
+    pub fn shadow_matrix(&self) -> Mat4 {
+        Mat4::from_cols_array_2d(&self.shadow_matrix)
+    }
+}
+
+/// What the frame uniform is made of.
+pub struct FrameParameters<'a> {
+    pub camera: &'a Camera,
+    pub bounds: &'a BoundingSphere,
+    /// Rotation of the background map about +Y, radians.
+    pub environment_rotation: f32,
+    pub light_count: usize,
+    pub background: bool,
+    pub pcf_taps: u32,
+}
+
+impl FrameUniform {
+    pub fn new(p: &FrameParameters) -> Self {
+        let (w, h) = (p.camera.width as f32, p.camera.height as f32);
+        let distance = (p.camera.position - p.bounds.center).length();
+        let near = (distance - p.bounds.radius).max(1e-3 * p.bounds.radius);
+        let far = (distance + p.bounds.radius) * 1.01;
+        let view_proj = p.camera.projection_matrix(near, far) * p.camera.view_matrix();
+        let (sin, cos) = p.environment_rotation.sin_cos();
+        Self {
+            view_proj: view_proj.to_cols_array_2d(),
+            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            viewport: [w, h, 1.0 / w, 1.0 / h],
+            env_rotation: [cos, sin, 0.0, 0.0],
+            light_count: p.light_count as u32,
+            flags: u32::from(p.background) << 1,
+            pcf_taps: p.pcf_taps,
+            _pad: 0,
+        }
+    }
+}
+
+/// Each light with its shadow matrix and filtering parameters.
+pub fn light_uniforms(
+    lights: &[DirectionalLight],
+    bounds: &BoundingSphere,
+    shadow_resolution: u32,
+) -> Vec<LightUniform> {
+    let texel = shadow_texel_size(bounds, shadow_resolution);
+    lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| LightUniform {
+            direction: l.direction.extend(0.0).to_array(),
+            power: l.power.extend(0.0).to_array(),
+            shadow_matrix: shadow_matrix(l.direction, bounds).to_cols_array_2d(),
+            params: [texel, 2.0 * bounds.radius, l.angular_radius.tan(), i as f32],
+        })
+        .collect()
+}
+
+/// The uniform buffers.
+pub struct FrameBuffers {
+    pub frame: wgpu::Buffer,
+    /// A uniform buffer: every fragment reads the same light at each loop step, which software
+    /// rasterizers handle far better than storage-buffer loads.
+    pub lights: wgpu::Buffer,
+}
+
+impl FrameBuffers {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        Self {
+            frame: writable_buffer(device, "frame", size_of::<FrameUniform>(), uniform),
+            lights: writable_buffer(
+                device,
+                "lights",
+                size_of::<LightUniform>() * MAX_LIGHTS,
+                uniform,
+            ),
+        }
+    }
+
+    pub fn write(&self, queue: &wgpu::Queue, frame: &FrameUniform, lights: &[LightUniform]) {
+        queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(frame));
+        if !lights.is_empty() {
+            queue.write_buffer(&self.lights, 0, bytemuck::cast_slice(lights));
+        }
+    }
+}

@@ -1,0 +1,204 @@
+//! Argument groups that several commands share (clap), and how they turn into library
+//! settings. Each command's own arguments live with the command.
+
+use crate::environment::{self, ChosenEnvironment};
+use clap::{Args, ValueEnum};
+use precompute::envmap::Layout;
+use precompute::scene::Scene;
+use runtime::render::{Backend, RenderMode, ShadowSettings};
+use runtime::{DecomposeMode, DecomposeSettings, Window};
+use std::path::PathBuf;
+
+/// `--env`, `--layout`, `--rotate`: the map a command lights the scene with.
+#[derive(Args, Clone, Debug)]
+pub struct EnvironmentArgs {
+    /// Environment map (default: the scene's).
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    /// Layout of the map (default: from the aspect ratio).
+    #[arg(long)]
+    pub layout: Option<Layout>,
+    /// Rotation of the map about +Y in degrees (default: the scene's rotation_deg, whichever
+    /// map is used).
+    #[arg(long, allow_negative_numbers = true)]
+    pub rotate: Option<f32>,
+}
+
+impl EnvironmentArgs {
+    pub fn choose(&self, scene: &Scene) -> anyhow::Result<ChosenEnvironment> {
+        environment::choose(scene, self.env.as_deref(), self.layout, self.rotate)
+    }
+}
+
+/// `--width`, `--height`: the image size, by default the scene camera's.
+#[derive(Args, Clone, Debug, Default)]
+pub struct ImageSizeArgs {
+    /// Image width (default: the scene camera's).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height (default: the scene camera's).
+    #[arg(long)]
+    pub height: Option<u32>,
+}
+
+impl ImageSizeArgs {
+    /// The scene's camera at this size.
+    pub fn camera(&self, scene: &Scene) -> anyhow::Result<precompute::camera::Camera> {
+        let camera = scene.camera.with_size(
+            self.width.unwrap_or(scene.camera.width),
+            self.height.unwrap_or(scene.camera.height),
+        );
+        camera.validate()?;
+        Ok(camera)
+    }
+}
+
+/// On or off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Switch {
+    On,
+    Off,
+}
+
+impl Switch {
+    pub fn is_on(self) -> bool {
+        self == Switch::On
+    }
+}
+
+/// Options of every command that decomposes a map (defaults: `DecomposeSettings::for_mode`).
+#[derive(Args, Clone, Debug)]
+pub struct DecomposeOptions {
+    /// SH order of the polynomial part (default: 5, or the bake's order when rendering).
+    #[arg(long)]
+    pub order: Option<usize>,
+    /// Weber fraction: keep lights while each adds more than this share of the luminance of
+    /// the brighter ones.
+    #[arg(long, default_value_t = DecomposeSettings::default().threshold)]
+    pub threshold: f32,
+    /// Radius of the SRBF / light caps in degrees (default: 8 for consistent, √2 × the
+    /// smoothing for thesis, which keeps a point source's power under the thesis' formula).
+    #[arg(long)]
+    pub radius: Option<f32>,
+    /// Cube-map face resolution.
+    #[arg(long, default_value_t = DecomposeSettings::default().face_size)]
+    pub face: usize,
+    /// Most lights kept (at most the 24 peaks considered per frame).
+    #[arg(long, default_value_t = DecomposeSettings::default().max_lights)]
+    pub max_lights: usize,
+    /// Icosahedron subdivision level of the peak search.
+    #[arg(long, default_value_t = DecomposeSettings::default().ico_level)]
+    pub ico_level: u32,
+    /// Standard deviation of the smoothing Gaussian, in degrees.
+    #[arg(long, default_value_t = DecomposeSettings::default().smoothing_deg)]
+    pub smoothing: f32,
+    /// Window of the SH part (none, hanning, lanczos); default: hanning for thesis, none for
+    /// consistent.
+    #[arg(long)]
+    pub window: Option<Window>,
+    /// A peak must exceed this multiple of the map's mean luminance to become a light.
+    #[arg(long, default_value_t = DecomposeSettings::default().min_contrast)]
+    pub min_contrast: f32,
+}
+
+impl DecomposeOptions {
+    /// The settings for `mode`, with `default_order` unless `--order` was given.
+    pub fn settings(&self, mode: DecomposeMode, default_order: usize) -> DecomposeSettings {
+        let defaults = DecomposeSettings::for_mode(mode, self.order.unwrap_or(default_order));
+        DecomposeSettings {
+            face_size: self.face,
+            ico_level: self.ico_level,
+            smoothing_deg: self.smoothing,
+            radius_deg: self
+                .radius
+                .unwrap_or_else(|| DecomposeSettings::default_radius(mode, self.smoothing)),
+            threshold: self.threshold,
+            max_lights: self.max_lights,
+            min_contrast: self.min_contrast,
+            window: self.window,
+            ..defaults
+        }
+    }
+}
+
+/// What a GPU frame draws and how its shadows are filtered.
+#[derive(Args, Clone, Debug)]
+pub struct RenderOptions {
+    /// prt: the SH projection of the whole map (the thesis' baseline); hybrid: SH part +
+    /// shadow-mapped lights; lights / unshadowed: debug views.
+    #[arg(long, default_value = "hybrid")]
+    pub mode: RenderMode,
+    /// Shadow-map resolution.
+    #[arg(long, default_value_t = ShadowSettings::default().resolution)]
+    pub shadow_res: u32,
+    /// PCF taps per side (odd).
+    #[arg(long, default_value_t = ShadowSettings::default().pcf_taps)]
+    pub pcf: u32,
+    /// Size each light's PCF kernel from its angular radius and the occluder distance
+    /// (off: a fixed kernel of --pcf taps one texel apart).
+    #[arg(long, value_enum, default_value = "on")]
+    pub pcf_from_radius: Switch,
+    /// Send the lights through the bake's indirect transfer too (their bounce light);
+    /// default: on in consistent mode, off in thesis mode.
+    #[arg(long, value_enum)]
+    pub lights_indirect: Option<Switch>,
+    /// Graphics backend: auto, vulkan or gl.
+    #[arg(long, default_value = "auto")]
+    pub backend: Backend,
+}
+
+impl RenderOptions {
+    pub fn shadow_settings(&self) -> ShadowSettings {
+        ShadowSettings {
+            resolution: self.shadow_res,
+            pcf_taps: self.pcf,
+            from_angular_radius: self.pcf_from_radius.is_on(),
+        }
+    }
+
+    /// `--lights-indirect`, if given (else the decomposition mode's rule applies).
+    pub fn lights_indirect(&self) -> Option<bool> {
+        self.lights_indirect.map(Switch::is_on)
+    }
+}
+
+/// Options of `hprt report`, shared with `hprt demo`.
+#[derive(Args, Clone, Debug)]
+pub struct ReportOptions {
+    /// Bake of the scene (default: the cached bake of the scene's settings, baked if missing).
+    #[arg(long)]
+    pub bake: Option<PathBuf>,
+    /// Light paths per pixel of the reference.
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: u32,
+    /// Indirect bounces of the reference (default: the bake's, so both see the same light).
+    #[arg(long)]
+    pub bounces: Option<u32>,
+    #[command(flatten)]
+    pub size: ImageSizeArgs,
+    /// Seed of the reference.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Weber thresholds of the error-against-threshold plot.
+    #[arg(long, num_args = 1.., default_values_t = [0.0, 0.02, 0.05, 0.1, 0.2, 0.4])]
+    pub thresholds: Vec<f32>,
+    /// Frames timed per method; the report gives the median.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    pub frames: u32,
+    /// Graphics backend: auto, vulkan or gl.
+    #[arg(long, default_value = "auto")]
+    pub backend: Backend,
+}
+
+/// A vector written "x,y,z".
+pub fn parse_vec3(text: &str) -> Result<glam::Vec3, String> {
+    let parts: Vec<f32> = text
+        .split(',')
+        .map(|p| p.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("expected \"x,y,z\", got {text:?}"))?;
+    match parts[..] {
+        [x, y, z] => Ok(glam::Vec3::new(x, y, z)),
+        _ => Err(format!("expected three numbers \"x,y,z\", got {text:?}")),
+    }
+}

@@ -1,0 +1,75 @@
+//! Which environment map lights a scene, loaded with context, and what follows from the map
+//! (its default exposure, the maps beside it).
+
+use anyhow::Context;
+use precompute::envmap::{self, EnvMap, Layout, LoadedEnvMap};
+use precompute::scene::Scene;
+use std::path::{Path, PathBuf};
+
+/// Loads a map with the file named in any error.
+pub fn load_map(path: &Path, layout: Option<Layout>) -> anyhow::Result<LoadedEnvMap> {
+    envmap::load(path, layout).context("cannot load the environment map")
+}
+
+/// The environment a command lights a scene with.
+pub struct ChosenEnvironment {
+    pub path: PathBuf,
+    pub loaded: LoadedEnvMap,
+    /// Degrees about +Y ([`runtime::lighting::map_rotation`]).
+    pub rotation_deg: f32,
+}
+
+/// `env` or the scene's map, `rotate` or the scene's rotation (the rule of
+/// [`runtime::lighting::map_rotation`], for any map).
+pub fn choose(
+    scene: &Scene,
+    env: Option<&Path>,
+    layout: Option<Layout>,
+    rotate: Option<f32>,
+) -> anyhow::Result<ChosenEnvironment> {
+    let path = match (env, &scene.environment) {
+        (Some(path), _) => path.to_owned(),
+        (None, Some(spec)) => spec.map.clone(),
+        (None, None) => anyhow::bail!(
+            "{} names no [environment]; pass --env MAP",
+            scene.path.display()
+        ),
+    };
+    let loaded = load_map(&path, layout)?;
+    Ok(ChosenEnvironment {
+        path,
+        loaded,
+        rotation_deg: scene_rotation(scene, rotate),
+    })
+}
+
+/// The rotation a map gets in `scene`: `rotate` if given, else the scene's.
+pub fn scene_rotation(scene: &Scene, rotate: Option<f32>) -> f32 {
+    runtime::lighting::map_rotation(scene.environment.as_ref().map(|e| e.rotation_deg), rotate)
+}
+
+/// The default tone-mapping exposure for a map: a white Lambertian surface seeing the whole
+/// environment (radiance = the map's mean luminance) maps to `1 - e^(-1/2)` (about 0.39
+/// linear, 0.66 after sRGB encoding), leaving headroom for sunlit surfaces.
+pub fn default_exposure(map: &EnvMap) -> f32 {
+    0.5 / map.mean_luminance().max(1e-6)
+}
+
+/// The maps next to `map` (its folder's `.exr` and `.hdr` files), sorted: the choices the
+/// viewer offers and the maps a report covers by default.
+pub fn maps_beside(map: &Path) -> Vec<PathBuf> {
+    let dir = match map.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut maps: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
+                .collect()
+        })
+        .unwrap_or_default();
+    maps.sort();
+    maps
+}

@@ -1,0 +1,84 @@
+//! Small helpers every command uses: loading a scene with context, thread pools, medians and
+//! the terminal progress bar.
+
+use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
+use precompute::progress::Progress;
+use precompute::scene::Scene;
+use std::path::Path;
+
+/// Loads a scene file, with the path in any error.
+pub fn load_scene(path: &Path) -> anyhow::Result<Scene> {
+    Scene::load(path).context("cannot load the scene")
+}
+
+/// Runs `f` on a rayon pool of `threads` threads (all cores when `None`).
+pub fn with_threads<T: Send>(
+    threads: Option<usize>,
+    f: impl FnOnce() -> T + Send,
+) -> anyhow::Result<T> {
+    match threads {
+        None => Ok(f()),
+        Some(0) => anyhow::bail!("--threads must be at least 1"),
+        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .context("cannot start the thread pool")?
+            .install(f)),
+    }
+}
+
+/// Median of a non-empty sample.
+pub fn median(mut xs: Vec<f64>) -> f64 {
+    xs.sort_by(f64::total_cmp);
+    let n = xs.len();
+    if n % 2 == 1 {
+        xs[n / 2]
+    } else {
+        0.5 * (xs[n / 2 - 1] + xs[n / 2])
+    }
+}
+
+/// A progress bar with ETA on a terminal; draws nothing when stderr is not a terminal.
+pub struct TerminalProgress(ProgressBar);
+
+impl TerminalProgress {
+    pub fn new(what: &str) -> Self {
+        let bar = ProgressBar::new(0);
+        bar.set_style(
+            ProgressStyle::with_template(&format!(
+                "{what} [{{bar:40}}] {{pos}}/{{len}} {{msg}} ({{elapsed}} elapsed, ETA {{eta}})"
+            ))
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        Self(bar)
+    }
+}
+
+impl Progress for TerminalProgress {
+    fn start(&self, total: u64) {
+        self.0.set_length(total);
+        self.0.set_position(0);
+    }
+    fn advance(&self, steps: u64) {
+        self.0.inc(steps);
+    }
+    fn status(&self, text: &str) {
+        self.0.set_message(text.to_owned());
+    }
+    fn finish(&self) {
+        self.0.finish_and_clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_and_even_samples() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), 2.5);
+    }
+}
