@@ -132,3 +132,79 @@ fn teapot_renders_match_the_committed_images_in_every_mode() {
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// One rotation rule everywhere: a map given with `--env` gets the scene's `rotation_deg`
+/// (-100° for the teapot) unless `--rotate` is given, in the GPU renderer and in the reference.
+#[test]
+fn a_map_given_on_the_command_line_gets_the_scene_rotation() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = scene("teapot.toml");
+    let scene = scene.to_str().unwrap();
+    let hall = repo().join("scenes/env/hall.exr");
+    let hall = hall.to_str().unwrap();
+    let out = hprt(
+        d,
+        &[
+            "bake",
+            scene,
+            "--samples",
+            "64",
+            "--bounces",
+            "1",
+            "-o",
+            "t.bake",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let size = ["--width", "96", "--height", "72"];
+    let render = |rotate: &[&str], exr: &str| {
+        let mut args = vec![
+            "render",
+            scene,
+            "--bake",
+            "t.bake",
+            "--env",
+            hall,
+            "--shadow-res",
+            "512",
+            "--backend",
+            "vulkan",
+            "-o",
+            "x.png",
+            "--exr",
+            exr,
+        ];
+        args.extend_from_slice(&size);
+        args.extend_from_slice(rotate);
+        let out = hprt(d, &args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        read_exr(&d.join(exr)).unwrap()
+    };
+    let default = render(&[], "default.exr");
+    assert_eq!(default, render(&["--rotate=-100"], "scene.exr"));
+    assert_ne!(default, render(&["--rotate=0"], "zero.exr"));
+
+    let reference = |rotate: &[&str], exr: &str| {
+        let mut args = vec![
+            "reference",
+            scene,
+            "--env",
+            hall,
+            "--spp",
+            "2",
+            "--bounces",
+            "0",
+            "-o",
+            exr,
+        ];
+        args.extend_from_slice(&["--width", "24", "--height", "18"]);
+        args.extend_from_slice(rotate);
+        let out = hprt(d, &args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        read_exr(&d.join(exr)).unwrap()
+    };
+    let default = reference(&[], "ref-default.exr");
+    assert_eq!(default, reference(&["--rotate=-100"], "ref-scene.exr"));
+    assert_ne!(default, reference(&["--rotate=0"], "ref-zero.exr"));
+}

@@ -13,6 +13,14 @@ pub enum ImageError {
     Read { path: PathBuf, message: String },
 }
 
+/// An image that could not be encoded (in memory, before anything is written).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot encode the {format}: {message}")]
+pub struct EncodeError {
+    pub format: &'static str,
+    pub message: String,
+}
+
 /// A linear RGB image, row-major from the top row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RgbImageF32 {
@@ -81,7 +89,7 @@ pub fn to_display_rgb8(image: &RgbImageF32, exposure: f32) -> Vec<u8> {
 }
 
 /// The PNG file of 8-bit RGB pixels, in memory.
-pub fn png_bytes(rgb: &[u8], width: usize, height: usize) -> Result<Vec<u8>, String> {
+pub fn png_bytes(rgb: &[u8], width: usize, height: usize) -> Result<Vec<u8>, EncodeError> {
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new(&mut bytes)
         .write_image(
@@ -90,7 +98,10 @@ pub fn png_bytes(rgb: &[u8], width: usize, height: usize) -> Result<Vec<u8>, Str
             height as u32,
             image::ExtendedColorType::Rgb8,
         )
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| EncodeError {
+            format: "PNG",
+            message: e.to_string(),
+        })?;
     Ok(bytes)
 }
 
@@ -105,7 +116,7 @@ pub fn write_png_rgb8(
         path: path.to_owned(),
         message,
     };
-    let bytes = png_bytes(rgb, width, height).map_err(error)?;
+    let bytes = png_bytes(rgb, width, height).map_err(|e| error(e.to_string()))?;
     write_atomic(path, &bytes).map_err(|e| error(e.to_string()))
 }
 
@@ -127,11 +138,12 @@ pub fn write_exr(path: &Path, image: &RgbImageF32) -> Result<(), ImageError> {
         path: path.to_owned(),
         message,
     };
-    write_atomic(path, &exr_bytes(image).map_err(error)?).map_err(|e| error(e.to_string()))
+    let bytes = exr_bytes(image).map_err(|e| error(e.to_string()))?;
+    write_atomic(path, &bytes).map_err(|e| error(e.to_string()))
 }
 
 /// The OpenEXR file of an image, in memory (32-bit float RGB, ZIP compression).
-pub fn exr_bytes(image: &RgbImageF32) -> Result<Vec<u8>, String> {
+pub fn exr_bytes(image: &RgbImageF32) -> Result<Vec<u8>, EncodeError> {
     use exr::prelude::*;
     let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
         let c = image.get(p.x(), p.y());
@@ -147,7 +159,10 @@ pub fn exr_bytes(image: &RgbImageF32) -> Result<Vec<u8>, String> {
     Image::from_layer(layer)
         .write()
         .to_buffered(&mut bytes)
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| EncodeError {
+            format: "EXR",
+            message: e.to_string(),
+        })?;
     Ok(bytes.into_inner())
 }
 

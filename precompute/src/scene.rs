@@ -1,5 +1,5 @@
 //! Scene files (TOML): objects with transforms and albedos, the camera, the default
-//! environment map and the default bake settings. See `docs/scene-format.md`.
+//! environment map and the default bake settings. The format is described in `scenes/README.md`.
 
 use crate::bake_settings::BakeSettings;
 use crate::camera::Camera;

@@ -200,8 +200,9 @@ impl CubeMap {
 }
 
 /// A map ready to be turned into cube maps of one face size at any rotation (every frame, for
-/// dynamic lighting): the map is first averaged down (keeping its integral) to about four
-/// equirectangular columns per cube texel, so the per-frame resampling reads little memory.
+/// dynamic lighting): the map is first averaged down by powers of two (keeping its integral)
+/// to one to two equirectangular columns per cube texel along the equator (`4 × face size`
+/// texels around it), so the per-frame resampling reads little memory.
 pub struct CubeSource {
     map: EnvMap,
     resampler: CubeResampler,

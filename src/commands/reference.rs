@@ -93,8 +93,7 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
         let progress = TerminalProgress::new("rendering rows");
         reference::render(&scene.geometry, &bvh, &light, &camera, &settings, &progress)
     })?;
-    let exr =
-        exr_bytes(&image.radiance).map_err(|m| anyhow::anyhow!("cannot encode the EXR: {m}"))?;
+    let exr = exr_bytes(&image.radiance)?;
     output
         .commit(&exr)
         .with_context(|| format!("cannot write {}", args.output.display()))?;

@@ -93,13 +93,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         &to_display_rgb8(&image, exposure),
         image.width,
         image.height,
-    )
-    .map_err(|m| anyhow::anyhow!("cannot encode the PNG: {m}"))?;
+    )?;
     output
         .commit(&png)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     if let Some(exr) = exr_output {
-        let bytes = exr_bytes(&image).map_err(|m| anyhow::anyhow!("cannot encode the EXR: {m}"))?;
+        let bytes = exr_bytes(&image)?;
         exr.commit(&bytes).context("cannot write the EXR")?;
     }
     println!(

@@ -74,7 +74,9 @@ pub fn heat_map(
         bar.draw(&Text::new(title.to_owned(), (0, 4), style))?;
         root.present()?;
     }
-    precompute::image_io::png_bytes(&rgb, w as usize, h as usize).map_err(anyhow::Error::msg)
+    Ok(precompute::image_io::png_bytes(
+        &rgb, w as usize, h as usize,
+    )?)
 }
 
 /// Tick values 1, 2, 5 × 10^k inside `[low, high]`: a log axis shows only whole decades

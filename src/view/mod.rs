@@ -1,5 +1,10 @@
 //! `hprt view`: the real-time viewer (winit + egui). The lighting is decomposed again every
 //! frame it changes, as in the thesis' dynamic-lighting case.
+//!
+//! The [`App`] is split by concern: the bake ([`BakeState`]), the environment's lighting
+//! ([`LightingState`]), the window and its GPU ([`WindowState`]), mouse input
+//! ([`InputState`]), the panel ([`ui::PanelState`]) and a script ([`ScriptState`]); the panel
+//! edits only the [`ViewSettings`].
 
 mod orbit;
 mod script;
@@ -18,12 +23,13 @@ use precompute::progress::SharedProgress;
 use precompute::scene::Scene;
 use runtime::lighting::lights_indirect_default;
 use runtime::render::{Backend, RenderMode, Renderer, ShadowSettings};
-use runtime::{DecomposeMode, Decomposition, EnvironmentLighting};
+use runtime::{DecomposeMode, DecomposeSettings, Decomposition, EnvironmentLighting};
 use settings::ViewSettings;
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
+use ui::{BakeStatus, PanelAction, PanelInfo, PanelState};
 use window::WindowGpu;
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -38,7 +44,7 @@ pub struct ViewArgs {
     /// to make one).
     #[arg(long)]
     pub bake: Option<PathBuf>,
-    /// Environment map (default: the scene's).
+    /// Environment map (default: the scene's); it gets the scene's rotation_deg.
     #[arg(long)]
     pub env: Option<PathBuf>,
     /// Graphics backend: auto, vulkan or gl.
@@ -54,54 +60,83 @@ pub struct ViewArgs {
     pub script: Option<PathBuf>,
 }
 
-/// A bake running in the background for the viewer.
+/// The scene's bake: loaded, being made in the background, or missing.
+struct BakeState {
+    path: PathBuf,
+    transfer: Option<Arc<Transfer>>,
+    job: Option<BakeJob>,
+}
+
+/// A bake running in the background.
 struct BakeJob {
     progress: Arc<SharedProgress>,
     result: std::sync::mpsc::Receiver<anyhow::Result<Transfer>>,
 }
 
-/// Everything the UI shows about the last decomposition.
+/// The environment map as lighting, and the settings it was last turned into lighting for.
 #[derive(Default)]
-pub struct Stats {
-    pub frame_ms: VecDeque<f64>,
-    pub decomposition_ms: f64,
-    pub decomposition: Option<Decomposition>,
-    pub adapter: String,
-    pub message: String,
-    pub panels: Vec<String>,
+struct LightingState {
+    environment: Option<EnvironmentLighting>,
+    lit_for: Option<ViewSettings>,
+    decomposition: Option<Decomposition>,
+    decomposition_ms: f64,
 }
 
-pub struct App {
-    scene: Scene,
-    bake_path: PathBuf,
-    transfer: Option<Arc<Transfer>>,
-    bake_job: Option<BakeJob>,
+/// The window, its GPU and what is drawn in it.
+struct WindowState {
     backend: Backend,
+    /// Requested, then current, window size in pixels.
     size: (u32, u32),
-    settings: ViewSettings,
-    /// Settings the lighting was last computed for.
-    lit_for: Option<(ViewSettings, usize)>,
-    env_path_text: String,
-    env_choices: Vec<PathBuf>,
-    environment: Option<EnvironmentLighting>,
-    orbit: Orbit,
-    initial_orbit: Orbit,
     window: Option<Arc<Window>>,
     gpu: Option<WindowGpu>,
     renderer: Option<Renderer>,
     egui_ctx: egui::Context,
     egui_state: Option<egui_winit::State>,
-    thumbnail: Option<egui::TextureHandle>,
-    thumbnail_for: Option<(PathBuf, i32)>,
-    stats: Stats,
-    last_frame: Option<Instant>,
+}
+
+/// The camera and the mouse.
+struct InputState {
+    orbit: Orbit,
+    initial_orbit: Orbit,
     drag: Option<(MouseButton, (f64, f64))>,
     cursor: (f64, f64),
-    script: VecDeque<script::Command>,
-    script_wait: u32,
+}
+
+/// Commands of `--script` still to run.
+#[derive(Default)]
+struct ScriptState {
+    commands: VecDeque<script::Command>,
+    /// Frames to wait before the next command.
+    wait: u32,
+}
+
+/// Timings and messages the panel and the scripted state report.
+#[derive(Default)]
+struct Stats {
+    frame_ms: VecDeque<f64>,
+    adapter: String,
+    message: String,
     frames: u64,
-    /// Width of the control panel in pixels (the scene fills the rest of the window).
-    panel_px: u32,
+    last_frame: Option<Instant>,
+}
+
+impl Stats {
+    fn median_frame_ms(&self) -> Option<f64> {
+        (!self.frame_ms.is_empty()).then(|| median(self.frame_ms.iter().copied().collect()))
+    }
+}
+
+pub struct App {
+    scene: Scene,
+    settings: ViewSettings,
+    env_choices: Vec<PathBuf>,
+    bake: BakeState,
+    lighting: LightingState,
+    window: WindowState,
+    input: InputState,
+    panel: PanelState,
+    script: ScriptState,
+    stats: Stats,
     error: Option<anyhow::Error>,
 }
 
@@ -121,15 +156,24 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
     check_display()?;
     let scene = load_scene(&args.scene)?;
     let bake_settings = scene.bake;
-    let (bake_path, transfer) = match &args.bake {
-        Some(path) => {
-            let transfer = bake_cache::load_bake(&scene, path, None)?;
-            (path.clone(), Some(Arc::new(transfer)))
-        }
+    let bake = match &args.bake {
+        Some(path) => BakeState {
+            transfer: Some(Arc::new(bake_cache::load_bake(&scene, path, None)?)),
+            path: path.clone(),
+            job: None,
+        },
         None => match bake_cache::load_cached(&scene, &bake_settings) {
-            Some((path, transfer)) => (path, Some(Arc::new(transfer))),
+            Some((path, transfer)) => BakeState {
+                path,
+                transfer: Some(Arc::new(transfer)),
+                job: None,
+            },
             // Offered in the window, with progress.
-            None => (bake_cache::bake_path(&scene, &bake_settings), None),
+            None => BakeState {
+                path: bake_cache::bake_path(&scene, &bake_settings),
+                transfer: None,
+                job: None,
+            },
         },
     };
     let env = match (&args.env, &scene.environment) {
@@ -140,8 +184,7 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
             scene.path.display()
         ),
     };
-    let rotation = scene_rotation(&scene, None);
-    let script = match &args.script {
+    let commands = match &args.script {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("cannot read {}", path.display()))?;
@@ -149,22 +192,23 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         }
         None => VecDeque::new(),
     };
-    let env_choices = maps_beside(&env);
-    let order = transfer
+    let order = bake
+        .transfer
         .as_ref()
         .map_or(bake_settings.order, |t| t.settings.order);
     let orbit = Orbit::from_camera(&scene.camera);
+    let decompose_mode = DecomposeMode::Consistent;
     let settings = ViewSettings {
         env: env.clone(),
-        rotation_deg: rotation,
+        rotation_deg: scene_rotation(&scene, None),
         animate: false,
         animate_speed: 20.0,
         mode: RenderMode::Hybrid,
-        decompose_mode: DecomposeMode::Consistent,
-        threshold: runtime::DecomposeSettings::default().threshold,
+        decompose_mode,
+        threshold: DecomposeSettings::default().threshold,
         order,
         shadow: ShadowSettings::default(),
-        lights_indirect: lights_indirect_default(DecomposeMode::Consistent),
+        lights_indirect: lights_indirect_default(decompose_mode),
         exposure: 1.0,
     };
     let event_loop = EventLoop::new().map_err(|e| {
@@ -173,34 +217,29 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         )
     })?;
     let mut app = App {
+        env_choices: maps_beside(&env),
+        panel: PanelState::new(&env),
         scene,
-        bake_path,
-        transfer,
-        bake_job: None,
-        backend: args.backend,
-        size: (args.width, args.height),
-        env_path_text: env.display().to_string(),
         settings,
-        lit_for: None,
-        env_choices,
-        environment: None,
-        orbit,
-        initial_orbit: orbit,
-        window: None,
-        gpu: None,
-        renderer: None,
-        egui_ctx: egui::Context::default(),
-        egui_state: None,
-        thumbnail: None,
-        thumbnail_for: None,
+        bake,
+        lighting: LightingState::default(),
+        window: WindowState {
+            backend: args.backend,
+            size: (args.width, args.height),
+            window: None,
+            gpu: None,
+            renderer: None,
+            egui_ctx: egui::Context::default(),
+            egui_state: None,
+        },
+        input: InputState {
+            orbit,
+            initial_orbit: orbit,
+            drag: None,
+            cursor: (0.0, 0.0),
+        },
+        script: ScriptState { commands, wait: 0 },
         stats: Stats::default(),
-        last_frame: None,
-        drag: None,
-        cursor: (0.0, 0.0),
-        script,
-        script_wait: 0,
-        frames: 0,
-        panel_px: 0,
         error: None,
     };
     app.load_environment();
@@ -230,11 +269,11 @@ impl App {
                     return;
                 }
             };
-        if self.settings.exposure == 1.0 && self.environment.is_none() {
+        if self.settings.exposure == 1.0 && self.lighting.environment.is_none() {
             self.settings.exposure = default_exposure(&loaded.map);
         }
-        self.lit_for = None;
-        self.thumbnail_for = None;
+        self.lighting.lit_for = None;
+        self.panel.environment_changed();
         self.stats.message = if loaded.sanitized > 0 {
             format!(
                 "{} texels with negative or invalid radiance set to 0",
@@ -243,43 +282,43 @@ impl App {
         } else {
             String::new()
         };
-        if let Some(r) = self.renderer.as_mut() {
+        if let Some(r) = self.window.renderer.as_mut() {
             r.set_environment(lighting.map(), self.settings.rotation_deg);
-            if let Some(gpu) = self.gpu.as_mut() {
+            if let Some(gpu) = self.window.gpu.as_mut() {
                 gpu.renderer_changed();
             }
         }
-        self.environment = Some(lighting);
+        self.lighting.environment = Some(lighting);
     }
 
     fn start_bake(&mut self) {
         let scene = self.scene.clone();
         let progress = Arc::new(SharedProgress::default());
-        let bar = progress.clone();
+        let shared = progress.clone();
         let (sender, receiver) = std::sync::mpsc::channel();
         std::thread::spawn(move || {
-            let result = bake_cache::bake_into_cache(&scene, &scene.bake, bar.as_ref())
+            let result = bake_cache::bake_into_cache(&scene, &scene.bake, shared.as_ref())
                 .map(|(_, transfer, _)| transfer);
             let _ = sender.send(result);
         });
-        self.bake_job = Some(BakeJob {
+        self.bake.job = Some(BakeJob {
             progress,
             result: receiver,
         });
     }
 
     fn poll_bake(&mut self) {
-        let Some(job) = &self.bake_job else { return };
+        let Some(job) = &self.bake.job else { return };
         match job.result.try_recv() {
             Ok(Ok(transfer)) => {
                 self.settings.order = transfer.settings.order;
-                self.transfer = Some(Arc::new(transfer));
-                self.bake_job = None;
-                self.stats.message = format!("baked into {}", self.bake_path.display());
+                self.bake.transfer = Some(Arc::new(transfer));
+                self.bake.job = None;
+                self.stats.message = format!("baked into {}", self.bake.path.display());
             }
             Ok(Err(e)) => {
                 self.stats.message = format!("the bake failed: {e:#}");
-                self.bake_job = None;
+                self.bake.job = None;
             }
             Err(_) => {}
         }
@@ -287,29 +326,29 @@ impl App {
 
     /// The decomposition (and the renderer's lighting) when anything it depends on changed.
     fn update_lighting(&mut self) -> anyhow::Result<()> {
-        let (Some(env), Some(renderer)) = (self.environment.as_mut(), self.renderer.as_mut())
-        else {
+        let (Some(env), Some(renderer)) = (
+            self.lighting.environment.as_mut(),
+            self.window.renderer.as_mut(),
+        ) else {
             return Ok(());
         };
-        let key = (self.settings.clone(), 0);
-        let needs = match &self.lit_for {
-            Some((previous, _)) => {
-                previous.rotation_deg != key.0.rotation_deg
-                    || previous.decompose_settings() != key.0.decompose_settings()
-                    || previous.mode != key.0.mode
-                    || previous.lights_indirect != key.0.lights_indirect
-                    || previous.env != key.0.env
+        renderer.set_shadow_settings(self.settings.shadow)?;
+        let needs = match &self.lighting.lit_for {
+            Some(previous) => {
+                previous.rotation_deg != self.settings.rotation_deg
+                    || previous.decompose_settings() != self.settings.decompose_settings()
+                    || previous.mode != self.settings.mode
+                    || previous.lights_indirect != self.settings.lights_indirect
+                    || previous.env != self.settings.env
             }
             None => true,
         };
-        renderer.set_shadow_settings(self.settings.shadow)?;
         if !needs {
             return Ok(());
         }
         env.set_settings(self.settings.decompose_settings())?;
         env.set_rotation(self.settings.rotation_deg);
         let frame = env.frame(self.settings.mode, Some(self.settings.lights_indirect));
-        self.stats.decomposition_ms = frame.ms;
         // The panel shows the lights in every mode, plain PRT included.
         let decomposition = match frame.decomposition {
             Some(d) => d,
@@ -317,19 +356,21 @@ impl App {
         };
         renderer.set_lighting(&frame.lighting)?;
         renderer.set_environment_rotation(self.settings.rotation_deg);
-        self.stats.decomposition = Some(decomposition);
-        self.lit_for = Some(key);
+        self.lighting.decomposition = Some(decomposition);
+        self.lighting.decomposition_ms = frame.ms;
+        self.lighting.lit_for = Some(self.settings.clone());
         Ok(())
     }
 
     fn ensure_renderer(&mut self) -> anyhow::Result<()> {
-        if self.renderer.is_some() {
+        if self.window.renderer.is_some() {
             return Ok(());
         }
-        let (Some(gpu), Some(transfer)) = (self.gpu.as_mut(), self.transfer.as_ref()) else {
+        let (Some(gpu), Some(transfer)) = (self.window.gpu.as_mut(), self.bake.transfer.as_ref())
+        else {
             return Ok(());
         };
-        let camera = self.orbit.camera(gpu.config.width, gpu.config.height);
+        let camera = self.input.orbit.camera(gpu.config.width, gpu.config.height);
         let mut renderer = Renderer::new(
             &gpu.gpu,
             &self.scene.geometry,
@@ -337,31 +378,35 @@ impl App {
             &camera,
             self.settings.shadow,
         )?;
-        if let Some(env) = &self.environment {
+        if let Some(env) = &self.lighting.environment {
             renderer.set_environment(env.map(), self.settings.rotation_deg);
         }
         gpu.renderer_changed();
-        self.renderer = Some(renderer);
-        self.lit_for = None;
+        self.window.renderer = Some(renderer);
+        self.lighting.lit_for = None;
         Ok(())
     }
 
+    fn reset_view(&mut self) {
+        self.input.orbit = self.input.initial_orbit;
+    }
+
     fn run_script(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<()> {
-        if self.script_wait > 0 {
-            self.script_wait -= 1;
+        if self.script.wait > 0 {
+            self.script.wait -= 1;
             return Ok(());
         }
-        while let Some(command) = self.script.pop_front() {
+        while let Some(command) = self.script.commands.pop_front() {
             use script::Command as C;
             match command {
                 C::Wait(n) => {
-                    self.script_wait = n;
+                    self.script.wait = n;
                     return Ok(());
                 }
-                C::Orbit(dx, dy) => self.orbit.rotate(dx, dy),
-                C::Pan(dx, dy) => self.orbit.pan(dx, dy, self.size.1),
-                C::Zoom(steps) => self.orbit.zoom(steps),
-                C::Reset => self.orbit = self.initial_orbit,
+                C::Orbit(dx, dy) => self.input.orbit.rotate(dx, dy),
+                C::Pan(dx, dy) => self.input.orbit.pan(dx, dy, self.window.size.1),
+                C::Zoom(steps) => self.input.orbit.zoom(steps),
+                C::Reset => self.reset_view(),
                 C::Set(name, value) => {
                     self.settings.set(&name, &value)?;
                     if name == "env" {
@@ -389,18 +434,20 @@ impl App {
 
     fn current_camera(&self) -> precompute::camera::Camera {
         let (w, h) = self
+            .window
             .gpu
             .as_ref()
-            .map_or(self.size, |g| (g.config.width, g.config.height));
-        self.orbit
-            .camera(w.saturating_sub(self.panel_px).max(16), h)
+            .map_or(self.window.size, |g| (g.config.width, g.config.height));
+        self.input
+            .orbit
+            .camera(w.saturating_sub(self.panel.width_px).max(16), h)
     }
 
     pub fn command_line(&self, output: &Path) -> String {
         self.settings
             .render_command(
                 &self.scene.path,
-                &self.bake_path,
+                &self.bake.path,
                 &self.current_camera(),
                 output,
             )
@@ -412,6 +459,7 @@ impl App {
 
     fn save_screenshot(&mut self, path: &Path) -> anyhow::Result<()> {
         let renderer = self
+            .window
             .renderer
             .as_ref()
             .context("nothing rendered yet (no bake)")?;
@@ -423,11 +471,11 @@ impl App {
     }
 
     fn save_window_screenshot(&mut self, path: &Path) -> anyhow::Result<()> {
-        let window = self.window.clone().context("no window")?;
+        let window = self.window.window.clone().context("no window")?;
         let (paint, screen) = self.run_ui(&window);
-        let gpu = self.gpu.as_mut().context("no window")?;
+        let gpu = self.window.gpu.as_mut().context("no window")?;
         let (w, h, rgb) = gpu.capture(
-            self.renderer.as_ref(),
+            self.window.renderer.as_ref(),
             self.settings.exposure,
             &paint,
             &screen,
@@ -437,27 +485,69 @@ impl App {
     }
 
     fn state_json(&self) -> serde_json::Value {
-        let times: Vec<f64> = self.stats.frame_ms.iter().copied().collect();
-        let frame_ms = if times.is_empty() { 0.0 } else { median(times) };
+        let frame_ms = self.stats.median_frame_ms().unwrap_or(0.0);
         let lights: Vec<f32> = self
-            .stats
+            .lighting
             .decomposition
             .as_ref()
             .map(|d| d.lights.iter().map(|l| l.share).collect())
             .unwrap_or_default();
+        let camera = self.current_camera();
         serde_json::json!({
             "adapter": self.stats.adapter,
-            "frames": self.frames,
+            "frames": self.stats.frames,
             "frame_ms": frame_ms,
             "fps": if frame_ms > 0.0 { 1000.0 / frame_ms } else { 0.0 },
-            "decomposition_ms": self.stats.decomposition_ms,
+            "decomposition_ms": self.lighting.decomposition_ms,
             "light_shares": lights,
-            "panels": self.stats.panels,
+            "panels": self.panel.headings,
             "mode": self.settings.mode.name(),
             "rotation_deg": self.settings.rotation_deg,
-            "window": [self.current_camera().width, self.current_camera().height],
+            "window": [camera.width, camera.height],
             "command": self.command_line(Path::new("render.png")),
         })
+    }
+
+    /// What the panel shows.
+    fn panel_info(&self, command_line: String) -> PanelInfo<'_> {
+        let bake = match (&self.bake.transfer, &self.bake.job) {
+            (Some(t), _) => BakeStatus::Ready {
+                order: t.settings.order,
+            },
+            (None, Some(job)) => BakeStatus::Baking(job.progress.fraction()),
+            (None, None) => BakeStatus::Missing {
+                path: &self.bake.path,
+                settings: self.scene.bake,
+            },
+        };
+        PanelInfo {
+            bake,
+            environment: self.lighting.environment.as_ref().map(|e| e.map()),
+            env_choices: &self.env_choices,
+            decomposition: self.lighting.decomposition.as_ref(),
+            frame_ms: self.stats.median_frame_ms(),
+            decomposition_ms: self.lighting.decomposition_ms,
+            adapter: &self.stats.adapter,
+            message: &self.stats.message,
+            command_line,
+        }
+    }
+
+    fn apply(&mut self, action: PanelAction) {
+        match action {
+            PanelAction::LoadEnvironment(path) => {
+                self.settings.env = path;
+                self.load_environment();
+            }
+            PanelAction::StartBake => self.start_bake(),
+            PanelAction::ResetView => self.reset_view(),
+            PanelAction::SaveScreenshot => {
+                let name = format!("hprt-{}-{}.png", self.scene.name, self.stats.frames);
+                if let Err(e) = self.save_screenshot(Path::new(&name)) {
+                    self.stats.message = format!("screenshot failed: {e:#}");
+                }
+            }
+        }
     }
 
     fn run_ui(
@@ -465,18 +555,34 @@ impl App {
         window: &Window,
     ) -> (Vec<egui::ClippedPrimitive>, egui_wgpu::ScreenDescriptor) {
         let state = self
+            .window
             .egui_state
             .as_mut()
             .expect("egui is set up with the window");
         let input = state.take_egui_input(window);
-        let ctx = self.egui_ctx.clone();
-        let mut output = ctx.run_ui(input, |ui| ui::panel(self, ui));
+        let ctx = self.window.egui_ctx.clone();
+        // The panel edits copies of the settings and its own state while it reads the rest.
+        let command_line = self.command_line(Path::new("render.png"));
+        let mut settings = self.settings.clone();
+        let mut panel = std::mem::take(&mut self.panel);
+        let info = self.panel_info(command_line);
+        let mut actions = Vec::new();
+        let mut output = ctx.run_ui(input, |ui| {
+            actions = ui::panel(ui, &mut settings, &mut panel, &info);
+        });
+        drop(info);
+        self.settings = settings;
+        self.panel = panel;
+        for action in actions {
+            self.apply(action);
+        }
         let state = self
+            .window
             .egui_state
             .as_mut()
             .expect("egui is set up with the window");
         state.handle_platform_output(window, output.platform_output);
-        let gpu = self.gpu.as_mut().expect("a window has its GPU");
+        let gpu = self.window.gpu.as_mut().expect("a window has its GPU");
         for (id, deltas) in &output.textures_delta.set {
             for delta in deltas {
                 gpu.egui
@@ -498,7 +604,7 @@ impl App {
 
     fn frame(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<()> {
         let now = Instant::now();
-        if let Some(last) = self.last_frame {
+        if let Some(last) = self.stats.last_frame {
             let dt = now.duration_since(last).as_secs_f64();
             self.stats.frame_ms.push_back(dt * 1e3);
             if self.stats.frame_ms.len() > 60 {
@@ -510,23 +616,23 @@ impl App {
                     .rem_euclid(360.0);
             }
         }
-        self.last_frame = Some(now);
+        self.stats.last_frame = Some(now);
         self.poll_bake();
         self.run_script(event_loop)?;
         self.ensure_renderer()?;
         self.update_lighting()?;
         let camera = self.current_camera();
-        if let Some(renderer) = self.renderer.as_mut() {
+        if let Some(renderer) = self.window.renderer.as_mut() {
             if renderer.set_camera(&camera)?
-                && let Some(gpu) = self.gpu.as_mut()
+                && let Some(gpu) = self.window.gpu.as_mut()
             {
                 gpu.renderer_changed();
             }
             renderer.render()?;
         }
-        let window = self.window.clone().context("no window")?;
+        let window = self.window.window.clone().context("no window")?;
         let (paint, screen) = self.run_ui(&window);
-        let gpu = self.gpu.as_mut().context("no window")?;
+        let gpu = self.window.gpu.as_mut().context("no window")?;
         let frame = match gpu.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(frame)
             | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
@@ -542,7 +648,7 @@ impl App {
         gpu.record(
             &mut encoder,
             &view,
-            self.renderer.as_ref(),
+            self.window.renderer.as_ref(),
             self.settings.exposure,
             &paint,
             &screen,
@@ -550,63 +656,77 @@ impl App {
         gpu.gpu.queue.submit([encoder.finish()]);
         window.pre_present_notify();
         gpu.gpu.queue.present(frame);
-        self.frames += 1;
+        self.stats.frames += 1;
         window.request_redraw();
         Ok(())
+    }
+
+    fn open_window(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<()> {
+        let (width, height) = self.window.size;
+        let attributes = Window::default_attributes()
+            .with_title(format!("hprt — {}", self.scene.name))
+            .with_inner_size(winit::dpi::PhysicalSize::new(width, height));
+        let window = Arc::new(
+            event_loop
+                .create_window(attributes)
+                .context("cannot create a window")?,
+        );
+        let descriptor = wgpu::InstanceDescriptor::new_with_display_handle(Box::new(
+            event_loop.owned_display_handle(),
+        ));
+        let gpu = WindowGpu::new(window.clone(), self.window.backend, descriptor)?;
+        self.stats.adapter = gpu.gpu.description().to_string();
+        println!("adapter: {}", self.stats.adapter);
+        self.window.egui_state = Some(egui_winit::State::new(
+            self.window.egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            None,
+        ));
+        self.window.gpu = Some(gpu);
+        self.window.window = Some(window.clone());
+        window.request_redraw();
+        Ok(())
+    }
+
+    fn mouse_moved(&mut self, x: f64, y: f64) {
+        let previous = self.input.cursor;
+        self.input.cursor = (x, y);
+        if let Some((button, _)) = self.input.drag {
+            let (dx, dy) = ((x - previous.0) as f32, (y - previous.1) as f32);
+            match button {
+                MouseButton::Left => self.input.orbit.rotate(dx, dy),
+                _ => self.input.orbit.pan(dx, dy, self.window.size.1),
+            }
+        }
     }
 }
 
 impl ApplicationHandler for App {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        if self.window.is_some() {
+        if self.window.window.is_some() {
             return;
         }
-        let attributes = Window::default_attributes()
-            .with_title(format!("hprt — {}", self.scene.name))
-            .with_inner_size(winit::dpi::PhysicalSize::new(self.size.0, self.size.1));
-        let result = (|| -> anyhow::Result<()> {
-            let window = Arc::new(
-                event_loop
-                    .create_window(attributes)
-                    .context("cannot create a window")?,
-            );
-            let descriptor = wgpu::InstanceDescriptor::new_with_display_handle(Box::new(
-                event_loop.owned_display_handle(),
-            ));
-            let gpu = WindowGpu::new(window.clone(), self.backend, descriptor)?;
-            self.stats.adapter = gpu.gpu.description().to_string();
-            println!("adapter: {}", self.stats.adapter);
-            self.egui_state = Some(egui_winit::State::new(
-                self.egui_ctx.clone(),
-                egui::ViewportId::ROOT,
-                &window,
-                Some(window.scale_factor() as f32),
-                None,
-                None,
-            ));
-            self.gpu = Some(gpu);
-            self.window = Some(window.clone());
-            window.request_redraw();
-            Ok(())
-        })();
-        if let Err(e) = result {
+        if let Err(e) = self.open_window(event_loop) {
             self.error = Some(e);
             event_loop.exit();
         }
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
-        let consumed = match (&mut self.egui_state, &self.window) {
+        let consumed = match (&mut self.window.egui_state, &self.window.window) {
             (Some(state), Some(window)) => state.on_window_event(window, &event).consumed,
             _ => false,
         };
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => {
-                if let Some(gpu) = self.gpu.as_mut() {
+                if let Some(gpu) = self.window.gpu.as_mut() {
                     gpu.resize(size.width, size.height);
                 }
-                self.size = (size.width.max(1), size.height.max(1));
+                self.window.size = (size.width.max(1), size.height.max(1));
             }
             WindowEvent::RedrawRequested => {
                 if let Err(e) = self.frame(event_loop) {
@@ -614,41 +734,28 @@ impl ApplicationHandler for App {
                     event_loop.exit();
                 }
             }
-            WindowEvent::CursorMoved { position, .. } => {
-                let previous = self.cursor;
-                self.cursor = (position.x, position.y);
-                if let Some((button, _)) = self.drag {
-                    let (dx, dy) = (
-                        (position.x - previous.0) as f32,
-                        (position.y - previous.1) as f32,
-                    );
-                    match button {
-                        MouseButton::Left => self.orbit.rotate(dx, dy),
-                        _ => self.orbit.pan(dx, dy, self.size.1),
-                    }
-                }
-            }
+            WindowEvent::CursorMoved { position, .. } => self.mouse_moved(position.x, position.y),
             WindowEvent::MouseInput { state, button, .. } if !consumed => match state {
-                ElementState::Pressed => self.drag = Some((button, self.cursor)),
-                ElementState::Released => self.drag = None,
+                ElementState::Pressed => self.input.drag = Some((button, self.input.cursor)),
+                ElementState::Released => self.input.drag = None,
             },
             WindowEvent::MouseInput {
                 state: ElementState::Released,
                 ..
-            } => self.drag = None,
+            } => self.input.drag = None,
             WindowEvent::MouseWheel { delta, .. } if !consumed => {
                 let steps = match delta {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
                 };
-                self.orbit.zoom(steps);
+                self.input.orbit.zoom(steps);
             }
             WindowEvent::KeyboardInput { event, .. }
                 if !consumed
                     && event.state == ElementState::Pressed
                     && event.logical_key == winit::keyboard::Key::Character("r".into()) =>
             {
-                self.orbit = self.initial_orbit;
+                self.reset_view();
             }
             _ => {}
         }

@@ -1,6 +1,7 @@
 //! What the viewer's panel controls, and the `hprt render` command line that reproduces it.
 
 use precompute::camera::Camera;
+use runtime::lighting::lights_indirect_default;
 use runtime::render::{RenderMode, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings};
 use std::path::{Path, PathBuf};
@@ -24,16 +25,18 @@ pub struct ViewSettings {
 
 impl ViewSettings {
     pub fn decompose_settings(&self) -> DecomposeSettings {
-        let defaults = DecomposeSettings::default();
         DecomposeSettings {
-            mode: self.decompose_mode,
-            order: self.order,
-            radius_deg: DecomposeSettings::default_radius(
-                self.decompose_mode,
-                defaults.smoothing_deg,
-            ),
             threshold: self.threshold,
-            ..defaults
+            ..DecomposeSettings::for_mode(self.decompose_mode, self.order)
+        }
+    }
+
+    /// Switches the decomposition mode; the lights' bounce light follows the mode's rule
+    /// ([`lights_indirect_default`]) until it is set again.
+    pub fn set_decompose_mode(&mut self, mode: DecomposeMode) {
+        if mode != self.decompose_mode {
+            self.decompose_mode = mode;
+            self.lights_indirect = lights_indirect_default(mode);
         }
     }
 
@@ -53,8 +56,8 @@ impl ViewSettings {
             "rotation" => self.rotation_deg = number()?,
             "animate" => self.animate = switch()?,
             "speed" => self.animate_speed = number()?,
-            "mode" => self.mode = value.parse().map_err(anyhow::Error::msg)?,
-            "decompose" => self.decompose_mode = value.parse().map_err(anyhow::Error::msg)?,
+            "mode" => self.mode = value.parse()?,
+            "decompose" => self.set_decompose_mode(value.parse()?),
             "threshold" => self.threshold = number()?,
             "order" => self.order = number()? as usize,
             "shadow_res" => self.shadow.resolution = number()? as u32,
@@ -163,6 +166,14 @@ mod tests {
             (12.5, RenderMode::Prt, false)
         );
         assert!(s.set("mode", "fancy").is_err());
+        // A decomposition mode brings its rule for the lights' bounce light.
+        s.set("decompose", "thesis").unwrap();
+        assert!(!s.lights_indirect);
+        s.set("lights_indirect", "on").unwrap();
+        s.set("decompose", "thesis").unwrap();
+        assert!(s.lights_indirect, "setting the same mode keeps a choice");
+        s.set("decompose", "consistent").unwrap();
+        assert!(s.lights_indirect);
         assert!(s.set("colour", "1").is_err());
         assert!(s.set("threshold", "x").is_err());
     }

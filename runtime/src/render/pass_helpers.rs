@@ -74,6 +74,26 @@ pub fn begin_pass<'e>(
     })
 }
 
+/// Primitives of the scene: triangles with both sides drawn (both sides of a triangle show
+/// its front, CONVENTIONS.md).
+pub fn two_sided_triangles() -> wgpu::PrimitiveState {
+    wgpu::PrimitiveState {
+        cull_mode: None,
+        ..Default::default()
+    }
+}
+
+/// A depth test that keeps the nearest surface, with `bias` added to the depth written.
+pub fn nearest_depth(bias: wgpu::DepthBiasState) -> Option<wgpu::DepthStencilState> {
+    Some(wgpu::DepthStencilState {
+        format: super::targets::DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias,
+    })
+}
+
 /// A buffer the CPU writes each frame (`COPY_DST` added to `usage`).
 pub fn writable_buffer(
     device: &wgpu::Device,

@@ -2,11 +2,11 @@
 //! depth, normals and albedo for the light pass (`shaders/geometry.wgsl`).
 
 use super::gpu_scene::{self, GpuScene};
-use super::pass_helpers::{begin_pass, color_attachment, depth_attachment};
-use super::shaders::Shader;
-use super::targets::{
-    ALBEDO_FORMAT, COLOR_FORMAT, DEPTH_COPY_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, Targets,
+use super::pass_helpers::{
+    begin_pass, color_attachment, depth_attachment, nearest_depth, two_sided_triangles,
 };
+use super::shaders::Shader;
+use super::targets::{ALBEDO_FORMAT, COLOR_FORMAT, DEPTH_COPY_FORMAT, NORMAL_FORMAT, Targets};
 
 pub struct PrtPass {
     pipeline: wgpu::RenderPipeline,
@@ -28,18 +28,8 @@ impl PrtPass {
                     Some(gpu_scene::RADIANCE_LAYOUT),
                 ],
             },
-            primitive: wgpu::PrimitiveState {
-                // Both sides of a triangle show its front (CONVENTIONS.md).
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
+            primitive: two_sided_triangles(),
+            depth_stencil: nearest_depth(Default::default()),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,

@@ -4,7 +4,9 @@
 
 use super::RenderError;
 use super::gpu_scene::{self, GpuScene};
-use super::pass_helpers::{begin_pass, color_attachment, depth_attachment, texture};
+use super::pass_helpers::{
+    begin_pass, color_attachment, depth_attachment, nearest_depth, texture, two_sided_triangles,
+};
 use super::shaders::Shader;
 use super::targets::{DEPTH_COPY_FORMAT, DEPTH_FORMAT};
 use glam::{Mat4, Vec3};
@@ -211,21 +213,12 @@ impl ShadowMaps {
                 compilation_options: Default::default(),
                 buffers: &[Some(gpu_scene::VERTEX_LAYOUT)],
             },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                // Slope-scaled bias against shadow acne on surfaces grazing the light.
-                bias: wgpu::DepthBiasState {
-                    constant: 2,
-                    slope_scale: 2.0,
-                    clamp: 0.0,
-                },
+            primitive: two_sided_triangles(),
+            // Slope-scaled bias against shadow acne on surfaces grazing the light.
+            depth_stencil: nearest_depth(wgpu::DepthBiasState {
+                constant: 2,
+                slope_scale: 2.0,
+                clamp: 0.0,
             }),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
