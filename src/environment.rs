@@ -1,14 +1,23 @@
 //! Which environment map lights a scene, loaded with context, and what follows from the map
 //! (its default exposure, the maps beside it).
 
-use anyhow::Context;
 use precompute::envmap::{self, EnvMap, Layout, LoadedEnvMap};
 use precompute::scene::Scene;
 use std::path::{Path, PathBuf};
 
-/// Loads a map with the file named in any error.
+/// Loads a map with the file named in any error (and the option that names a layout, when
+/// the layout is what failed).
 pub fn load_map(path: &Path, layout: Option<Layout>) -> anyhow::Result<LoadedEnvMap> {
-    envmap::load(path, layout).context("cannot load the environment map")
+    envmap::load(path, layout).map_err(|e| {
+        let context = match e {
+            envmap::EnvMapError::Layout { .. } => format!(
+                "cannot load the environment map; name its layout with --layout ({})",
+                Layout::ALL.map(Layout::name).join(", ")
+            ),
+            _ => "cannot load the environment map".to_owned(),
+        };
+        anyhow::Error::new(e).context(context)
+    })
 }
 
 /// The environment a command lights a scene with.

@@ -58,6 +58,34 @@ fn bakes_a_small_scene_and_reports_throughput() {
     );
     let (header, _) = precompute::bakefile::read(&dir.path().join("out.bake")).unwrap();
     assert_eq!((header.settings.order, header.settings.samples), (2, 16));
+    assert!(!stderr(&out).contains("GPU"), "{}", stderr(&out));
+}
+
+/// Orders above the GPU's are baked (the CPU code uses them) with a warning at bake time,
+/// not an error at render time only.
+#[test]
+fn bakes_beyond_the_gpu_order_warn_that_they_are_cpu_only() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("quad.obj"), TRIANGLE_OBJ).unwrap();
+    let scene = write_scene(dir.path(), "s.toml", &obj_object("quad.obj"));
+    let order = (runtime::render::MAX_GPU_ORDER + 1).to_string();
+    let out = hprt(
+        dir.path(),
+        &[
+            "bake",
+            scene.to_str().unwrap(),
+            "--order",
+            &order,
+            "-o",
+            "out.bake",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("above the GPU renderer's maximum"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]

@@ -107,7 +107,7 @@ pub fn load(path: &Path, layout: Option<Layout>) -> Result<LoadedEnvMap, EnvMapE
                     path: path.to_owned(),
                     message: format!(
                         "cannot infer the layout of a {}x{} image (2:1 equirect, 4:3 or 3:4 \
-                         cross, 1:1 probe); pass --layout",
+                         cross, 1:1 probe); give its layout explicitly",
                         image.width, image.height
                     ),
                 }

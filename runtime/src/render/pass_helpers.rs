@@ -83,10 +83,14 @@ pub fn two_sided_triangles() -> wgpu::PrimitiveState {
     }
 }
 
-/// A depth test that keeps the nearest surface, with `bias` added to the depth written.
-pub fn nearest_depth(bias: wgpu::DepthBiasState) -> Option<wgpu::DepthStencilState> {
+/// A depth test into a `format` target that keeps the nearest surface, with `bias` added to
+/// the depth written.
+pub fn nearest_depth(
+    format: wgpu::TextureFormat,
+    bias: wgpu::DepthBiasState,
+) -> Option<wgpu::DepthStencilState> {
     Some(wgpu::DepthStencilState {
-        format: super::targets::DEPTH_FORMAT,
+        format,
         depth_write_enabled: Some(true),
         depth_compare: Some(wgpu::CompareFunction::Less),
         stencil: Default::default(),

@@ -6,7 +6,9 @@ use super::pass_helpers::{
     begin_pass, color_attachment, depth_attachment, nearest_depth, two_sided_triangles,
 };
 use super::shaders::Shader;
-use super::targets::{ALBEDO_FORMAT, COLOR_FORMAT, DEPTH_COPY_FORMAT, NORMAL_FORMAT, Targets};
+use super::targets::{
+    ALBEDO_FORMAT, COLOR_FORMAT, DEPTH_COPY_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, Targets,
+};
 
 pub struct PrtPass {
     pipeline: wgpu::RenderPipeline,
@@ -29,7 +31,7 @@ impl PrtPass {
                 ],
             },
             primitive: two_sided_triangles(),
-            depth_stencil: nearest_depth(Default::default()),
+            depth_stencil: nearest_depth(DEPTH_FORMAT, Default::default()),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,

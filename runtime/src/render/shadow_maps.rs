@@ -215,11 +215,14 @@ impl ShadowMaps {
             },
             primitive: two_sided_triangles(),
             // Slope-scaled bias against shadow acne on surfaces grazing the light.
-            depth_stencil: nearest_depth(wgpu::DepthBiasState {
-                constant: 2,
-                slope_scale: 2.0,
-                clamp: 0.0,
-            }),
+            depth_stencil: nearest_depth(
+                DEPTH_FORMAT,
+                wgpu::DepthBiasState {
+                    constant: 2,
+                    slope_scale: 2.0,
+                    clamp: 0.0,
+                },
+            ),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,
