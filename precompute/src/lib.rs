@@ -15,6 +15,7 @@ pub mod quadrature;
 pub mod reference;
 pub mod sampling;
 pub mod sh;
+pub mod sh_rotation;
 
 pub use color::{Rgb, luminance};
 pub mod atomic_file;

@@ -1,8 +1,9 @@
 //! Per-frame decomposition cost (one thread): `cargo bench -p runtime --bench decompose`.
-//! Targets: 6×64×64 under 2 ms, 6×256×256 under 15 ms.
+//! Targets: 6×64×64 under 2 ms, 6×256×256 under 15 ms; turning a decomposed map (SH rotation
+//! of the SH part and the lights) well under 0.05 ms at order 5.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer};
+use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer, EnvironmentLighting};
 use std::path::Path;
 
 fn bench(c: &mut Criterion) {
@@ -34,6 +35,17 @@ fn bench(c: &mut Criterion) {
         let mut cube = source.cube(0.0);
         group.bench_function(format!("{name}/{face}/resample-rotated"), |b| {
             b.iter(|| source.cube_into(0.3, &mut cube))
+        });
+        let mut lighting =
+            EnvironmentLighting::new(&map, DecomposeSettings::default()).expect("valid settings");
+        lighting.decompose();
+        let mut angle = 0.0f32;
+        group.bench_function(format!("{name}/{face}/rotate-decomposition"), |b| {
+            b.iter(|| {
+                angle += 1.0;
+                lighting.set_rotation(angle);
+                lighting.decompose()
+            })
         });
     }
     group.finish();

@@ -9,7 +9,7 @@ use precompute::envmap::Layout;
 use precompute::image_io::write_png_rgb8;
 use precompute::{Rgb, luminance};
 use runtime::decompose::visualize::{decomposition_picture, describe};
-use runtime::{DecomposeMode, DecomposeSettings, Decomposition, EnvironmentLighting};
+use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -76,17 +76,15 @@ pub fn run(args: DecomposeArgs) -> anyhow::Result<()> {
     }
     let loaded = load_map(&args.env, args.layout)?;
     let mut lighting = EnvironmentLighting::new(&loaded.map, settings.clone())?;
-    lighting.set_rotation(args.rotate);
-    lighting.cube();
     let mut times = Vec::with_capacity(args.repeat);
-    let mut result: Option<Decomposition> = None;
     for _ in 0..args.repeat {
         let start = Instant::now();
-        let d = lighting.decompose();
+        lighting.redecompose();
         times.push(start.elapsed().as_secs_f64() * 1e3);
-        result = Some(d);
     }
-    let result = result.expect("at least one run");
+    // Decomposed in the map's frame, then turned.
+    lighting.set_rotation(args.rotate);
+    let result = lighting.decompose();
     let median = median(times.clone());
     let json = DecompositionJson {
         map: args.env.display().to_string(),
