@@ -6,6 +6,7 @@ mod cli;
 mod commands;
 mod environment;
 mod report;
+mod sequence;
 mod support;
 mod view;
 

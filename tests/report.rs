@@ -265,3 +265,111 @@ fn report_with_a_missing_bake_fails_cleanly() {
     assert_clean_failure(&out, &["missing.bake"]);
     assert!(!dir.path().join("out").exists());
 }
+
+/// A sequence report on a small sun sequence: every frame measured, temporal errors from the
+/// second frame on, the sun's light checked against the true sun, an animated GIF of all
+/// frames; and `render --env-sequence --frame` draws one frame of the same sequence.
+#[test]
+fn sequence_report_measures_every_frame_over_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let bake = d.join("t.bake");
+    let out = hprt(
+        d,
+        &[
+            "bake",
+            scene("teapot.toml").to_str().unwrap(),
+            "--samples",
+            "64",
+            "--bounces",
+            "1",
+            "-o",
+            bake.to_str().unwrap(),
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let base = repo().join("scenes/env/forest.exr");
+    let sequence = d.join("sun.toml");
+    std::fs::write(
+        &sequence,
+        format!(
+            "[sun]\nbase = {base:?}\nframes = 5\nfrom = [-40, 10]\nto = [-10, 30]\n\
+             angular_radius_deg = 0.5\npower = [7, 6.6, 6]\n"
+        ),
+    )
+    .unwrap();
+    let out = hprt_with_env(
+        d,
+        &[
+            "report",
+            scene("teapot.toml").to_str().unwrap(),
+            "--env-sequence",
+            sequence.to_str().unwrap(),
+            "--bake",
+            bake.to_str().unwrap(),
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--spp",
+            "8",
+            "-o",
+            "seq",
+        ],
+        &[("HPRT_CACHE", d)],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("seq/sequence.json")).unwrap())
+            .unwrap();
+    let frames = report["per_frame"].as_array().unwrap();
+    assert_eq!(frames.len(), 5);
+    for (k, frame) in frames.iter().enumerate() {
+        let methods = frame["methods"].as_array().unwrap();
+        let names: Vec<&str> = methods
+            .iter()
+            .map(|m| m["method"].as_str().unwrap())
+            .collect();
+        assert_eq!(names, ["prt", "hybrid/tracked", "hybrid/untracked"]);
+        for m in methods {
+            assert_eq!(m["temporal"].is_null(), k == 0, "{m}");
+            assert!(m["mean"].as_f64().unwrap() > 0.0);
+        }
+        // The sun's light follows the sun.
+        assert!(frame["sun"]["angle_deg"].as_f64().unwrap() < 0.5, "{frame}");
+    }
+    assert_eq!(report["methods"][0]["light_count_changes"], 0);
+    let gif = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(
+        std::fs::File::open(d.join("seq/sequence.gif")).unwrap(),
+    ))
+    .unwrap();
+    use image::AnimationDecoder;
+    assert_eq!(gif.into_frames().count(), 5);
+    for file in ["report.html", "sequence.csv", "error.svg", "temporal.svg"] {
+        assert!(d.join("seq").join(file).exists(), "{file}");
+    }
+
+    let render = |frame: &str| {
+        hprt(
+            d,
+            &[
+                "render",
+                scene("teapot.toml").to_str().unwrap(),
+                "--bake",
+                bake.to_str().unwrap(),
+                "--env-sequence",
+                sequence.to_str().unwrap(),
+                "--frame",
+                frame,
+                "--width",
+                "48",
+                "--height",
+                "36",
+                "-o",
+                &format!("frame{frame}.png"),
+            ],
+        )
+    };
+    assert!(render("4").status.success());
+    assert_clean_failure(&render("5"), &["past the sequence's last frame"]);
+}

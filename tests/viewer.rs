@@ -148,3 +148,67 @@ fn smoke_test_under_xvfb() {
         "the command line reproduces the viewer's image (worst difference {worst})"
     );
 }
+
+/// The viewer plays an environment sequence, tracking its lights.
+#[test]
+fn plays_an_environment_sequence_under_xvfb() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let teapot = scene("teapot.toml");
+    let bake = hprt(
+        d,
+        &[
+            "bake",
+            teapot.to_str().unwrap(),
+            "-o",
+            "t.bake",
+            "--order",
+            "3",
+            "--samples",
+            "16",
+            "--bounces",
+            "1",
+        ],
+    );
+    assert!(bake.status.success(), "{}", stderr(&bake));
+    let base = repo().join("scenes/env/forest.exr");
+    std::fs::write(
+        d.join("sun.toml"),
+        format!(
+            "[sun]\nbase = {base:?}\nframes = 3\nfrom = [-40, 10]\nto = [-10, 30]\n\
+             angular_radius_deg = 0.5\npower = [7, 6.6, 6]\n"
+        ),
+    )
+    .unwrap();
+    std::fs::write(d.join("play.script"), "wait 6\nstate state.json\nquit\n").unwrap();
+    let out = Command::new("xvfb-run")
+        .args([
+            "-a",
+            "-s",
+            "-screen 0 1024x768x24",
+            env!("CARGO_BIN_EXE_hprt"),
+            "view",
+        ])
+        .arg(&teapot)
+        .args([
+            "--bake",
+            "t.bake",
+            "--env-sequence",
+            "sun.toml",
+            "--width",
+            "640",
+            "--height",
+            "400",
+            "--script",
+            "play.script",
+        ])
+        .current_dir(d)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("xvfb-run (package xvfb; tests/run.sh installs it)");
+    assert!(out.status.success(), "viewer failed: {}", stderr(&out));
+    let state: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("state.json")).unwrap()).unwrap();
+    assert!(state["frames"].as_u64().unwrap() >= 6);
+    assert!(!state["light_shares"].as_array().unwrap().is_empty());
+}

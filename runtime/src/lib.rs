@@ -7,6 +7,8 @@ pub mod decompose;
 pub mod light;
 pub mod lighting;
 pub mod render;
+pub mod sequence;
+pub mod tracking;
 
 pub use cubemap::{CubeGeometry, CubeMap, CubeResampler, CubeSource};
 pub use decompose::{
@@ -14,3 +16,4 @@ pub use decompose::{
 };
 pub use light::DirectionalLight;
 pub use lighting::{EnvironmentLighting, FrameLighting, LitFrame, RenderMode};
+pub use tracking::{LightTracker, TrackedLight, TrackingSettings};

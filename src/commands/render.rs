@@ -2,7 +2,8 @@
 
 use crate::bake_cache::load_bake;
 use crate::cli::{DecomposeOptions, EnvironmentArgs, ImageSizeArgs, RenderOptions, parse_vec3};
-use crate::environment::default_exposure;
+use crate::environment::{default_exposure, scene_rotation};
+use crate::sequence::{Sequence, lighting_at_frame};
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
@@ -21,6 +22,13 @@ pub struct RenderArgs {
     pub bake: PathBuf,
     #[command(flatten)]
     pub environment: EnvironmentArgs,
+    /// An environment sequence (a folder of maps or a sequence file, see scenes/README.md):
+    /// renders its frame --frame, the lights tracked from its first frame.
+    #[arg(long, conflicts_with = "env")]
+    pub env_sequence: Option<PathBuf>,
+    /// Frame of --env-sequence to render (from 0).
+    #[arg(long, default_value_t = 0, requires = "env_sequence")]
+    pub frame: usize,
     #[command(flatten)]
     pub render: RenderOptions,
     /// How the decomposition forms lights (thesis or consistent).
@@ -53,7 +61,7 @@ pub struct RenderArgs {
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let transfer = load_bake(&scene, &args.bake, args.decompose.order)?;
-    let env = args.environment.choose(&scene)?;
+    let rotation_deg = scene_rotation(&scene, args.environment.rotate);
     let mut camera = args.size.camera(&scene)?;
     camera.position = args.camera_position.unwrap_or(camera.position);
     camera.target = args.camera_target.unwrap_or(camera.target);
@@ -70,8 +78,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let settings = args
         .decompose
         .settings(args.decompose_mode, transfer.settings.order);
-    let mut lighting = EnvironmentLighting::new(&env.loaded.map, settings)?;
-    lighting.set_rotation(env.rotation_deg);
+    let mut lighting = match &args.env_sequence {
+        Some(path) => {
+            let sequence = Sequence::load(path)?;
+            lighting_at_frame(&sequence, settings, rotation_deg, args.frame)?
+        }
+        None => {
+            let env = args.environment.choose(&scene)?;
+            let mut lighting = EnvironmentLighting::new(&env.loaded.map, settings)?;
+            lighting.set_rotation(rotation_deg);
+            lighting
+        }
+    };
     let frame = lighting.frame(args.render.mode, args.render.lights_indirect());
     let gpu = GpuContext::headless(args.render.backend)?;
     println!("adapter: {}", gpu.description());
@@ -82,13 +100,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         &camera,
         args.render.shadow_settings(),
     )?;
-    renderer.set_environment(&env.loaded.map, env.rotation_deg);
+    renderer.set_environment(lighting.map(), rotation_deg);
     renderer.set_lighting(&frame.lighting)?;
     renderer.render()?;
     let image: RgbImageF32 = renderer.read_back()?;
     let exposure = args
         .exposure
-        .unwrap_or_else(|| default_exposure(&env.loaded.map));
+        .unwrap_or_else(|| default_exposure(lighting.map()));
     let png = png_bytes(
         &to_display_rgb8(&image, exposure),
         image.width,

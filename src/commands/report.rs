@@ -15,6 +15,10 @@ pub struct ReportArgs {
     /// Environment maps (default: the scene's map and every .exr / .hdr map beside it).
     #[arg(long, num_args = 1..)]
     pub envs: Vec<PathBuf>,
+    /// Report on an environment sequence instead (a folder of maps or a sequence file, see
+    /// scenes/README.md): per-frame and temporal errors, popping frames, an animated GIF.
+    #[arg(long, conflicts_with = "envs")]
+    pub env_sequence: Option<PathBuf>,
     #[command(flatten)]
     pub options: ReportOptions,
     /// Output folder: report.html, stats.json, stats.csv and one folder of images per map.
@@ -24,6 +28,14 @@ pub struct ReportArgs {
 
 pub fn run(args: ReportArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
+    if let Some(sequence) = &args.env_sequence {
+        return report::sequence::write_sequence_report(
+            &scene,
+            sequence,
+            &args.options,
+            &args.output,
+        );
+    }
     let envs = if args.envs.is_empty() {
         let Some(environment) = &scene.environment else {
             anyhow::bail!(

@@ -187,6 +187,107 @@ pub fn threshold_plot(title: &str, curves: &[Curve], prt_error: f64) -> anyhow::
     Ok(svg)
 }
 
+/// Values over the frames of a sequence, one line per method. Returns SVG text.
+pub fn time_plot(
+    title: &str,
+    y_label: &str,
+    series: &[(String, Vec<f64>)],
+) -> anyhow::Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (600, 300)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let frames = series
+            .iter()
+            .map(|(_, v)| v.len())
+            .max()
+            .unwrap_or(1)
+            .max(2);
+        let high = series
+            .iter()
+            .flat_map(|(_, v)| v.iter().copied())
+            .filter(|v| v.is_finite())
+            .fold(1e-6, f64::max)
+            * 1.15;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, (font(), 16))
+            .margin(10)
+            .x_label_area_size(36)
+            .y_label_area_size(56)
+            .build_cartesian_2d(0usize..frames - 1, 0.0..high)?;
+        chart
+            .configure_mesh()
+            .x_desc("frame")
+            .y_desc(y_label)
+            .y_label_formatter(&|v| format!("{v:.3}"))
+            .label_style((font(), 12))
+            .axis_desc_style((font(), 12))
+            .draw()?;
+        let palette = [
+            RGBColor(0, 0, 0),
+            RGBColor(200, 60, 40),
+            RGBColor(40, 110, 200),
+            RGBColor(40, 160, 90),
+        ];
+        for (k, (label, values)) in series.iter().enumerate() {
+            let colour = palette[k % palette.len()];
+            chart
+                .draw_series(LineSeries::new(
+                    values
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, v)| v.is_finite())
+                        .map(|(i, v)| (i, *v)),
+                    colour.stroke_width(2),
+                ))?
+                .label(label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font((font(), 12))
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()?;
+        root.present()?;
+    }
+    Ok(svg)
+}
+
+/// An animated GIF of `frames` (8-bit RGB, `width × height` each), `delay_ms` per frame,
+/// looping.
+pub fn animated_gif(
+    frames: &[Vec<u8>],
+    width: u32,
+    height: u32,
+    delay_ms: u32,
+) -> anyhow::Result<Vec<u8>> {
+    use image::codecs::gif::{GifEncoder, Repeat};
+    let mut bytes = Vec::new();
+    {
+        let mut encoder = GifEncoder::new_with_speed(&mut bytes, 10);
+        encoder.set_repeat(Repeat::Infinite)?;
+        for rgb in frames {
+            let rgba: Vec<u8> = rgb
+                .chunks_exact(3)
+                .flat_map(|p| [p[0], p[1], p[2], 255])
+                .collect();
+            let buffer = image::RgbaImage::from_raw(width, height, rgba)
+                .ok_or_else(|| anyhow::anyhow!("a GIF frame of the wrong size"))?;
+            encoder.encode_frame(image::Frame::from_parts(
+                buffer,
+                0,
+                0,
+                image::Delay::from_numer_denom_ms(delay_ms, 1),
+            ))?;
+        }
+    }
+    Ok(bytes)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

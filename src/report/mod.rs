@@ -5,6 +5,7 @@
 
 pub mod figures;
 mod html;
+pub mod sequence;
 pub mod stats;
 
 use crate::bake_cache::{self, cache_dir};
@@ -137,42 +138,44 @@ pub struct Report {
     pub maps: Vec<MapReport>,
 }
 
-/// Everything that determines a reference image, hashed: the cache key.
+/// Everything that determines a reference image, hashed: the cache key (the map by its
+/// content, so generated maps are cached too).
 fn reference_key(
     scene: &Scene,
     camera: &Camera,
-    env: &Path,
+    map: &EnvMap,
     rotation_deg: f32,
     settings: &ReferenceSettings,
 ) -> anyhow::Result<String> {
     let mut hasher = blake3::Hasher::new();
-    hasher.update(b"hprt reference v1");
+    hasher.update(b"hprt reference v2");
     hasher.update(&scene.geometry.content_hash());
     hasher.update(serde_json::to_string(camera)?.as_bytes());
-    hasher.update(&std::fs::read(env).with_context(|| format!("cannot read {}", env.display()))?);
+    hasher.update(&(map.width() as u64).to_le_bytes());
+    hasher.update(&(map.height() as u64).to_le_bytes());
+    hasher.update(bytemuck::cast_slice(map.texels()));
     hasher.update(&rotation_deg.to_le_bytes());
     hasher.update(serde_json::to_string(settings)?.as_bytes());
     Ok(hasher.finalize().to_hex()[..24].to_owned())
 }
 
 /// The reference with its coverage and visibility, from the cache or rendered (then cached).
-struct ReferenceImages {
-    radiance: RgbImageF32,
-    coverage: Vec<f32>,
-    visibility: Vec<f32>,
-    cached: bool,
-    seconds: f64,
+pub(crate) struct ReferenceImages {
+    pub(crate) radiance: RgbImageF32,
+    pub(crate) coverage: Vec<f32>,
+    pub(crate) visibility: Vec<f32>,
+    pub(crate) cached: bool,
+    pub(crate) seconds: f64,
 }
 
-fn reference_images(
+pub(crate) fn reference_images(
     scene: &Scene,
     camera: &Camera,
     map: &EnvMap,
-    env: &Path,
     rotation_deg: f32,
     settings: &ReferenceSettings,
 ) -> anyhow::Result<ReferenceImages> {
-    let key = reference_key(scene, camera, env, rotation_deg, settings)?;
+    let key = reference_key(scene, camera, map, rotation_deg, settings)?;
     let dir = cache_dir().join("references");
     let paths =
         ["radiance", "coverage", "visibility"].map(|kind| dir.join(format!("{key}.{kind}.exr")));
@@ -316,14 +319,7 @@ fn report_map(job: &mut MapJob, env: &Path) -> anyhow::Result<MapReport> {
         bounces: job.settings.bounces,
         seed: job.settings.seed,
     };
-    let reference = reference_images(
-        job.scene,
-        &job.camera,
-        &map,
-        env,
-        rotation,
-        &reference_settings,
-    )?;
+    let reference = reference_images(job.scene, &job.camera, &map, rotation, &reference_settings)?;
     if reference.cached {
         println!("{name}: reference from the cache");
     } else {

@@ -14,6 +14,7 @@ mod window;
 
 use crate::bake_cache;
 use crate::environment::{default_exposure, maps_beside, scene_rotation};
+use crate::sequence::Sequence;
 use crate::support::{load_scene, median};
 use anyhow::Context;
 use clap::Args;
@@ -47,6 +48,10 @@ pub struct ViewArgs {
     /// Environment map (default: the scene's); it gets the scene's rotation_deg.
     #[arg(long)]
     pub env: Option<PathBuf>,
+    /// Play an environment sequence (a folder of maps or a sequence file, see
+    /// scenes/README.md): one sequence frame per drawn frame, looping, the lights tracked.
+    #[arg(long, conflicts_with = "env")]
+    pub env_sequence: Option<PathBuf>,
     /// Graphics backend: auto, vulkan or gl.
     #[arg(long, default_value = "auto")]
     pub backend: Backend,
@@ -80,6 +85,8 @@ struct LightingState {
     lit_for: Option<ViewSettings>,
     decomposition: Option<Decomposition>,
     decomposition_ms: f64,
+    /// A sequence being played, and the frame shown.
+    sequence: Option<(Sequence, usize)>,
 }
 
 /// The window, its GPU and what is drawn in it.
@@ -184,6 +191,10 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
             scene.path.display()
         ),
     };
+    let sequence = match &args.env_sequence {
+        Some(path) => Some((Sequence::load(path)?, 0)),
+        None => None,
+    };
     let commands = match &args.script {
         Some(path) => {
             let text = std::fs::read_to_string(path)
@@ -222,7 +233,10 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         scene,
         settings,
         bake,
-        lighting: LightingState::default(),
+        lighting: LightingState {
+            sequence,
+            ..Default::default()
+        },
         window: WindowState {
             backend: args.backend,
             size: (args.width, args.height),
@@ -254,14 +268,24 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
 
 impl App {
     fn load_environment(&mut self) {
-        let loaded = match precompute::envmap::load(&self.settings.env, None) {
+        let loaded = match &self.lighting.sequence {
+            Some((sequence, _)) => sequence
+                .frame(0)
+                .map(|map| precompute::envmap::LoadedEnvMap {
+                    map,
+                    layout: precompute::envmap::Layout::Equirect,
+                    sanitized: 0,
+                }),
+            None => crate::environment::load_map(&self.settings.env, None),
+        };
+        let loaded = match loaded {
             Ok(loaded) => loaded,
             Err(e) => {
-                self.stats.message = format!("cannot load the map: {e}");
+                self.stats.message = format!("cannot load the map: {e:#}");
                 return;
             }
         };
-        let lighting =
+        let mut lighting =
             match EnvironmentLighting::new(&loaded.map, self.settings.decompose_settings()) {
                 Ok(lighting) => lighting,
                 Err(e) => {
@@ -269,6 +293,11 @@ impl App {
                     return;
                 }
             };
+        if self.lighting.sequence.is_some()
+            && let Err(e) = lighting.enable_tracking(Some(runtime::TrackingSettings::default()))
+        {
+            self.stats.message = format!("cannot track the lights: {e}");
+        }
         if self.settings.exposure == 1.0 && self.lighting.environment.is_none() {
             self.settings.exposure = default_exposure(&loaded.map);
         }
@@ -322,6 +351,31 @@ impl App {
             }
             Err(_) => {}
         }
+    }
+
+    /// Shows the next frame of the sequence being played.
+    fn advance_sequence(&mut self) -> anyhow::Result<()> {
+        let (Some((sequence, frame)), Some(env)) = (
+            self.lighting.sequence.as_mut(),
+            self.lighting.environment.as_mut(),
+        ) else {
+            return Ok(());
+        };
+        *frame = (*frame + 1) % sequence.len();
+        if *frame == 0 {
+            // Looping: start the tracking afresh, as on the first frame.
+            env.enable_tracking(Some(runtime::TrackingSettings::default()))?;
+        }
+        env.set_map(&sequence.frame(*frame)?);
+        if let Some(renderer) = self.window.renderer.as_mut() {
+            renderer.set_environment(env.map(), self.settings.rotation_deg);
+            if let Some(gpu) = self.window.gpu.as_mut() {
+                gpu.renderer_changed();
+            }
+        }
+        self.lighting.lit_for = None;
+        self.panel.environment_changed();
+        Ok(())
     }
 
     /// The decomposition (and the renderer's lighting) when anything it depends on changed.
@@ -525,6 +579,16 @@ impl App {
             environment: self.lighting.environment.as_ref().map(|e| e.map()),
             env_choices: &self.env_choices,
             decomposition: self.lighting.decomposition.as_ref(),
+            tracked: self
+                .lighting
+                .environment
+                .as_ref()
+                .map_or(&[], |e| e.tracked_lights()),
+            sequence_frame: self
+                .lighting
+                .sequence
+                .as_ref()
+                .map(|(s, frame)| (*frame, s.len())),
             frame_ms: self.stats.median_frame_ms(),
             decomposition_ms: self.lighting.decomposition_ms,
             adapter: &self.stats.adapter,
@@ -620,6 +684,9 @@ impl App {
         self.poll_bake();
         self.run_script(event_loop)?;
         self.ensure_renderer()?;
+        if self.window.renderer.is_some() {
+            self.advance_sequence()?;
+        }
         self.update_lighting()?;
         let camera = self.current_camera();
         if let Some(renderer) = self.window.renderer.as_mut() {

@@ -7,7 +7,7 @@ use precompute::bake::BakeSettings;
 use precompute::envmap::{EnvMap, direction_of_uv, rotate_y, uv_of_direction};
 use precompute::image_io::{srgb_encode, tonemap};
 use runtime::render::RenderMode;
-use runtime::{DecomposeMode, Decomposition};
+use runtime::{DecomposeMode, Decomposition, TrackedLight};
 use std::path::{Path, PathBuf};
 
 const THUMBNAIL: [usize; 2] = [256, 128];
@@ -31,6 +31,10 @@ pub struct PanelInfo<'a> {
     pub environment: Option<&'a EnvMap>,
     pub env_choices: &'a [PathBuf],
     pub decomposition: Option<&'a Decomposition>,
+    /// The tracked lights, when a sequence plays.
+    pub tracked: &'a [TrackedLight],
+    /// `(frame, frames)` of the sequence being played.
+    pub sequence_frame: Option<(usize, usize)>,
     /// Median frame time, once frames have been timed.
     pub frame_ms: Option<f64>,
     pub decomposition_ms: f64,
@@ -318,6 +322,28 @@ impl Panel<'_> {
             self.info.decomposition_ms
         ));
         ui.label(format!("adapter: {}", self.info.adapter));
+        if let Some((frame, frames)) = self.info.sequence_frame {
+            ui.label(format!("sequence frame {} of {frames}", frame + 1));
+        }
+        if !self.info.tracked.is_empty() {
+            ui.label(format!("{} tracked light(s)", self.info.tracked.len()));
+            for t in self.info.tracked {
+                let state = if t.fading_out {
+                    "fading out"
+                } else if t.weight < 1.0 {
+                    "fading in"
+                } else {
+                    "steady"
+                };
+                ui.label(format!(
+                    "#{}: {:.1}% of the map, {state} ({:.0}%)",
+                    t.id,
+                    100.0 * t.light.share,
+                    100.0 * t.weight
+                ));
+            }
+            return;
+        }
         let Some(decomposition) = self.info.decomposition else {
             return;
         };

@@ -360,6 +360,21 @@ impl Decomposer {
         }
     }
 
+    /// What `map` holds around `centres` as the consistent mode measures a light: the excess
+    /// of the map over the refitted SH part in each centre's cap (texels shared by caps go to
+    /// the nearest centre). Measures a map's own "local level" where another map has a light.
+    pub fn cap_excess(&mut self, map: &CubeMap, centres: &[Vec3]) -> Vec<Rgb> {
+        assert_eq!(
+            map.size(),
+            self.settings.face_size,
+            "cube map of the wrong size"
+        );
+        self.prepare_analysis(map);
+        let full = self.projector.project(self.analysis_map(map));
+        let (_, lights) = self.extract(map, &full, centres, CONSISTENT_ITERATIONS);
+        lights.iter().map(|l| l.power).collect()
+    }
+
     /// Steps 1, 2 and 4: smoothed map minus SH part on the icosahedron, its significant local
     /// maxima, refined; brightest first.
     fn find_peaks(
