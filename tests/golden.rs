@@ -48,23 +48,13 @@ const CASES: [(&str, &[&str]); 7] = [
 #[test]
 fn teapot_renders_match_the_committed_images_in_every_mode() {
     let dir = tempfile::tempdir().unwrap();
-    let bake = dir.path().join("teapot.bake");
+    let bake = bake_teapot(
+        dir.path(),
+        "teapot.bake",
+        &["--samples", "64", "--bounces", "1"],
+    );
     let scene = scene("teapot.toml");
     let scene = scene.to_str().unwrap();
-    let out = hprt(
-        dir.path(),
-        &[
-            "bake",
-            scene,
-            "--samples",
-            "64",
-            "--bounces",
-            "1",
-            "-o",
-            bake.to_str().unwrap(),
-        ],
-    );
-    assert!(out.status.success(), "{}", stderr(&out));
     let hall = repo().join("scenes/env/hall.exr");
     let bless = std::env::var_os("HPRT_BLESS").is_some();
     let mut failures = Vec::new();
@@ -143,20 +133,7 @@ fn a_map_given_on_the_command_line_gets_the_scene_rotation() {
     let scene = scene.to_str().unwrap();
     let hall = repo().join("scenes/env/hall.exr");
     let hall = hall.to_str().unwrap();
-    let out = hprt(
-        d,
-        &[
-            "bake",
-            scene,
-            "--samples",
-            "64",
-            "--bounces",
-            "1",
-            "-o",
-            "t.bake",
-        ],
-    );
-    assert!(out.status.success(), "{}", stderr(&out));
+    bake_teapot(d, "t.bake", &["--samples", "64", "--bounces", "1"]);
     let size = ["--width", "96", "--height", "72"];
     let render = |rotate: &[&str], exr: &str| {
         let mut args = vec![

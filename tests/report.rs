@@ -273,21 +273,7 @@ fn report_with_a_missing_bake_fails_cleanly() {
 fn sequence_report_measures_every_frame_over_time() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let bake = d.join("t.bake");
-    let out = hprt(
-        d,
-        &[
-            "bake",
-            scene("teapot.toml").to_str().unwrap(),
-            "--samples",
-            "64",
-            "--bounces",
-            "1",
-            "-o",
-            bake.to_str().unwrap(),
-        ],
-    );
-    assert!(out.status.success(), "{}", stderr(&out));
+    let bake = bake_teapot(d, "t.bake", &["--samples", "64", "--bounces", "1"]);
     let base = repo().join("scenes/env/forest.exr");
     let sequence = d.join("sun.toml");
     std::fs::write(

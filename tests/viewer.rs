@@ -28,22 +28,11 @@ fn smoke_test_under_xvfb() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let teapot = scene("teapot.toml");
-    let bake = hprt(
+    bake_teapot(
         d,
-        &[
-            "bake",
-            teapot.to_str().unwrap(),
-            "-o",
-            "t.bake",
-            "--order",
-            "3",
-            "--samples",
-            "32",
-            "--bounces",
-            "1",
-        ],
+        "t.bake",
+        &["--order", "3", "--samples", "32", "--bounces", "1"],
     );
-    assert!(bake.status.success(), "{}", stderr(&bake));
     std::fs::write(
         d.join("smoke.script"),
         "wait 2\norbit 60 -15\nzoom 1\npan 5 5\nset rotation 30\nwait 2\nscreenshot scene.png\n\
@@ -155,22 +144,11 @@ fn plays_an_environment_sequence_under_xvfb() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let teapot = scene("teapot.toml");
-    let bake = hprt(
+    bake_teapot(
         d,
-        &[
-            "bake",
-            teapot.to_str().unwrap(),
-            "-o",
-            "t.bake",
-            "--order",
-            "3",
-            "--samples",
-            "16",
-            "--bounces",
-            "1",
-        ],
+        "t.bake",
+        &["--order", "3", "--samples", "16", "--bounces", "1"],
     );
-    assert!(bake.status.success(), "{}", stderr(&bake));
     let base = repo().join("scenes/env/forest.exr");
     std::fs::write(
         d.join("sun.toml"),

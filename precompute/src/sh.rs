@@ -305,17 +305,55 @@ pub fn clamped_cosine_bands(order: usize) -> Vec<f32> {
         .collect()
 }
 
+/// Helpers of the SH tests (this module's and the rotation's).
 #[cfg(test)]
-mod tests {
+pub(crate) mod test_support {
     use super::*;
     use crate::quadrature::SphereQuadrature;
     use glam::DVec3;
 
-    fn eval64(basis: &ShBasis<f64>, w: DVec3) -> Vec<f64> {
+    /// The basis at `w` in double precision.
+    pub fn eval64(basis: &ShBasis<f64>, w: DVec3) -> Vec<f64> {
         let mut out = vec![0.0; basis.num_coeffs()];
         basis.eval_into(w.to_array(), &mut out);
         out
     }
+
+    /// Projects `f` with a quadrature exact for products of `order`-band functions.
+    pub fn project64(order: usize, f: impl Fn(DVec3) -> f64) -> Vec<f64> {
+        let basis = ShBasis::<f64>::new(order).unwrap();
+        let q = SphereQuadrature::gauss_product(order + 2);
+        let mut c = vec![0.0f64; basis.num_coeffs()];
+        for (w, weight) in q.points() {
+            let v = f(*w) * weight;
+            for (ck, yk) in c.iter_mut().zip(eval64(&basis, *w)) {
+                *ck += v * yk;
+            }
+        }
+        c
+    }
+
+    /// Reproducible coefficients in `[-1, 1)`.
+    pub fn random_coeffs(order: usize, seed: u64) -> ShCoeffs<f32> {
+        let mut state = seed;
+        let coeffs = (0..num_coeffs(order))
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+            })
+            .collect();
+        ShCoeffs::from_vec(coeffs).unwrap()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_support::{eval64, project64, random_coeffs};
+    use super::*;
+    use crate::quadrature::SphereQuadrature;
+    use glam::DVec3;
 
     #[test]
     fn orthonormal_up_to_order_10_and_beyond() {
@@ -388,31 +426,8 @@ mod tests {
         }
     }
 
-    /// Projects `f` with an exact quadrature for functions of `order` bands.
     fn project(order: usize, f: impl Fn(DVec3) -> f64) -> ShCoeffs<f32> {
-        let basis = ShBasis::<f64>::new(order).unwrap();
-        let q = SphereQuadrature::gauss_product(order + 2);
-        let mut c = vec![0.0f64; basis.num_coeffs()];
-        for (w, weight) in q.points() {
-            let v = f(*w) * weight;
-            for (ck, yk) in c.iter_mut().zip(eval64(&basis, *w)) {
-                *ck += v * yk;
-            }
-        }
-        ShCoeffs::from_vec(c.into_iter().map(|x| x as f32).collect()).unwrap()
-    }
-
-    fn random_coeffs(order: usize, seed: u64) -> ShCoeffs<f32> {
-        let mut state = seed;
-        let coeffs = (0..num_coeffs(order))
-            .map(|_| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-            })
-            .collect();
-        ShCoeffs::from_vec(coeffs).unwrap()
+        ShCoeffs::from_vec(project64(order, f).into_iter().map(|x| x as f32).collect()).unwrap()
     }
 
     #[test]

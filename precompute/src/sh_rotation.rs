@@ -160,42 +160,9 @@ fn next_band(r1: &[f64], prev: &[f64], l: usize) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quadrature::SphereQuadrature;
     use crate::sh::ShBasis;
+    use crate::sh::test_support::{eval64, project64, random_coeffs};
     use glam::{DQuat, DVec3, Quat};
-
-    fn eval64(basis: &ShBasis<f64>, w: DVec3) -> Vec<f64> {
-        let mut out = vec![0.0; basis.num_coeffs()];
-        basis.eval_into([w.x, w.y, w.z], &mut out);
-        out
-    }
-
-    /// Projects `f` with a quadrature exact for products of `order`-band functions.
-    fn project(order: usize, f: impl Fn(DVec3) -> f64) -> Vec<f64> {
-        let basis = ShBasis::<f64>::new(order).unwrap();
-        let q = SphereQuadrature::gauss_product(order + 2);
-        let mut c = vec![0.0f64; basis.num_coeffs()];
-        for (w, weight) in q.points() {
-            let v = f(*w) * weight;
-            for (ck, yk) in c.iter_mut().zip(eval64(&basis, *w)) {
-                *ck += v * yk;
-            }
-        }
-        c
-    }
-
-    fn random_coeffs(order: usize, seed: u64) -> ShCoeffs<f32> {
-        let mut state = seed;
-        let coeffs = (0..num_coeffs(order))
-            .map(|_| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-            })
-            .collect();
-        ShCoeffs::from_vec(coeffs).unwrap()
-    }
 
     fn random_rotation(seed: u64) -> DQuat {
         let c = random_coeffs(2, seed);
@@ -223,7 +190,7 @@ mod tests {
                     .sum()
             };
             let q = random_rotation(seed * 31 + 7);
-            let expected = project(order, |w| f(q.inverse() * w));
+            let expected = project64(order, |w| f(q.inverse() * w));
             let rotation = ShRotation::new(Mat3::from_quat(q.as_quat()), order).unwrap();
             let got = rotation.rotate(&c);
             let scale = expected.iter().map(|x| x.abs()).fold(0.0, f64::max);

@@ -46,6 +46,23 @@ pub struct ReportSettings {
     pub backend: Backend,
 }
 
+impl ReportSettings {
+    /// The settings `options` ask for at `camera`'s size; the reference's bounces default to
+    /// the bake's, so both see the same light.
+    pub fn new(options: &ReportOptions, camera: &Camera, transfer: &Transfer) -> Self {
+        Self {
+            width: camera.width,
+            height: camera.height,
+            spp: options.spp,
+            bounces: options.bounces.unwrap_or(transfer.settings.bounces),
+            seed: options.seed,
+            thresholds: options.thresholds.clone(),
+            frames: options.frames as usize,
+            backend: options.backend,
+        }
+    }
+}
+
 /// The methods of the comparison, in the table's order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
@@ -540,16 +557,7 @@ pub fn write_report(
     anyhow::ensure!(!envs.is_empty(), "no environment maps to report on");
     let (bake_path, transfer) = bake_cache::bake_for(scene, options.bake.as_deref())?;
     let camera = options.size.camera(scene)?;
-    let settings = ReportSettings {
-        width: camera.width,
-        height: camera.height,
-        spp: options.spp,
-        bounces: options.bounces.unwrap_or(transfer.settings.bounces),
-        seed: options.seed,
-        thresholds: options.thresholds.clone(),
-        frames: options.frames as usize,
-        backend: options.backend,
-    };
+    let settings = ReportSettings::new(options, &camera, &transfer);
     let report = run_report(scene, &transfer, &bake_path, envs, &settings, output)?;
     println!();
     println!(

@@ -185,14 +185,8 @@ pub fn write_sequence_report(
     let (_, transfer) = bake_cache::bake_for(scene, options.bake.as_deref())?;
     let camera = options.size.camera(scene)?;
     let settings = ReportSettings {
-        width: camera.width,
-        height: camera.height,
-        spp: options.spp,
-        bounces: options.bounces.unwrap_or(transfer.settings.bounces),
-        seed: options.seed,
         thresholds: Vec::new(),
-        frames: options.frames as usize,
-        backend: options.backend,
+        ..ReportSettings::new(options, &camera, &transfer)
     };
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let gpu = GpuContext::headless(options.backend)?;

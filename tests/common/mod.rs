@@ -78,3 +78,16 @@ pub fn bake_quietly(
         .expect("valid bake settings")
         .0
 }
+
+/// Bakes the bundled teapot into `dir/name` with the extra `hprt bake` arguments `settings`
+/// (e.g. `["--samples", "64"]`), asserting success; returns the bake's path.
+pub fn bake_teapot(dir: &Path, name: &str, settings: &[&str]) -> PathBuf {
+    let output = dir.join(name);
+    let teapot = scene("teapot.toml");
+    let mut args = vec!["bake", teapot.to_str().expect("UTF-8 path")];
+    args.extend_from_slice(settings);
+    args.extend_from_slice(&["-o", output.to_str().expect("UTF-8 path")]);
+    let out = hprt(dir, &args);
+    assert!(out.status.success(), "the bake failed: {}", stderr(&out));
+    output
+}
