@@ -3,7 +3,7 @@
 mod common;
 
 use common::*;
-use std::process::Command;
+use std::process::{Command, Output};
 
 fn image_rgb(path: &std::path::Path) -> (u32, u32, Vec<u8>) {
     let decoded = image::open(path)
@@ -39,16 +39,10 @@ fn smoke_test_under_xvfb() {
          window-screenshot window.png\ncommand render.sh\nset animate on\nset speed 90\nwait 3\nstate state.json\nquit\n",
     )
     .unwrap();
-    let out = Command::new("xvfb-run")
-        .args([
-            "-a",
-            "-s",
-            "-screen 0 1024x768x24",
-            env!("CARGO_BIN_EXE_hprt"),
-            "view",
-        ])
-        .arg(&teapot)
-        .args([
+    let out = view_under_xvfb(
+        d,
+        &teapot,
+        &[
             "--bake",
             "t.bake",
             "--width",
@@ -57,11 +51,8 @@ fn smoke_test_under_xvfb() {
             "500",
             "--script",
             "smoke.script",
-        ])
-        .current_dir(d)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .expect("xvfb-run (package xvfb; tests/run.sh installs it)");
+        ],
+    );
     assert!(out.status.success(), "viewer failed: {}", stderr(&out));
     assert!(stdout(&out).contains("adapter:"));
 
@@ -159,16 +150,10 @@ fn plays_an_environment_sequence_under_xvfb() {
     )
     .unwrap();
     std::fs::write(d.join("play.script"), "wait 6\nstate state.json\nquit\n").unwrap();
-    let out = Command::new("xvfb-run")
-        .args([
-            "-a",
-            "-s",
-            "-screen 0 1024x768x24",
-            env!("CARGO_BIN_EXE_hprt"),
-            "view",
-        ])
-        .arg(&teapot)
-        .args([
+    let out = view_under_xvfb(
+        d,
+        &teapot,
+        &[
             "--bake",
             "t.bake",
             "--env-sequence",
@@ -179,14 +164,29 @@ fn plays_an_environment_sequence_under_xvfb() {
             "400",
             "--script",
             "play.script",
-        ])
-        .current_dir(d)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .expect("xvfb-run (package xvfb; tests/run.sh installs it)");
+        ],
+    );
     assert!(out.status.success(), "viewer failed: {}", stderr(&out));
     let state: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(d.join("state.json")).unwrap()).unwrap();
     assert!(state["frames"].as_u64().unwrap() >= 6);
     assert!(!state["light_shares"].as_array().unwrap().is_empty());
+}
+
+/// Runs `hprt view SCENE ARGS` in `dir` under a virtual X server.
+fn view_under_xvfb(dir: &std::path::Path, scene: &std::path::Path, args: &[&str]) -> Output {
+    Command::new("xvfb-run")
+        .args([
+            "-a",
+            "-s",
+            "-screen 0 1024x768x24",
+            env!("CARGO_BIN_EXE_hprt"),
+            "view",
+        ])
+        .arg(scene)
+        .args(args)
+        .current_dir(dir)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("xvfb-run (package xvfb; tests/run.sh installs it)")
 }
