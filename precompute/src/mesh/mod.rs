@@ -44,7 +44,8 @@ impl TriangleMesh {
     }
 
     /// Unit geometric normal of triangle `t`, flipped to the side its vertex normals point to
-    /// (the "front" side; back faces reflect nothing but still occlude).
+    /// (the "front" side; a back face shows its front's radiance and occludes: CONVENTIONS.md,
+    /// "Surfaces").
     pub fn front_normal(&self, t: usize) -> Vec3 {
         let [a, b, c] = self.corners(t);
         let n = (b - a).cross(c - a).normalize_or_zero();
