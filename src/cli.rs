@@ -20,7 +20,7 @@ pub struct EnvironmentArgs {
     pub layout: Option<Layout>,
     /// Rotation of the map about +Y in degrees (default: the scene's rotation_deg, whichever
     /// map is used).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_finite)]
     pub rotate: Option<f32>,
 }
 
@@ -190,15 +190,49 @@ pub struct ReportOptions {
     pub backend: Backend,
 }
 
-/// A vector written "x,y,z".
+/// A vector written "x,y,z" of finite numbers.
 pub fn parse_vec3(text: &str) -> Result<glam::Vec3, String> {
     let parts: Vec<f32> = text
         .split(',')
-        .map(|p| p.trim().parse::<f32>())
+        .map(|p| parse_finite(p.trim()))
         .collect::<Result<_, _>>()
-        .map_err(|_| format!("expected \"x,y,z\", got {text:?}"))?;
+        .map_err(|_| format!("expected three finite numbers \"x,y,z\", got {text:?}"))?;
     match parts[..] {
         [x, y, z] => Ok(glam::Vec3::new(x, y, z)),
         _ => Err(format!("expected three numbers \"x,y,z\", got {text:?}")),
+    }
+}
+
+/// A finite number (Rust's parser also takes "NaN" and "inf").
+pub fn parse_finite(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(x) => Err(format!("{x} is not a finite number")),
+        Err(_) => Err(format!("{text:?} is not a number")),
+    }
+}
+
+/// A finite number above zero.
+pub fn parse_positive(text: &str) -> Result<f32, String> {
+    match parse_finite(text)? {
+        x if x > 0.0 => Ok(x),
+        x => Err(format!("{x} must be above 0")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_from_the_command_line_are_finite() {
+        assert_eq!(parse_finite("-100"), Ok(-100.0));
+        for bad in ["NaN", "inf", "-inf", "x"] {
+            assert!(parse_finite(bad).is_err(), "{bad}");
+        }
+        assert!(parse_positive("0").is_err() && parse_positive("-1").is_err());
+        assert_eq!(parse_positive("0.5"), Ok(0.5));
+        assert!(parse_vec3("1,NaN,2").is_err());
+        assert_eq!(parse_vec3("1, 2,3"), Ok(glam::Vec3::new(1.0, 2.0, 3.0)));
     }
 }

@@ -171,6 +171,13 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<(BakeHeader, Transfer), BakeF
         .chunks_exact(4)
         .map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes")))
         .collect();
+    if let Some(i) = floats.iter().position(|x| !x.is_finite()) {
+        // A checksum guards against damage, not against a writer that stored NaN.
+        return Err(corrupt(format!(
+            "transfer value {i} is {} (a bake holds finite numbers only)",
+            floats[i]
+        )));
+    }
     let (direct, indirect) = floats.split_at(floats_per_part as usize);
     let vertex_count = vertex_count as usize;
     let transfer = Transfer {

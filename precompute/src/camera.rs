@@ -53,6 +53,18 @@ impl Camera {
         if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 179.0) {
             return invalid(format!("fov_y_deg {} is outside (0, 179)", self.fov_y_deg));
         }
+        for (name, v) in [
+            ("position", self.position),
+            ("target", self.target),
+            ("up", self.up),
+        ] {
+            if !v.is_finite() {
+                return invalid(format!("camera {name} {v} is not finite"));
+            }
+        }
+        if self.up.length() < 1e-6 {
+            return invalid("camera up vector is zero".into());
+        }
         let forward = self.target - self.position;
         if !forward.is_finite() || forward.length() < 1e-6 {
             return invalid("camera position and target coincide".into());

@@ -295,6 +295,14 @@ impl Scene {
                 .ok_or_else(|| invalid(format!("{name}: the transform is singular")))?;
             geometry.push_object(name, &world, albedo);
         }
+        if let Some(env) = &file.environment
+            && !env.rotation_deg.is_finite()
+        {
+            return Err(invalid(format!(
+                "environment: rotation_deg {} is not finite",
+                env.rotation_deg
+            )));
+        }
         let environment = file.environment.map(|env| EnvironmentSpec {
             map: dir.join(env.map),
             rotation_deg: env.rotation_deg,
@@ -369,6 +377,13 @@ fn box_object(b: &BoxSpec) -> Result<TriangleMesh, ObjectError> {
             ))
         })?;
         skip[index] = true;
+    }
+    if skip.iter().all(|s| *s) {
+        log::warn!(
+            "the box {:?}..{:?} skips all six faces: it adds nothing to the scene",
+            b.min,
+            b.max
+        );
     }
     Ok(box_mesh(min, max, b.segments, skip))
 }

@@ -22,7 +22,12 @@ pub struct DecomposeArgs {
     #[arg(long)]
     pub layout: Option<Layout>,
     /// Rotation of the map about +Y in degrees (counter-clockwise seen from above).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        default_value_t = 0.0,
+        value_parser = crate::cli::parse_finite
+    )]
     pub rotate: f32,
     /// thesis: the thesis' light power; consistent: lights and SH part add up to the map.
     #[arg(long, default_value = "consistent")]

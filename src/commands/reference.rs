@@ -31,7 +31,7 @@ pub struct ReferenceArgs {
     #[arg(long)]
     pub threads: Option<usize>,
     /// Tone-mapping exposure of the PNG (default: 0.5 / the map's mean luminance).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cli::parse_positive)]
     pub exposure: Option<f32>,
     /// Output linear OpenEXR.
     #[arg(short, long)]

@@ -1,7 +1,9 @@
 //! `hprt render`: the hybrid (or plain PRT) image of a baked scene, on the GPU.
 
 use crate::bake_cache::load_bake;
-use crate::cli::{DecomposeOptions, EnvironmentArgs, ImageSizeArgs, RenderOptions, parse_vec3};
+use crate::cli::{
+    DecomposeOptions, EnvironmentArgs, ImageSizeArgs, RenderOptions, parse_positive, parse_vec3,
+};
 use crate::environment::{default_exposure, scene_rotation};
 use crate::sequence::{Sequence, lighting_at_frame};
 use crate::support::load_scene;
@@ -45,10 +47,10 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub camera_target: Option<glam::Vec3>,
     /// Vertical field of view in degrees (default: the scene's).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive)]
     pub fov: Option<f32>,
     /// Tone-mapping exposure (default: 0.5 / the map's mean luminance).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive)]
     pub exposure: Option<f32>,
     /// Output PNG (tone-mapped).
     #[arg(short, long)]

@@ -42,11 +42,7 @@ impl ViewSettings {
 
     /// Applies a `set NAME VALUE` of a script.
     pub fn set(&mut self, name: &str, value: &str) -> anyhow::Result<()> {
-        let number = || {
-            value
-                .parse::<f32>()
-                .map_err(|_| anyhow::anyhow!("{name}: {value:?} is not a number"))
-        };
+        let number = || crate::cli::parse_finite(value).map_err(|m| anyhow::anyhow!("{name}: {m}"));
         let switch = || match value {
             "on" | "true" => Ok(true),
             "off" | "false" => Ok(false),
