@@ -127,6 +127,11 @@ pub fn load(path: &Path, layout: Option<Layout>) -> Result<LoadedEnvMap, EnvMapE
     finish(path, layout, images)
 }
 
+/// The narrowest map hprt reads, in latitude-longitude texels (the height is half): smaller maps
+/// are integrated too coarsely (a 2x1 uniform map would hold 2π² instead of 4π) and their
+/// resampling to cubes is too uneven (spurious lights).
+pub const MIN_MAP_WIDTH: usize = 64;
+
 fn finish(
     path: &Path,
     layout: Layout,
@@ -140,6 +145,21 @@ fn finish(
         );
     }
     let map = resample(path, layout, &images)?;
+    if map.width() < MIN_MAP_WIDTH {
+        return Err(EnvMapError::Layout {
+            path: path.to_owned(),
+            message: format!(
+                "the map is {}x{} as a latitude-longitude map; hprt needs at least {}x{} (a \
+                 cross or face files of {} pixels per face), below which the map cannot be \
+                 integrated accurately",
+                map.width(),
+                map.height(),
+                MIN_MAP_WIDTH,
+                MIN_MAP_WIDTH / 2,
+                MIN_MAP_WIDTH / 4
+            ),
+        });
+    }
     Ok(LoadedEnvMap {
         map,
         sanitized,
@@ -498,6 +518,32 @@ mod tests {
             Layout::CrossVertical,
         ] {
             assert_eq!(l.name().parse::<Layout>(), Ok(l));
+        }
+    }
+
+    /// Uniform maps: below the minimum they are refused with the sizes named; from the minimum
+    /// up (odd sizes too) they hold 4π times their radiance.
+    #[test]
+    fn tiny_maps_are_refused_and_small_ones_integrate_to_four_pi() {
+        let dir = tempfile::tempdir().unwrap();
+        let write = |w: usize, h: usize| {
+            let path = dir.path().join(format!("u{w}x{h}.exr"));
+            let image = crate::image_io::RgbImageF32::filled(w, h, Rgb::ONE);
+            crate::image_io::write_exr(&path, &image).unwrap();
+            path
+        };
+        for (w, h) in [(2, 1), (8, 4), (32, 16), (62, 31)] {
+            let message = load(&write(w, h), None).err().unwrap().to_string();
+            assert!(
+                message.contains(&format!("{w}x{h}")) && message.contains("at least 64x32"),
+                "{message}"
+            );
+        }
+        for (w, h) in [(64, 32), (100, 50), (256, 128)] {
+            let map = load(&write(w, h), None).unwrap().map;
+            let total = map.total_power().x;
+            let four_pi = 4.0 * std::f32::consts::PI;
+            assert!((total - four_pi).abs() < 1e-3 * four_pi, "{w}x{h}: {total}");
         }
     }
 }

@@ -6,7 +6,7 @@ pub mod cube;
 mod load;
 pub mod sampling;
 
-pub use load::{EnvMapError, Layout, LoadedEnvMap, load};
+pub use load::{EnvMapError, Layout, LoadedEnvMap, MIN_MAP_WIDTH, load};
 
 use crate::color::{Rgb, luminance};
 use crate::sh::{ShBasis, ShCoeffs};

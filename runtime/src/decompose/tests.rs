@@ -264,3 +264,20 @@ fn more_lights_than_peaks_considered_is_an_error() {
     let message = Decomposer::new(settings).err().unwrap().to_string();
     assert!(message.contains("at most 24 lights"), "{message}");
 }
+
+/// The smallest maps hprt reads (`precompute::envmap::MIN_MAP_WIDTH`) decompose like large
+/// ones: a uniform map has no light and its SH part holds exactly its power, 4π.
+#[test]
+fn the_smallest_uniform_maps_have_no_lights() {
+    let min = precompute::envmap::MIN_MAP_WIDTH;
+    for (w, h) in [(min, min / 2), (100, 50), (128, 64)] {
+        let map = EnvMap::uniform(w, h, Rgb::ONE);
+        for mode in [DecomposeMode::Consistent, DecomposeMode::Thesis] {
+            let result = decompose(&map, 0.0, DecomposeSettings::for_mode(mode, 5));
+            assert!(result.lights.is_empty(), "{w}x{h} {mode:?}: {:?}", result.lights);
+            let total = luminance(result.total());
+            let four_pi = 4.0 * PI;
+            assert!((total - four_pi).abs() < 2e-3 * four_pi, "{w}x{h}: {total}");
+        }
+    }
+}
