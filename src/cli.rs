@@ -169,7 +169,7 @@ pub struct ReportOptions {
     #[arg(long)]
     pub bake: Option<PathBuf>,
     /// Light paths per pixel of the reference.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
     pub spp: u32,
     /// Indirect bounces of the reference (default: the bake's, so both see the same light).
     #[arg(long)]

@@ -156,3 +156,71 @@ fn a_bake_holding_nan_is_refused() {
         "{message}"
     );
 }
+
+/// Declared sizes are checked before anything is allocated (issue 13, class 1): a small file
+/// claiming a huge image, and a patch tessellation beyond its bound.
+#[test]
+fn declared_sizes_are_checked_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A valid 64x32 EXR whose data window is then made to claim 100000 x 100000 texels.
+    let image = precompute::image_io::RgbImageF32::filled(64, 32, precompute::Rgb::ONE);
+    let mut exr = precompute::image_io::exr_bytes(&image).unwrap();
+    let tag = b"dataWindow\0box2i\0";
+    let at = exr.windows(tag.len()).position(|w| w == tag).unwrap() + tag.len() + 4;
+    exr[at + 8..at + 12].copy_from_slice(&99_999i32.to_le_bytes());
+    exr[at + 12..at + 16].copy_from_slice(&99_999i32.to_le_bytes());
+    std::fs::write(d.join("huge.exr"), &exr).unwrap();
+    std::fs::write(
+        d.join("huge.hdr"),
+        b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 200000\n\0\0\0\0",
+    )
+    .unwrap();
+    for map in ["huge.exr", "huge.hdr"] {
+        let start = std::time::Instant::now();
+        let out = hprt(d, &["decompose", map, "-o", "out.json"]);
+        assert_clean_failure(&out, &[map, "at most"]);
+        assert!(
+            start.elapsed().as_secs() < 5,
+            "{map} was refused only after decoding"
+        );
+        assert!(!d.join("out.json").exists());
+    }
+    // Image sizes and sample counts.
+    let scene = quad_scene(d, "s.toml", CAMERA, "");
+    let env = repo().join("scenes/env/sunrise.exr");
+    let env = env.to_str().unwrap();
+    for (args, needle) in [
+        (
+            vec!["--width", "100000", "--height", "10"],
+            "over the limit",
+        ),
+        (
+            vec!["--width", "10000", "--height", "10000"],
+            "over the limit",
+        ),
+        (vec!["--spp", "4000000000"], "spp"),
+    ] {
+        let mut all = vec!["reference", scene.as_str(), "--env", env, "-o", "big.exr"];
+        all.extend_from_slice(&args);
+        let out = hprt(d, &all);
+        assert_clean_failure(&out, &[needle]);
+        assert!(!d.join("big.exr").exists());
+    }
+    // Bézier patch tessellation: 0 and a huge count are refused.
+    std::fs::copy(repo().join("scenes/meshes/teapot.bpt"), d.join("t.bpt")).unwrap();
+    for segments in ["0", "100000"] {
+        let scene = quad_scene(
+            d,
+            "bpt.toml",
+            CAMERA,
+            &format!(
+                "[[object]]\nmesh = \"t.bpt\"\npatch_segments = {segments}\n\
+                 albedo = [0.5, 0.5, 0.5]"
+            ),
+        );
+        let out = hprt(d, &["bake", &scene, "-o", "out.bake"]);
+        assert_clean_failure(&out, &["patch_segments", "1..=256"]);
+        assert!(!d.join("out.bake").exists());
+    }
+}

@@ -29,6 +29,11 @@ pub struct CameraBasis {
     pub forward: Vec3,
 }
 
+/// Largest image side a camera may have.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+/// Most pixels of an image (8192², 1 GB as float RGBA): checked before any image is allocated.
+pub const MAX_IMAGE_PIXELS: u64 = 8192 * 8192;
+
 impl Camera {
     /// The same camera rendering `width × height` pixels.
     pub fn with_size(mut self, width: u32, height: u32) -> Self {
@@ -47,6 +52,16 @@ impl Camera {
         if self.width == 0 || self.height == 0 {
             return invalid(format!(
                 "image size {}x{} is empty",
+                self.width, self.height
+            ));
+        }
+        if self.width > MAX_IMAGE_SIDE
+            || self.height > MAX_IMAGE_SIDE
+            || self.width as u64 * self.height as u64 > MAX_IMAGE_PIXELS
+        {
+            return invalid(format!(
+                "image size {}x{} is over the limit ({MAX_IMAGE_SIDE} per side, \
+                 {MAX_IMAGE_PIXELS} pixels)",
                 self.width, self.height
             ));
         }

@@ -18,7 +18,7 @@ pub struct DemoArgs {
     #[arg(long)]
     pub scene: Option<PathBuf>,
     /// Light paths per pixel of the references.
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
     pub spp: u32,
     #[arg(long, default_value_t = 400)]
     pub width: u32,

@@ -17,7 +17,7 @@ pub struct ExportArgs {
     #[arg(long, default_value_t = 3)]
     pub bounces: u32,
     /// Samples per pixel.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
     pub spp: u32,
     #[command(flatten)]
     pub size: ImageSizeArgs,

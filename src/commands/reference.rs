@@ -20,7 +20,7 @@ pub struct ReferenceArgs {
     #[command(flatten)]
     pub size: ImageSizeArgs,
     /// Light paths per pixel.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
     pub spp: u32,
     /// Indirect bounces, as in the bake (0: shadowed direct lighting).
     #[arg(long, default_value_t = 3)]

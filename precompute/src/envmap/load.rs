@@ -127,6 +127,24 @@ pub fn load(path: &Path, layout: Option<Layout>) -> Result<LoadedEnvMap, EnvMapE
     finish(path, layout, images)
 }
 
+/// Most texels an input image may declare (8192 × 4096: 400 MB as float RGB): checked against
+/// the file's header before its pixels are allocated.
+pub const MAX_IMAGE_TEXELS: usize = 8192 * 4096;
+
+/// Refuses an image whose declared size is over [`MAX_IMAGE_TEXELS`].
+fn check_size(path: &Path, width: usize, height: usize) -> Result<(), EnvMapError> {
+    match width.checked_mul(height) {
+        Some(texels) if texels <= MAX_IMAGE_TEXELS => Ok(()),
+        _ => Err(EnvMapError::Layout {
+            path: path.to_owned(),
+            message: format!(
+                "the image declares {width}x{height} texels; hprt reads at most {MAX_IMAGE_TEXELS} \
+                 (8192x4096)"
+            ),
+        }),
+    }
+}
+
 /// The narrowest map hprt reads, in latitude-longitude texels (the height is half): smaller maps
 /// are integrated too coarsely (a 2x1 uniform map would hold 2π² instead of 4π) and their
 /// resampling to cubes is too uneven (spurious lights).
@@ -211,6 +229,9 @@ fn read_exr(path: &Path) -> Result<RgbImage, EnvMapError> {
     };
     // Check the compression first: the reader cannot decode DWA and would fail obscurely.
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(decode)?;
+    for header in &meta.headers {
+        check_size(path, header.layer_size.width(), header.layer_size.height())?;
+    }
     if let Some(header) = meta.headers.first() {
         let name = match header.compression {
             Compression::DWAA(_) => Some("DWAA"),
@@ -241,6 +262,19 @@ fn read_exr(path: &Path) -> Result<RgbImage, EnvMapError> {
 }
 
 fn read_hdr(path: &Path) -> Result<RgbImage, EnvMapError> {
+    // The header's size first, before anything the size of the image is allocated.
+    let (width, height) = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|cause| EnvMapError::Io {
+            path: path.to_owned(),
+            cause,
+        })?
+        .into_dimensions()
+        .map_err(|e| EnvMapError::Decode {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+    check_size(path, width as usize, height as usize)?;
     let decoded = image::ImageReader::open(path)
         .map_err(|cause| EnvMapError::Io {
             path: path.to_owned(),

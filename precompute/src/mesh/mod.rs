@@ -152,6 +152,10 @@ pub struct LoadOptions {
     pub skip_patches: Vec<usize>,
 }
 
+/// Most quads per side of a Bézier patch (`patch_segments`): 256² quads per patch, far past any
+/// use (the teapot needs 16), and bounded before anything is allocated.
+pub const MAX_PATCH_SEGMENTS: u32 = 256;
+
 /// Reads a mesh file (OBJ, PLY ASCII or binary, BPT; any of them gzipped) without clean-up.
 pub fn read_mesh(path: &Path, options: &LoadOptions) -> Result<RawMesh, MeshError> {
     let format = format_of(path).ok_or_else(|| MeshError::UnsupportedFormat {
@@ -169,6 +173,15 @@ pub fn read_mesh(path: &Path, options: &LoadOptions) -> Result<RawMesh, MeshErro
                     message: format!(
                         "cannot skip patch {bad}: the file has {} patches",
                         patches.len()
+                    ),
+                });
+            }
+            let segments = options.patch_segments.unwrap_or(16);
+            if !(1..=MAX_PATCH_SEGMENTS).contains(&segments) {
+                return Err(MeshError::Invalid {
+                    path: path.to_owned(),
+                    message: format!(
+                        "patch_segments {segments} is outside 1..={MAX_PATCH_SEGMENTS}"
                     ),
                 });
             }

@@ -274,7 +274,11 @@ fn the_smallest_uniform_maps_have_no_lights() {
         let map = EnvMap::uniform(w, h, Rgb::ONE);
         for mode in [DecomposeMode::Consistent, DecomposeMode::Thesis] {
             let result = decompose(&map, 0.0, DecomposeSettings::for_mode(mode, 5));
-            assert!(result.lights.is_empty(), "{w}x{h} {mode:?}: {:?}", result.lights);
+            assert!(
+                result.lights.is_empty(),
+                "{w}x{h} {mode:?}: {:?}",
+                result.lights
+            );
             let total = luminance(result.total());
             let four_pi = 4.0 * PI;
             assert!((total - four_pi).abs() < 2e-3 * four_pi, "{w}x{h}: {total}");

@@ -76,6 +76,22 @@ fn checked<T>(
     }
 }
 
+/// Refuses an image larger than the adapter's textures can be (before the driver would).
+fn check_image_size(device: &wgpu::Device, camera: &Camera) -> Result<(), RenderError> {
+    let max = device.limits().max_texture_dimension_2d;
+    if camera.width > max || camera.height > max {
+        return Err(InvalidSettings::new(
+            "image size",
+            format!(
+                "{}x{} is larger than the graphics adapter allows ({max} per side)",
+                camera.width, camera.height
+            ),
+        )
+        .into());
+    }
+    Ok(())
+}
+
 /// What a frame is drawn with and whether the vertex radiance is stale.
 struct FrameState {
     camera: Camera,
@@ -122,6 +138,7 @@ impl Renderer {
         shadow: ShadowSettings,
     ) -> Result<Self, RenderError> {
         camera.validate()?;
+        check_image_size(&gpu.device, camera)?;
         let device = gpu.device.clone();
         let scene = GpuScene::new(&device, geometry, transfer)?;
         let buffers = FrameBuffers::new(&device);
@@ -183,6 +200,7 @@ impl Renderer {
     /// [`Self::color_view`]) was re-created for a new size.
     pub fn set_camera(&mut self, camera: &Camera) -> Result<bool, RenderError> {
         camera.validate()?;
+        check_image_size(&self.device, camera)?;
         let resized = (camera.width, camera.height) != (self.targets.width, self.targets.height);
         if resized {
             self.targets = Targets::new(&self.device, camera.width, camera.height);
