@@ -224,3 +224,31 @@ fn declared_sizes_are_checked_before_allocating() {
         assert!(!d.join("out.bake").exists());
     }
 }
+
+/// A PLY header declaring more elements than its file can hold is refused at once.
+#[test]
+fn ply_element_counts_are_checked_against_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for format in ["ascii", "binary_little_endian"] {
+        std::fs::write(
+            d.join("big.ply"),
+            format!(
+                "ply\nformat {format} 1.0\nelement vertex 4000000000\nproperty float x\n\
+                 property float y\nproperty float z\nelement face 1\n\
+                 property list uchar int vertex_indices\nend_header\n"
+            ),
+        )
+        .unwrap();
+        std::fs::write(
+            d.join("s.toml"),
+            format!(
+                "[camera]\n{CAMERA}\nfov_y_deg = 40\nwidth = 16\nheight = 12\n\
+                 [[object]]\nmesh = \"big.ply\"\nalbedo = [0.5, 0.5, 0.5]\n"
+            ),
+        )
+        .unwrap();
+        let out = hprt(d, &["bake", "s.toml", "-o", "out.bake"]);
+        assert_clean_failure(&out, &["big.ply", "4000000000 vertex elements"]);
+    }
+}

@@ -124,6 +124,21 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let header = vertex_parser
         .read_header(&mut reader)
         .map_err(|e| to_error(e, "bad PLY header"))?;
+    // Every element takes at least a byte: a count beyond the file's size is a lie, refused
+    // before the reader reserves memory for it.
+    for (name, element) in &header.elements {
+        if element.count > bytes.len() {
+            return Err(MeshError::Invalid {
+                path: path.to_owned(),
+                message: format!(
+                    "the header declares {} {name} elements, more than the file's {} bytes \
+                     can hold",
+                    element.count,
+                    bytes.len()
+                ),
+            });
+        }
+    }
 
     let (mut vertices, mut faces) = (Vec::new(), Vec::new());
     for (name, element) in &header.elements {
