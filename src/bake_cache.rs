@@ -23,6 +23,17 @@ pub fn cache_dir() -> PathBuf {
         .unwrap_or_else(|| std::env::temp_dir().join("hprt-cache"))
 }
 
+/// Creates a folder of the cache, naming the variables that chose it when that fails.
+pub fn create_cache_folder(dir: &Path) -> anyhow::Result<()> {
+    crate::support::create_folder(dir).with_context(|| {
+        format!(
+            "cannot use the cache folder {} (chosen by HPRT_CACHE, else XDG_CACHE_HOME, else \
+             HOME)",
+            cache_dir().display()
+        )
+    })
+}
+
 /// Reads the scene's bake, refusing one of another mesh, or one whose SH order is below the
 /// lighting order asked (a lower lighting order than the bake's just drops bands).
 pub fn load_bake(scene: &Scene, path: &Path, order: Option<usize>) -> anyhow::Result<Transfer> {
@@ -71,7 +82,7 @@ pub fn bake_into_cache(
     let bvh = SceneBvh::build(&scene.geometry.mesh);
     let (transfer, stats) = precompute::bake::bake(&scene.geometry, &bvh, settings, progress)?;
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        create_cache_folder(dir)?;
     }
     precompute::bakefile::write(&path, &transfer, &scene.geometry.content_hash())?;
     Ok((path, transfer, stats))

@@ -28,6 +28,15 @@ pub fn with_threads<T: Send>(
     }
 }
 
+/// Creates the output folder `dir` (and its parents), saying clearly when a file is in the way.
+pub fn create_folder(dir: &Path) -> anyhow::Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        anyhow::bail!("{} exists and is not a folder", dir.display());
+    }
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create the folder {}", dir.display()))
+}
+
 /// Median of a non-empty sample.
 pub fn median(mut xs: Vec<f64>) -> f64 {
     xs.sort_by(f64::total_cmp);

@@ -252,3 +252,60 @@ fn ply_element_counts_are_checked_against_the_file() {
         assert_clean_failure(&out, &["big.ply", "4000000000 vertex elements"]);
     }
 }
+
+/// Messages that point the right way (issue 13, class 5).
+#[test]
+fn messages_name_the_real_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sunrise = repo().join("scenes/env/sunrise.exr");
+    let sunrise = sunrise.to_str().unwrap();
+    // An empty EXR.
+    std::fs::write(d.join("empty.exr"), b"").unwrap();
+    let out = hprt(d, &["decompose", "empty.exr", "-o", "x.json"]);
+    assert_clean_failure(&out, &["empty.exr", "empty or cut short"]);
+    // The faces layout without {face}.
+    let out = hprt(
+        d,
+        &["decompose", sunrise, "--layout", "faces", "-o", "x.json"],
+    );
+    assert_clean_failure(&out, &["{face}"]);
+    // An output folder that is a file.
+    let scene = quad_scene(d, "s.toml", CAMERA, "");
+    std::fs::write(d.join("taken"), b"x").unwrap();
+    let out = hprt(d, &["export", &scene, "--env", sunrise, "-o", "taken"]);
+    assert!(!out.status.success());
+    let out = hprt_with_env(
+        d,
+        &["report", &scene, "--envs", sunrise, "-o", "taken"],
+        &[("HPRT_CACHE", &d.join("cache"))],
+    );
+    assert_clean_failure(&out, &["taken exists and is not a folder"]);
+    // A cache that is a file names the variable that chose it.
+    let out = hprt_with_env(
+        d,
+        &["report", &scene, "--envs", sunrise, "-o", "rep"],
+        &[("HPRT_CACHE", &d.join("taken"))],
+    );
+    assert_clean_failure(&out, &["HPRT_CACHE"]);
+    // `bake -o` naming a folder fails before baking.
+    std::fs::create_dir(d.join("folder")).unwrap();
+    let out = hprt(d, &["bake", &scene, "-o", "folder"]);
+    assert_clean_failure(&out, &["folder is a folder"]);
+    // A bake of the same mesh with other albedos is named as such.
+    let out = hprt(d, &["bake", &scene, "-o", "s.bake"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(d.join("s.toml")).unwrap();
+    std::fs::write(
+        d.join("s.toml"),
+        text.replace("[0.5, 0.5, 0.5]", "[0.6, 0.5, 0.5]"),
+    )
+    .unwrap();
+    let out = hprt(
+        d,
+        &[
+            "render", &scene, "--bake", "s.bake", "--env", sunrise, "-o", "r.png",
+        ],
+    );
+    assert_clean_failure(&out, &["albedos"]);
+}

@@ -13,6 +13,12 @@ pub struct AtomicOutput {
 
 impl AtomicOutput {
     pub fn create(path: &Path) -> Result<Self, std::io::Error> {
+        if path.is_dir() {
+            return Err(std::io::Error::other(format!(
+                "{} is a folder; name a file to write",
+                path.display()
+            )));
+        }
         let dir = match path.parent() {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),

@@ -54,7 +54,7 @@ pub enum BakeFileError {
     #[error("{}: corrupt bake file: {message}", path.display())]
     Corrupt { path: PathBuf, message: String },
     #[error(
-        "{}: the bake was made from a different mesh than this scene's (mesh hash mismatch); re-bake with `hprt bake`",
+        "{}: the bake was made for another scene: its geometry, normals or albedos differ from this scene's (the transfer holds the albedos); re-bake with `hprt bake`",
         path.display()
     )]
     MeshMismatch { path: PathBuf },

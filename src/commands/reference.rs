@@ -70,7 +70,7 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
     let output = AtomicOutput::create(&args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     if let Some(dir) = &args.aux {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        crate::support::create_folder(dir)?;
     }
     let settings = ReferenceSettings {
         spp: args.spp,

@@ -106,6 +106,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     renderer.set_lighting(&frame.lighting)?;
     renderer.render()?;
     let image: RgbImageF32 = renderer.read_back()?;
+    // The renderer's target is half float: radiance above its largest value is clipped.
+    let clipped = image
+        .pixels
+        .iter()
+        .filter(|p| p.max_element() >= 65504.0)
+        .count();
+    if clipped > 0 && args.exr.is_some() {
+        log::warn!(
+            "{clipped} pixel(s) reached 65504, the largest value of the renderer's half-float \
+             target: the EXR holds them clipped"
+        );
+    }
     let exposure = args
         .exposure
         .unwrap_or_else(|| default_exposure(lighting.map()));

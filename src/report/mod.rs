@@ -12,7 +12,6 @@ use crate::bake_cache::{self, cache_dir};
 use crate::cli::ReportOptions;
 use crate::environment::{default_exposure, load_map, scene_rotation};
 use crate::support::{TerminalProgress, median};
-use anyhow::Context;
 use figures::Curve;
 use precompute::atomic_file::write_atomic;
 use precompute::bake::Transfer;
@@ -216,7 +215,7 @@ pub(crate) fn reference_images(
     let light = EnvironmentLight::new(map, rotation_deg);
     let progress = TerminalProgress::new("reference rows");
     let image = reference::render(&scene.geometry, &bvh, &light, camera, settings, &progress);
-    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    bake_cache::create_cache_folder(&dir)?;
     let (w, h) = (camera.width as usize, camera.height as usize);
     write_exr(&paths[0], &image.radiance)?;
     write_exr(&paths[1], &RgbImageF32::from_grey(w, h, &image.coverage))?;
@@ -329,7 +328,7 @@ fn report_map(job: &mut MapJob, env: &Path) -> anyhow::Result<MapReport> {
     let rotation = scene_rotation(job.scene, None);
     let exposure = default_exposure(&map);
     let dir = job.out.join(&name);
-    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    crate::support::create_folder(&dir)?;
 
     let reference_settings = ReferenceSettings {
         spp: job.settings.spp,
@@ -427,7 +426,7 @@ pub fn run_report(
     settings: &ReportSettings,
     out: &Path,
 ) -> anyhow::Result<Report> {
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    crate::support::create_folder(out)?;
     let camera = scene.camera.with_size(settings.width, settings.height);
     camera.validate()?;
     let gpu = GpuContext::headless(settings.backend)?;

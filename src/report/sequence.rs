@@ -12,7 +12,6 @@ use crate::bake_cache;
 use crate::cli::ReportOptions;
 use crate::environment::{default_exposure, scene_rotation};
 use crate::sequence::Sequence;
-use anyhow::Context;
 use base64::Engine;
 use precompute::atomic_file::write_atomic;
 use precompute::image_io::{RgbImageF32, to_display_rgb8, tonemap};
@@ -188,7 +187,7 @@ pub fn write_sequence_report(
         thresholds: Vec::new(),
         ..ReportSettings::new(options, &camera, &transfer)
     };
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    crate::support::create_folder(out)?;
     let gpu = GpuContext::headless(options.backend)?;
     println!("adapter: {}", gpu.description());
     let mut renderer = Renderer::new(

@@ -89,7 +89,15 @@ pub struct LoadedEnvMap {
 pub fn load(path: &Path, layout: Option<Layout>) -> Result<LoadedEnvMap, EnvMapError> {
     let is_pattern = path.to_string_lossy().contains("{face}");
     let layout = match (layout, is_pattern) {
-        (Some(Layout::Faces), _) | (None, true) => Layout::Faces,
+        (Some(Layout::Faces), false) => {
+            return Err(EnvMapError::Layout {
+                path: path.to_owned(),
+                message: "the faces layout reads six files: give a path containing {face}, \
+                          replaced by px, nx, py, ny, pz and nz"
+                    .into(),
+            });
+        }
+        (Some(Layout::Faces), true) | (None, true) => Layout::Faces,
         (Some(other), false) => other,
         (Some(other), true) => {
             return Err(EnvMapError::Layout {
@@ -223,9 +231,22 @@ fn read_image(path: &Path) -> Result<RgbImage, EnvMapError> {
 
 fn read_exr(path: &Path) -> Result<RgbImage, EnvMapError> {
     use exr::prelude::*;
-    let decode = |e: exr::error::Error| EnvMapError::Decode {
-        path: path.to_owned(),
-        message: e.to_string(),
+    let decode = |e: exr::error::Error| {
+        let message = e.to_string();
+        let length = std::fs::metadata(path).map_or(0, |m| m.len());
+        EnvMapError::Decode {
+            path: path.to_owned(),
+            message: if message.contains("missing bytes") || length == 0 {
+                format!("the file is empty or cut short ({length} bytes): {message}")
+            } else if message.contains("no layer in the image matched") {
+                format!(
+                    "{message}: hprt needs the R, G and B channels{}",
+                    channel_list(path)
+                )
+            } else {
+                message
+            },
+        }
     };
     // Check the compression first: the reader cannot decode DWA and would fail obscurely.
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(decode)?;
@@ -259,6 +280,20 @@ fn read_exr(path: &Path) -> Result<RgbImage, EnvMapError> {
     )
     .map_err(decode)?;
     Ok(image.layer_data.channel_data.pixels)
+}
+
+/// ", the file has: Y, A" (the channels of the EXR's first layer), or nothing if unreadable.
+fn channel_list(path: &Path) -> String {
+    exr::meta::MetaData::read_from_file(path, false)
+        .ok()
+        .and_then(|meta| {
+            meta.headers.first().map(|h| {
+                let names: Vec<String> =
+                    h.channels.list.iter().map(|c| c.name.to_string()).collect();
+                format!(", the file has: {}", names.join(", "))
+            })
+        })
+        .unwrap_or_default()
 }
 
 fn read_hdr(path: &Path) -> Result<RgbImage, EnvMapError> {
