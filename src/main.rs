@@ -55,6 +55,12 @@ fn main() {
             writeln!(buf, "{level}: {}", record.args())
         })
         .init();
+    // Ctrl-C or SIGTERM: remove the outputs' temporary files, as a failed run does.
+    let _ = ctrlc::set_handler(|| {
+        precompute::atomic_file::remove_partials();
+        eprintln!("interrupted");
+        std::process::exit(130);
+    });
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo(args) => commands::demo::run(args),

@@ -309,3 +309,100 @@ fn messages_name_the_real_problem() {
     );
     assert_clean_failure(&out, &["albedos"]);
 }
+
+/// Outputs never destroy what is at their path (issue 13, class 2): two outputs of one command
+/// at one path are refused, a symbolic link is written through, and a run stopped by a
+/// signal leaves no temporary file.
+#[test]
+fn outputs_keep_links_refuse_collisions_and_clean_up_on_signals() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = quad_scene(d, "s.toml", CAMERA, "");
+    let env = repo().join("scenes/env/sunrise.exr");
+    let env = env.to_str().unwrap();
+    let out = hprt(
+        d,
+        &[
+            "reference",
+            &scene,
+            "--env",
+            env,
+            "--spp",
+            "1",
+            "-o",
+            "x.exr",
+            "--png",
+            "./x.exr",
+        ],
+    );
+    assert_clean_failure(&out, &["-o and --png name the same file"]);
+    assert!(!d.join("x.exr").exists());
+    let out = hprt(d, &["decompose", env, "-o", "same", "--png", "same"]);
+    assert_clean_failure(&out, &["the same file"]);
+
+    // A symbolic link: its target gets the image, the link stays.
+    #[cfg(unix)]
+    {
+        std::fs::write(d.join("real.exr"), b"old").unwrap();
+        std::os::unix::fs::symlink("real.exr", d.join("link.exr")).unwrap();
+        let out = hprt(
+            d,
+            &[
+                "reference",
+                &scene,
+                "--env",
+                env,
+                "--spp",
+                "1",
+                "-o",
+                "link.exr",
+            ],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let link = std::fs::symlink_metadata(d.join("link.exr")).unwrap();
+        assert!(link.file_type().is_symlink());
+        assert!(precompute::image_io::read_exr(&d.join("real.exr")).is_ok());
+    }
+
+    // SIGTERM in the middle of a long reference render: no partial file remains.
+    #[cfg(unix)]
+    {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_hprt"))
+            .args([
+                "reference",
+                &scene,
+                "--env",
+                env,
+                "--spp",
+                "100000",
+                "-o",
+                "long.exr",
+            ])
+            .current_dir(d)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        // Wait until its temporary file exists, then stop it.
+        let partial = || {
+            std::fs::read_dir(d)
+                .unwrap()
+                .flatten()
+                .any(|e| e.file_name().to_string_lossy().ends_with(".partial"))
+        };
+        let start = std::time::Instant::now();
+        while !partial() && start.elapsed().as_secs() < 20 {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        assert!(partial(), "the render made no temporary file");
+        let status = std::process::Command::new("kill")
+            .args(["-TERM", &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let code = child.wait().unwrap().code();
+        assert_eq!(code, Some(130));
+        assert!(!partial(), "a temporary file was left behind");
+        assert!(!d.join("long.exr").exists());
+    }
+}

@@ -6,9 +6,78 @@ use std::path::{Path, PathBuf};
 /// An output file opened before the work that fills it, so an unwritable path fails at once. The data
 /// goes to a temporary file beside the target and is renamed over it only when complete: an
 /// interrupted bake never leaves a partial file at `path`.
+///
+/// - A symbolic link is followed: the file it points to is replaced, the link stays.
+/// - A target that is not a regular file (`/dev/null`, a FIFO) is written straight through,
+///   never replaced.
+/// - The temporary file (`.NAME.PID.XXXXXX.partial`) is removed if the work fails, when the
+///   program is stopped by a signal (the program calls [`remove_partials`]), and, if a process
+///   died without that, by the next output to the same folder.
 pub struct AtomicOutput {
     path: PathBuf,
-    temp: tempfile::NamedTempFile,
+    /// `None` once committed.
+    target: Option<Target>,
+}
+
+enum Target {
+    Temporary(tempfile::NamedTempFile),
+    Direct(std::fs::File),
+}
+
+/// Temporary files of this process not yet committed, for [`remove_partials`].
+static PARTIALS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Removes this process's uncommitted temporary files (from a signal handler's thread, before
+/// exiting).
+pub fn remove_partials() {
+    if let Ok(partials) = PARTIALS.lock() {
+        for path in partials.iter() {
+            let _ = std::fs::remove_file(path);
+        }
+    }
+}
+
+/// The file a chain of symbolic links ends at (the path itself when it is none).
+fn follow_links(path: &Path) -> Result<PathBuf, std::io::Error> {
+    let mut path = path.to_owned();
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&path) {
+            Ok(meta) if meta.file_type().is_symlink() => {
+                let target = std::fs::read_link(&path)?;
+                path = match path.parent() {
+                    Some(dir) if target.is_relative() => dir.join(target),
+                    _ => target,
+                };
+            }
+            _ => return Ok(path),
+        }
+    }
+    Err(std::io::Error::other(format!(
+        "{}: too many levels of symbolic links",
+        path.display()
+    )))
+}
+
+/// Removes `.NAME.PID.*.partial` files in `dir` left by processes that no longer run.
+fn remove_stale_partials(dir: &Path, name: &str) {
+    let prefix = format!(".{name}.");
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let Some(rest) = file.strip_prefix(&prefix) else {
+            continue;
+        };
+        if !rest.ends_with(".partial") {
+            continue;
+        }
+        let pid = rest.split('.').next().and_then(|p| p.parse::<u32>().ok());
+        let alive = pid.is_none_or(|pid| Path::new(&format!("/proc/{pid}")).exists());
+        if !alive && cfg!(target_os = "linux") {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
 }
 
 impl AtomicOutput {
@@ -19,15 +88,27 @@ impl AtomicOutput {
                 path.display()
             )));
         }
-        let dir = match path.parent() {
+        let resolved = follow_links(path)?;
+        if let Ok(meta) = std::fs::metadata(&resolved)
+            && !meta.is_file()
+        {
+            // A device or a pipe: write to it, never replace it.
+            let file = std::fs::OpenOptions::new().write(true).open(&resolved)?;
+            return Ok(Self {
+                path: path.to_owned(),
+                target: Some(Target::Direct(file)),
+            });
+        }
+        let dir = match resolved.parent() {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
-        let name = path
+        let name = resolved
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .ok_or_else(|| std::io::Error::other("the output path has no file name"))?;
-        let prefix = format!(".{name}.");
+        remove_stale_partials(dir, &name);
+        let prefix = format!(".{name}.{}.", std::process::id());
         let mut builder = tempfile::Builder::new();
         builder.prefix(&prefix).suffix(".partial");
         // Temporary files are private (0600) by default; the output is an ordinary file, so it
@@ -35,9 +116,12 @@ impl AtomicOutput {
         #[cfg(unix)]
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
         let temp = builder.tempfile_in(dir)?;
+        if let Ok(mut partials) = PARTIALS.lock() {
+            partials.push(temp.path().to_owned());
+        }
         Ok(Self {
-            path: path.to_owned(),
-            temp,
+            path: resolved,
+            target: Some(Target::Temporary(temp)),
         })
     }
 
@@ -47,10 +131,31 @@ impl AtomicOutput {
 
     /// Writes `bytes` and moves the file into place.
     pub fn commit(mut self, bytes: &[u8]) -> Result<(), std::io::Error> {
-        self.temp.write_all(bytes)?;
-        self.temp.as_file().sync_all()?;
-        self.temp.persist(&self.path).map_err(|e| e.error)?;
-        Ok(())
+        match self.target.take() {
+            None => Ok(()),
+            Some(Target::Direct(mut file)) => file.write_all(bytes),
+            Some(Target::Temporary(mut temp)) => {
+                forget_partial(temp.path());
+                temp.write_all(bytes)?;
+                temp.as_file().sync_all()?;
+                temp.persist(&self.path).map_err(|e| e.error)?;
+                Ok(())
+            }
+        }
+    }
+}
+
+fn forget_partial(path: &Path) {
+    if let Ok(mut partials) = PARTIALS.lock() {
+        partials.retain(|p| p != path);
+    }
+}
+
+impl Drop for AtomicOutput {
+    fn drop(&mut self) {
+        if let Some(Target::Temporary(temp)) = &self.target {
+            forget_partial(temp.path());
+        }
     }
 }
 
@@ -62,6 +167,42 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), std::io::Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[cfg(unix)]
+    #[test]
+    fn links_are_followed_and_devices_written_through() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("real.png");
+        std::fs::write(&target, b"old").unwrap();
+        let link = dir.path().join("link.png");
+        std::os::unix::fs::symlink("real.png", &link).unwrap();
+        write_atomic(&link, b"new").unwrap();
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+        // /dev/null stays a device.
+        write_atomic(Path::new("/dev/null"), b"data").unwrap();
+        assert!(!std::fs::metadata("/dev/null").unwrap().is_file());
+    }
+
+    #[test]
+    fn stale_partials_of_dead_processes_are_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        // No process has PID 4294967: its partial is stale; a live one's stays.
+        let stale = dir.path().join(".x.exr.4294967.abcdef.partial");
+        let live = dir
+            .path()
+            .join(format!(".x.exr.{}.abcdef.partial", std::process::id()));
+        std::fs::write(&stale, b"").unwrap();
+        std::fs::write(&live, b"").unwrap();
+        write_atomic(&dir.path().join("x.exr"), b"data").unwrap();
+        assert_eq!(stale.exists(), !cfg!(target_os = "linux"));
+        assert!(live.exists());
+    }
 
     #[test]
     fn unwritable_destination_fails_before_any_work() {

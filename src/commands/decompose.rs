@@ -76,6 +76,10 @@ pub fn run(args: DecomposeArgs) -> anyhow::Result<()> {
         .options
         .settings(args.mode, DecomposeSettings::default().order);
     settings.validate()?;
+    crate::support::distinct_outputs(&[
+        ("-o", Some(&args.output)),
+        ("--png", args.png.as_deref()),
+    ])?;
     if args.repeat == 0 {
         anyhow::bail!("--repeat must be at least 1");
     }

@@ -67,6 +67,10 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let env = args.environment.choose(&scene)?;
     let camera = args.size.camera(&scene)?;
+    crate::support::distinct_outputs(&[
+        ("-o", Some(&args.output)),
+        ("--png", args.png.as_deref()),
+    ])?;
     let output = AtomicOutput::create(&args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     if let Some(dir) = &args.aux {

@@ -69,6 +69,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     camera.target = args.camera_target.unwrap_or(camera.target);
     camera.fov_y_deg = args.fov.unwrap_or(camera.fov_y_deg);
     camera.validate()?;
+    crate::support::distinct_outputs(&[
+        ("-o", Some(&args.output)),
+        ("--exr", args.exr.as_deref()),
+    ])?;
     let output = AtomicOutput::create(&args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     let exr_output = match &args.exr {

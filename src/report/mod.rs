@@ -248,6 +248,23 @@ fn render_timed(
     Ok((image, median(times)))
 }
 
+/// Each map's name in the report (and its folder's): the file stem, with `-2`, `-3`... added to
+/// later maps of the same stem, so that no map's images overwrite another's.
+fn unique_map_names(envs: &[PathBuf]) -> Vec<String> {
+    let mut names: Vec<String> = Vec::with_capacity(envs.len());
+    for env in envs {
+        let stem = map_name(env);
+        let mut name = stem.clone();
+        let mut k = 2;
+        while names.contains(&name) {
+            name = format!("{stem}-{k}");
+            k += 1;
+        }
+        names.push(name);
+    }
+    names
+}
+
 fn map_name(path: &Path) -> String {
     path.file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -322,8 +339,8 @@ fn write_heat_maps(
 }
 
 /// One map's section; an error is reported as a failed map by the caller.
-fn report_map(job: &mut MapJob, env: &Path) -> anyhow::Result<MapReport> {
-    let name = map_name(env);
+fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapReport> {
+    let name = name.to_owned();
     let map = load_map(env, None)?.map;
     let rotation = scene_rotation(job.scene, None);
     let exposure = default_exposure(&map);
@@ -439,7 +456,7 @@ pub fn run_report(
         ShadowSettings::default(),
     )?;
     let mut maps = Vec::new();
-    for env in envs {
+    for (env, name) in envs.iter().zip(unique_map_names(envs)) {
         let mut cx = MapJob {
             scene,
             camera,
@@ -447,10 +464,10 @@ pub fn run_report(
             renderer: &mut renderer,
             out,
         };
-        let report = report_map(&mut cx, env).unwrap_or_else(|e| {
+        let report = report_map(&mut cx, env, &name).unwrap_or_else(|e| {
             println!("{}: failed: {e:#}", env.display());
             MapReport {
-                name: map_name(env),
+                name: name.clone(),
                 path: env.display().to_string(),
                 status: MapStatus::Failed,
                 error: Some(format!("{e:#}")),
@@ -589,4 +606,18 @@ pub fn write_report(
         anyhow::bail!("every map failed; see the messages above");
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn maps_of_the_same_name_get_their_own_folders() {
+        let envs: Vec<PathBuf> = ["a/sky.exr", "b/sky.exr", "c/sky.hdr", "sun.exr"]
+            .iter()
+            .map(PathBuf::from)
+            .collect();
+        assert_eq!(unique_map_names(&envs), ["sky", "sky-2", "sky-3", "sun"]);
+    }
 }
