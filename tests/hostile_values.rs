@@ -406,3 +406,18 @@ fn outputs_keep_links_refuse_collisions_and_clean_up_on_signals() {
         assert!(!d.join("long.exr").exists());
     }
 }
+
+/// Coordinates too large for single precision get their own message, not "zero area".
+#[test]
+fn huge_coordinates_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("huge.obj"),
+        "v 0 0 0\nv 1e30 0 0\nv 0 1e30 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let scene = write_scene(d, "s.toml", "mesh = \"huge.obj\"\nalbedo = [0.5, 0.5, 0.5]");
+    let out = hprt(d, &["bake", scene.to_str().unwrap(), "-o", "out.bake"]);
+    assert_clean_failure(&out, &["huge.obj", "vertex 1", "beyond"]);
+}

@@ -110,11 +110,26 @@ impl MeshCleanup {
     }
 }
 
+/// Largest coordinate magnitude a mesh may have: products of two edge vectors (areas, normals)
+/// must stay finite in f32.
+pub const MAX_COORDINATE: f32 = 1e15;
+
 /// Finite coordinates, finite normals of the right count, indices in range.
 fn validate(raw: &RawMesh) -> Result<(), String> {
     if let Some(i) = raw.positions.iter().position(|p| !p.is_finite()) {
         return Err(format!(
             "vertex {i} has a non-finite coordinate {:?}",
+            raw.positions[i].to_array()
+        ));
+    }
+    if let Some(i) = raw
+        .positions
+        .iter()
+        .position(|p| p.abs().max_element() > MAX_COORDINATE)
+    {
+        return Err(format!(
+            "vertex {i} has a coordinate beyond ±{MAX_COORDINATE:e} ({:?}): areas and normals \
+             would overflow in single precision",
             raw.positions[i].to_array()
         ));
     }
