@@ -119,7 +119,7 @@ fn a_bake_of_another_mesh_is_refused() {
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains("a.bake") && err.contains("different mesh"),
+        err.contains("a.bake") && err.contains("another scene") && err.contains("geometry"),
         "{err}"
     );
 }

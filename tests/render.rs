@@ -313,7 +313,7 @@ fn bad_inputs_give_clear_errors() {
     };
     assert_clean_failure(
         &run(base(&b), &["-o", "x.png"]),
-        &["a.bake", "different mesh"],
+        &["a.bake", "made for another scene"],
     );
     assert_clean_failure(
         &run(base(&a), &["--order", "6", "-o", "x.png"]),
