@@ -110,6 +110,9 @@ pub enum MeshError {
 }
 
 /// Reads a file, transparently decompressing `.gz`.
+/// Largest decompressed mesh file (a gzip file is read only this far).
+pub const MAX_MESH_BYTES: u64 = 4 << 30;
+
 fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
     let bytes = std::fs::read(path).map_err(|cause| MeshError::Io {
         path: path.to_owned(),
@@ -121,12 +124,23 @@ fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
     {
         use std::io::Read;
         let mut out = Vec::new();
+        // Read one byte past the limit to tell a file at the limit from one beyond it.
         flate2::read::MultiGzDecoder::new(&bytes[..])
+            .take(MAX_MESH_BYTES + 1)
             .read_to_end(&mut out)
             .map_err(|e| MeshError::Invalid {
                 path: path.to_owned(),
                 message: format!("corrupt or truncated gzip data: {e}"),
             })?;
+        if out.len() as u64 > MAX_MESH_BYTES {
+            return Err(MeshError::Invalid {
+                path: path.to_owned(),
+                message: format!(
+                    "the gzip data expands beyond {} GB, the largest mesh hprt reads",
+                    MAX_MESH_BYTES >> 30
+                ),
+            });
+        }
         Ok(out)
     } else {
         Ok(bytes)
