@@ -51,11 +51,6 @@ impl ShRotation {
         Ok(Self { order, bands })
     }
 
-    /// The rotation about world +Y by `angle` radians (counter-clockwise seen from above).
-    pub fn about_y(angle: f32, order: usize) -> Result<Self, UnsupportedOrder> {
-        Self::new(Mat3::from_rotation_y(angle), order)
-    }
-
     pub fn order(&self) -> usize {
         self.order
     }
@@ -214,7 +209,9 @@ mod tests {
             }
         }
         let c = random_coeffs(7, 9);
-        let a = ShRotation::about_y(0.83, 7).unwrap().rotate(&c);
+        let a = ShRotation::new(Mat3::from_rotation_y(0.83), 7)
+            .unwrap()
+            .rotate(&c);
         let b = c.rotated_about_y(0.83);
         for (x, y) in a.as_slice().iter().zip(b.as_slice()) {
             assert!((x - y).abs() < 1e-5, "{x} vs {y}");

@@ -143,6 +143,8 @@ pub struct EnvironmentLighting {
     map: EnvMap,
     /// The map averaged down for resampling to cubes.
     source: CubeSource,
+    /// The map as a cube in its own frame (made on first use, once per map and face size).
+    cube: Option<CubeMap>,
     /// The settings asked for.
     settings: DecomposeSettings,
     /// Built from `settings`, at the tracker's leaving threshold when tracking.
@@ -165,6 +167,7 @@ impl EnvironmentLighting {
         Ok(Self {
             map: map.clone(),
             source,
+            cube: None,
             settings,
             decomposer,
             tracker: None,
@@ -238,6 +241,7 @@ impl EnvironmentLighting {
     }
 
     fn invalidate(&mut self) {
+        self.cube = None;
         self.decomposition = None;
         self.projection = None;
         self.tracked = None;
@@ -261,31 +265,19 @@ impl EnvironmentLighting {
         }
     }
 
-    pub fn orientation(&self) -> Quat {
-        self.orientation
-    }
-
-    /// The map as a cube in its own frame.
-    fn map_frame_cube(&self) -> CubeMap {
-        self.source.cube(0.0)
-    }
-
     /// Decomposes the map in its own frame again (even if it was), and keeps the result: the
     /// per-frame cost of a map whose content changes.
     pub fn redecompose(&mut self) -> &Decomposition {
-        let cube = self.map_frame_cube();
+        let cube = self.cube.get_or_insert_with(|| self.source.cube(0.0));
         self.tracked = None;
-        self.decomposition.insert(self.decomposer.decompose(&cube))
+        self.decomposition.insert(self.decomposer.decompose(cube))
     }
 
-    /// The thesis' way for a turning map, kept for comparison: resample the map turned by the
-    /// current rotation about +Y (the rotation part of the orientation is taken about +Y) and
-    /// decompose it again. Its lights jump and flicker as the sources move against the cube's
-    /// texels; [`Self::decompose`] does not.
-    pub fn decompose_resampled(&mut self) -> Decomposition {
-        let (axis, angle) = self.orientation.to_axis_angle();
-        let angle_about_y = if axis.y < 0.0 { -angle } else { angle };
-        let cube = self.source.cube(angle_about_y);
+    /// The thesis' way for a turning map, kept for comparison: resample the map turned by
+    /// `rotation_deg` about +Y and decompose it again. Its lights jump and flicker as the
+    /// sources move against the cube's texels; [`Self::decompose`] does not.
+    pub fn decompose_resampled(&mut self, rotation_deg: f32) -> Decomposition {
+        let cube = self.source.cube(rotation_deg.to_radians());
         self.decomposer.decompose(&cube)
     }
 
@@ -315,16 +307,16 @@ impl EnvironmentLighting {
     pub fn cap_excess(&mut self, centres: &[Vec3]) -> Vec<Rgb> {
         let to_map = self.orientation.inverse();
         let in_map: Vec<Vec3> = centres.iter().map(|c| (to_map * *c).normalize()).collect();
-        let cube = self.map_frame_cube();
-        self.decomposer.cap_excess(&cube, &in_map)
+        let cube = self.cube.get_or_insert_with(|| self.source.cube(0.0));
+        self.decomposer.cap_excess(cube, &in_map)
     }
 
     /// The plain SH projection of the whole map at the current orientation (the PRT
     /// baseline's lighting).
     pub fn project(&mut self) -> ShCoeffs<Rgb> {
         if self.projection.is_none() {
-            let cube = self.map_frame_cube();
-            self.projection = Some(self.decomposer.project(&cube));
+            let cube = self.cube.get_or_insert_with(|| self.source.cube(0.0));
+            self.projection = Some(self.decomposer.project(cube));
         }
         let base = self.projection.as_ref().expect("projected above");
         rotate_sh(base, self.orientation)

@@ -58,15 +58,6 @@ impl SunDisc {
         self.radiance * Self::solid_angle_of(self.angular_radius)
     }
 
-    /// The radiance the disc adds in direction `w`.
-    pub fn radiance_at(&self, w: Vec3) -> Rgb {
-        if w.dot(self.direction) >= self.angular_radius.cos() {
-            self.radiance
-        } else {
-            Rgb::ZERO
-        }
-    }
-
     /// `base` with the disc added, at `base`'s resolution: each texel gets the disc's radiance
     /// times the share of the texel it covers (sampled on a fine grid), scaled so that the map
     /// holds exactly the disc's power however the disc falls on the texels (a moving sun does

@@ -13,7 +13,7 @@
 use crate::decompose::Decomposition;
 use crate::decompose::weber::weber_elbow;
 use crate::light::DirectionalLight;
-use precompute::{Rgb, luminance};
+use precompute::luminance;
 
 /// How lights are followed.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -184,15 +184,11 @@ impl LightTracker {
     }
 }
 
-/// The summed power of `lights`.
-pub fn lights_power(lights: &[DirectionalLight]) -> Rgb {
-    lights.iter().map(|l| l.power).sum()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use glam::Vec3;
+    use precompute::Rgb;
     use precompute::sh::ShCoeffs;
     use std::f32::consts::PI;
 
@@ -217,6 +213,10 @@ mod tests {
             total_power: Rgb::splat(10.0),
             candidates: 0,
         }
+    }
+
+    fn lights_power(lights: &[DirectionalLight]) -> Rgb {
+        lights.iter().map(|l| l.power).sum()
     }
 
     fn total(d: &Decomposition) -> f32 {

@@ -405,7 +405,7 @@ fn turn_stats(
         lighting.set_rotation(angle);
         let start = std::time::Instant::now();
         let d = if resampled {
-            lighting.decompose_resampled()
+            lighting.decompose_resampled(angle)
         } else {
             lighting.decompose()
         };

@@ -268,49 +268,42 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
 
 impl App {
     fn load_environment(&mut self) {
+        // The map, and how many of its texels were invalid and set to 0.
         let loaded = match &self.lighting.sequence {
-            Some((sequence, _)) => sequence
-                .frame(0)
-                .map(|map| precompute::envmap::LoadedEnvMap {
-                    map,
-                    layout: precompute::envmap::Layout::Equirect,
-                    sanitized: 0,
-                }),
-            None => crate::environment::load_map(&self.settings.env, None),
+            Some((sequence, _)) => sequence.frame(0).map(|map| (map, 0)),
+            None => crate::environment::load_map(&self.settings.env, None)
+                .map(|loaded| (loaded.map, loaded.sanitized)),
         };
-        let loaded = match loaded {
+        let (map, sanitized) = match loaded {
             Ok(loaded) => loaded,
             Err(e) => {
                 self.stats.message = format!("cannot load the map: {e:#}");
                 return;
             }
         };
-        let mut lighting =
-            match EnvironmentLighting::new(&loaded.map, self.settings.decompose_settings()) {
-                Ok(lighting) => lighting,
-                Err(e) => {
-                    self.stats.message = format!("cannot light the scene with the map: {e}");
-                    return;
-                }
-            };
+        let mut lighting = match EnvironmentLighting::new(&map, self.settings.decompose_settings())
+        {
+            Ok(lighting) => lighting,
+            Err(e) => {
+                self.stats.message = format!("cannot light the scene with the map: {e}");
+                return;
+            }
+        };
+        if self.settings.exposure == 1.0 && self.lighting.environment.is_none() {
+            self.settings.exposure = default_exposure(&map);
+        }
+        self.lighting.lit_for = None;
+        self.panel.environment_changed();
+        self.stats.message = if sanitized > 0 {
+            format!("{sanitized} texels with negative or invalid radiance set to 0")
+        } else {
+            String::new()
+        };
         if self.lighting.sequence.is_some()
             && let Err(e) = lighting.enable_tracking(Some(runtime::TrackingSettings::default()))
         {
             self.stats.message = format!("cannot track the lights: {e}");
         }
-        if self.settings.exposure == 1.0 && self.lighting.environment.is_none() {
-            self.settings.exposure = default_exposure(&loaded.map);
-        }
-        self.lighting.lit_for = None;
-        self.panel.environment_changed();
-        self.stats.message = if loaded.sanitized > 0 {
-            format!(
-                "{} texels with negative or invalid radiance set to 0",
-                loaded.sanitized
-            )
-        } else {
-            String::new()
-        };
         if let Some(r) = self.window.renderer.as_mut() {
             r.set_environment(lighting.map(), self.settings.rotation_deg);
             if let Some(gpu) = self.window.gpu.as_mut() {
