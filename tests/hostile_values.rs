@@ -395,8 +395,9 @@ fn outputs_keep_links_refuse_collisions_and_clean_up_on_signals() {
             std::thread::sleep(std::time::Duration::from_millis(20));
         }
         assert!(partial(), "the render made no temporary file");
-        let status = std::process::Command::new("kill")
-            .args(["-TERM", &child.id().to_string()])
+        // The shell's own `kill`: no procps package needed.
+        let status = std::process::Command::new("sh")
+            .args(["-c", "kill -TERM \"$0\"", &child.id().to_string()])
             .status()
             .unwrap();
         assert!(status.success());
