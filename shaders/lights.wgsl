@@ -1,6 +1,6 @@
 // Second pass, added onto the first: each directional light's Lambertian contribution
-// ρ/π · power · max(0, n·d) · visibility, visibility by percentage-closer filtering of its
-// shadow map. Pixels that see no geometry show the environment map.
+// ρ/π · power · max(0, n·d) · visibility, visibility by percentage-closer soft shadows on its
+// shadow map (blocker search, then PCF over the penumbra the source's size gives). Pixels that see no geometry show the environment map.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> lights: array<Light, MAX_LIGHTS>;
@@ -12,6 +12,8 @@
 @group(0) @binding(7) var environment: texture_2d<f32>;
 // The shadow maps' depths as plain floats (for the blocker search).
 @group(0) @binding(8) var shadow_depths: texture_2d_array<f32>;
+// Trilinear, wrapping in azimuth.
+@group(0) @binding(9) var environment_sampler: sampler;
 
 const PI: f32 = 3.14159265358979;
 
@@ -22,8 +24,10 @@ override SHADOWED: bool = true;
 // Whether PCF kernels are sized from the light's angular radius (blocker search).
 override KERNEL_FROM_RADIUS: bool = true;
 
-// Equirectangular lookup, constant per texel (CONVENTIONS.md).
-fn environment_radiance(w_world: vec3<f32>) -> vec3<f32> {
+// The background seen along `w_world`: the equirectangular map (CONVENTIONS.md) filtered at the
+// mip level whose texels span `pixel_angle` radians, the angle between neighbouring pixels'
+// rays (bilinear when magnified, no aliasing when minified).
+fn environment_radiance(w_world: vec3<f32>, pixel_angle: f32) -> vec3<f32> {
     // The map is turned by the rotation: look up R_y(-angle) w.
     let c = frame.env_rotation.x;
     let s = frame.env_rotation.y;
@@ -32,8 +36,9 @@ fn environment_radiance(w_world: vec3<f32>) -> vec3<f32> {
     var u = atan2(w.x, -w.z) / (2.0 * PI);
     u = u - floor(u);
     let v = acos(clamp(w.y, -1.0, 1.0)) / PI;
-    let texel = min(vec2<u32>(vec2<f32>(u, v) * size), vec2<u32>(size) - vec2<u32>(1u));
-    return textureLoad(environment, texel, 0).xyz;
+    // Explicit level: derivatives of u jump at the map's seam.
+    let lod = max(log2(pixel_angle * size.x / (2.0 * PI)), 0.0);
+    return textureSampleLevel(environment, environment_sampler, vec2<f32>(u, v), lod).xyz;
 }
 
 fn shadow_coordinates(light: Light, position: vec3<f32>) -> vec3<f32> {
@@ -41,32 +46,55 @@ fn shadow_coordinates(light: Light, position: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(clip.x * 0.5 + 0.5, 0.5 - clip.y * 0.5, clip.z);
 }
 
-// Occluders around `uv` within `radius` texels: a 3×3 grid of shadow-map texels, each compared
-// with the receiver plane's depth there. Returns (mean occluder depth, fraction of the texels
-// that occlude): fraction 0 means fully lit, 1 fully in umbra.
-fn blockers(layer: i32, uv: vec2<f32>, receiver: f32, slope: vec2<f32>, radius: f32) -> vec2<f32> {
+// Samples of the blocker search and of the PCF kernel: the centre plus points of a Vogel
+// (golden-angle) spiral, which covers the unit disc evenly at any count. The spiral is turned
+// per pixel, so what falls between its points on one pixel is sampled on its neighbours.
+const BLOCKER_SAMPLES: u32 = 24u;
+const PCF_SAMPLES: u32 = 16u;
+const GOLDEN_ANGLE: f32 = 2.39996323;
+
+// Point `i` of an `n`-point Vogel spiral on the unit disc, turned by `phase` radians.
+fn vogel(i: u32, n: u32, phase: f32) -> vec2<f32> {
+    let r = sqrt((f32(i) + 0.5) / f32(n));
+    let a = f32(i) * GOLDEN_ANGLE + phase;
+    return r * vec2<f32>(cos(a), sin(a));
+}
+
+// Interleaved gradient noise (Jimenez 2014): a per-pixel angle with little low-frequency
+// structure, so the turned spirals dither instead of banding.
+fn pixel_phase(pixel: vec2<f32>) -> f32 {
+    return 2.0 * PI * fract(52.9829189 * fract(dot(pixel, vec2<f32>(0.06711056, 0.00583715))));
+}
+
+// Occluders within `radius` texels of `uv`: the centre texel and a spiral of texels, each
+// compared with the receiver plane's depth there. The centre is always among them, so a point
+// in any umbra, however thin its occluder, finds a blocker. Returns (mean occluder depth,
+// occluding samples); 0 occluding samples means fully lit.
+fn blockers(layer: i32, uv: vec2<f32>, receiver: f32, slope: vec2<f32>, radius: f32, phase: f32) -> vec2<f32> {
     let size = vec2<f32>(textureDimensions(shadow_depths));
-    let texel = vec2<i32>(uv * size);
+    let last = vec2<i32>(size) - vec2<i32>(1);
     let slack = (abs(slope.x) + abs(slope.y)) * 2.0 / size.x + 1e-5;
     var sum = 0.0;
     var count = 0.0;
-    for (var y = -1; y <= 1; y = y + 1) {
-        for (var x = -1; x <= 1; x = x + 1) {
-            let offset = vec2<i32>(vec2<f32>(f32(x), f32(y)) * radius);
-            let at = clamp(texel + offset, vec2<i32>(0), vec2<i32>(size) - vec2<i32>(1));
-            let depth = decode_depth(textureLoad(shadow_depths, at, layer, 0));
-            let local = vec2<f32>(at - texel) / size;
-            let plane = receiver + dot(slope, vec2<f32>(2.0 * local.x, -2.0 * local.y)) - slack;
-            if depth < plane {
-                sum = sum + depth;
-                count = count + 1.0;
-            }
+    for (var i = 0u; i <= BLOCKER_SAMPLES; i = i + 1u) {
+        var offset = vec2<f32>(0.0);
+        if i > 0u {
+            offset = vogel(i - 1u, BLOCKER_SAMPLES, phase) * radius;
+        }
+        let at = clamp(vec2<i32>(floor(uv * size + offset)), vec2<i32>(0), last);
+        let depth = decode_depth(textureLoad(shadow_depths, at, layer, 0));
+        let local = (vec2<f32>(at) + 0.5) / size - uv;
+        // Extrapolated past the map's far plane, the receiver is as far as nothing drawn.
+        let plane = min(receiver + dot(slope, vec2<f32>(2.0 * local.x, -2.0 * local.y)) - slack, 1.0);
+        if depth < plane {
+            sum = sum + depth;
+            count = count + 1.0;
         }
     }
     if count == 0.0 {
         return vec2<f32>(0.0, 0.0);
     }
-    return vec2<f32>(sum / count, count / 9.0);
+    return vec2<f32>(sum / count, count);
 }
 
 // Depth slope of the receiver's tangent plane in shadow-map clip space: how the light-space
@@ -109,54 +137,63 @@ fn pcf(light: Light, coords: vec3<f32>, slope: vec2<f32>, radius: f32) -> f32 {
     return lit / f32(taps * taps);
 }
 
-// How much of the area within `radius` texels of `coords` is lit, roughly: 4 gathered
-// comparisons = 16 texels. 1: all lit, 0: all shadowed, in between: a shadow edge.
-fn coverage(layer: i32, coords: vec3<f32>, slope: vec2<f32>, radius: f32) -> f32 {
+// Fraction of `light` visible at `coords` over a disc of `radius` texels: the centre and a
+// turned spiral of hardware-filtered (2×2) comparisons, each against the receiver plane's
+// depth there. The disc average is the visible fraction of a uniform disc source.
+fn pcf_disc(layer: i32, coords: vec3<f32>, slope: vec2<f32>, radius: f32, phase: f32) -> f32 {
     let size = vec2<f32>(textureDimensions(shadow_maps));
-    let slack = (abs(slope.x) + abs(slope.y)) * 2.0 / size.x + 1e-5;
+    let slack = 0.5 * (abs(slope.x) + abs(slope.y)) * 2.0 / size.x + 1e-5;
     var lit = 0.0;
-    for (var k = 0; k < 4; k = k + 1) {
-        let corner = vec2<f32>(f32(k & 1) * 2.0 - 1.0, f32(k >> 1u) * 2.0 - 1.0) * (0.5 * radius);
-        let offset = corner / size;
-        let depth = coords.z + dot(slope, vec2<f32>(2.0 * offset.x, -2.0 * offset.y)) - slack;
-        lit = lit + dot(textureGatherCompare(shadow_maps, shadow_sampler, coords.xy + offset, layer, depth), vec4<f32>(1.0));
+    for (var i = 0u; i <= PCF_SAMPLES; i = i + 1u) {
+        var offset = vec2<f32>(0.0);
+        if i > 0u {
+            offset = vogel(i - 1u, PCF_SAMPLES, phase) * radius / size;
+        }
+        let depth = min(coords.z + dot(slope, vec2<f32>(2.0 * offset.x, -2.0 * offset.y)) - slack, 1.0);
+        lit = lit + textureSampleCompareLevel(shadow_maps, shadow_sampler, coords.xy + offset, layer, depth);
     }
-    return lit / 16.0;
+    return lit / f32(PCF_SAMPLES + 1u);
 }
 
-fn visibility(index: u32, position: vec3<f32>, normal: vec3<f32>) -> f32 {
+// World-space offset along the normal before the shadow lookup (normal-offset bias): a texel's
+// footprint, growing as the surface turns from the light, where the depth of one shadow-map
+// texel spreads over more of the receiver.
+fn normal_offset(light: Light, normal: vec3<f32>) -> vec3<f32> {
+    let cosine = clamp(dot(normal, light.direction.xyz), 0.0, 1.0);
+    let sine = sqrt(1.0 - cosine * cosine);
+    return normal * (light.params.x * sine);
+}
+
+fn visibility(index: u32, position: vec3<f32>, normal: vec3<f32>, phase: f32) -> f32 {
     let light = lights[index];
-    let coords = shadow_coordinates(light, position + normal * (0.5 * light.params.x));
+    let coords = shadow_coordinates(light, position + normal_offset(light, normal));
     if coords.x < 0.0 || coords.x > 1.0 || coords.y < 0.0 || coords.y > 1.0 || coords.z > 1.0 {
         return 1.0;
     }
     let slope = receiver_depth_slope(light, normal);
     let layer = i32(light.params.w);
-    // The widest the kernel can be: a penumbra of a distant source of angular radius α behind
-    // an occluder at distance d has a half-width d tan α, and d is at most the scene's depth.
-    var widest = f32(frame.pcf_taps / 2u) + 1.0;
-    if KERNEL_FROM_RADIUS {
-        widest = clamp(light.params.y * light.params.z / light.params.x, 1.0, 32.0);
-    }
-    if !KERNEL_FROM_RADIUS && frame.pcf_taps == 1u {
-        // The cheapest filter: one hardware 2×2 comparison.
+    if !KERNEL_FROM_RADIUS {
         return pcf(light, coords, slope, 1.0);
     }
-    // Most pixels are plainly lit or in umbra: decide those from 16 texels.
-    let around = coverage(layer, coords, slope, widest);
-    if around == 1.0 || around == 0.0 {
-        return around;
+    // Search as wide as the widest penumbra can be: a distant source of angular radius α
+    // behind an occluder at distance d gives a half-width d tan α, d at most the map's depth.
+    // No early exit: every pixel searches the whole disc, so no shadow narrower than the
+    // kernel is skipped.
+    let widest = clamp(light.params.y * light.params.z / light.params.x, 1.0, 32.0);
+    let found = blockers(layer, coords.xy, coords.z, slope, widest, phase);
+    if found.y == 0.0 {
+        return 1.0;
     }
-    var radius = 1.0;
-    if KERNEL_FROM_RADIUS {
-        let found = blockers(layer, coords.xy, coords.z, slope, widest);
-        if found.y == 0.0 {
-            return 1.0;
-        }
-        let distance = max(coords.z - found.x, 0.0) * light.params.y;
-        radius = clamp(distance * light.params.z / light.params.x, 1.0, 32.0);
-    }
-    return pcf(light, coords, slope, radius);
+    let distance = max(coords.z - found.x, 0.0) * light.params.y;
+    let radius = clamp(distance * light.params.z / light.params.x, 0.75, 32.0);
+    return pcf_disc(layer, coords, slope, radius, phase);
+}
+
+// The unit direction of the camera ray through `ndc`.
+fn view_ray(ndc: vec2<f32>) -> vec3<f32> {
+    let far = frame.inv_view_proj * vec4<f32>(ndc, 1.0, 1.0);
+    let near = frame.inv_view_proj * vec4<f32>(ndc, 0.0, 1.0);
+    return normalize(far.xyz / far.w - near.xyz / near.w);
 }
 
 @fragment
@@ -168,16 +205,17 @@ fn fs_main(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
         if (frame.flags & 2u) == 0u {
             return vec4<f32>(0.0);
         }
-        let far = frame.inv_view_proj * vec4<f32>(ndc, 1.0, 1.0);
-        let near = frame.inv_view_proj * vec4<f32>(ndc, 0.0, 1.0);
-        let direction = normalize(far.xyz / far.w - near.xyz / near.w);
-        return vec4<f32>(environment_radiance(direction), 0.0);
+        let direction = view_ray(ndc);
+        let next = view_ray(ndc + vec2<f32>(2.0 * frame.viewport.z, 0.0));
+        let pixel_angle = acos(clamp(dot(direction, next), -1.0, 1.0));
+        return vec4<f32>(environment_radiance(direction, pixel_angle), 0.0);
     }
     let world = frame.inv_view_proj * vec4<f32>(ndc, depth, 1.0);
     let position = world.xyz / world.w;
     let normal = textureLoad(normal_buffer, texel, 0).xyz;
     let albedo = textureLoad(albedo_buffer, texel, 0).xyz;
     let diffuse = albedo / PI;
+    let phase = pixel_phase(pixel.xy);
     var sum = vec3<f32>(0.0);
     // A constant trip count with an early break lets the compiler unroll the loop and index
     // the light array with constants.
@@ -190,7 +228,7 @@ fn fs_main(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
         if cosine > 0.0 {
             var v = 1.0;
             if SHADOWED {
-                v = visibility(i, position, normal);
+                v = visibility(i, position, normal, phase);
             }
             sum = sum + diffuse * lights[i].power.xyz * (cosine * v);
         }

@@ -5,7 +5,7 @@ mod common;
 use common::*;
 use glam::Vec3;
 use precompute::bake::{BakeSettings, Transfer};
-use precompute::bvh::SceneBvh;
+use precompute::bvh::{SceneBvh, Skip};
 use precompute::camera::Camera;
 use precompute::envmap::EnvMap;
 use precompute::image_io::{RgbImageF32, tonemap};
@@ -198,6 +198,176 @@ fn shadow_of_a_sphere_lands_where_geometry_predicts() {
     // The shadow is where predicted, not mirrored: the other side of the sphere is lit.
     let mirrored = Vec3::new(-shadow_centre.x, 0.0, -shadow_centre.z);
     assert!(pixel_of(mirrored).max_element() > 0.9 * lit.max_element());
+}
+
+/// A floor (y ≤ 0, albedo 0.5, `half_size` from the origin) plus `occluders`.
+fn floor_with(half_size: f32, occluders: &[(Vec3, Vec3)]) -> SceneMesh {
+    let mut geometry = SceneMesh::default();
+    let floor = box_mesh(
+        Vec3::new(-half_size, -0.1, -half_size),
+        Vec3::new(half_size, 0.0, half_size),
+        [16, 1, 16],
+        [false; 6],
+    );
+    geometry.push_object("floor".into(), &floor, Rgb::splat(0.5));
+    for (k, (lo, hi)) in occluders.iter().enumerate() {
+        let mesh = box_mesh(*lo, *hi, [4, 1, 1], [false; 6]);
+        geometry.push_object(format!("occluder {k}"), &mesh, Rgb::splat(0.5));
+    }
+    geometry
+}
+
+/// Checks the GPU's shadow of `light` on the floor against ray casting: where the floor sees
+/// none of the light's disc (its umbra, 13 rays over the disc), the image must be dark; where
+/// it sees all of it, lit; both where the neighbours (3 pixels away for full light,
+/// `umbra_margin` for the umbra) agree. Returns (umbra, lit) pixel counts.
+fn shadow_agrees_with_ray_casting(
+    geometry: &SceneMesh,
+    light: DirectionalLight,
+    cam: &Camera,
+    umbra_margin: i32,
+) -> (usize, usize) {
+    let transfer = bake_of(geometry, 2, 16, 0);
+    let lighting = FrameLighting {
+        sh: ShCoeffs::zeros(2),
+        lights: vec![light],
+        lights_indirect: false,
+        shadows: true,
+    };
+    let image = render(&gpu(), geometry, &transfer, cam, &lighting);
+    if let Ok(path) = std::env::var("HPRT_DEBUG_PNG") {
+        precompute::image_io::write_png(std::path::Path::new(&path), &image, 1.0).unwrap();
+    }
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let basis = cam.basis();
+    let d = light.direction;
+    let (u, v) = (
+        d.any_orthonormal_vector(),
+        d.cross(d.any_orthonormal_vector()),
+    );
+    let disc: Vec<Vec3> = std::iter::once(d)
+        .chain((0..12).map(|k| {
+            let a = k as f32 * std::f32::consts::TAU / 12.0;
+            (d + (u * a.cos() + v * a.sin()) * light.angular_radius.tan()).normalize()
+        }))
+        .collect();
+    // Which of the disc's rays each pixel's floor point sees: None off the floor.
+    let (w, h) = (cam.width, cam.height);
+    let seen: Vec<Option<usize>> = (0..h)
+        .flat_map(|j| (0..w).map(move |i| (i, j)))
+        .map(|(i, j)| {
+            let ray = cam.pixel_direction(&basis, i, j);
+            let hit = bvh.intersect(cam.position, ray, 0.0, f32::MAX)?;
+            let p = cam.position + ray * hit.t;
+            (p.y.abs() < 1e-3).then(|| {
+                disc.iter()
+                    .filter(|r| {
+                        !bvh.occluded(p + Vec3::Y * 1e-4, **r, 0.0, f32::MAX, Skip::Nothing)
+                    })
+                    .count()
+            })
+        })
+        .collect();
+    let lit_value = 0.5 / std::f32::consts::PI * luminance(light.power) * d.y;
+    let (mut umbra, mut lit) = (0, 0);
+    for j in 3..h - 3 {
+        for i in 3..w - 3 {
+            let at = |di: i32, dj: i32| seen[((j as i32 + dj) * w as i32 + i as i32 + di) as usize];
+            let value = luminance(image.get(i as usize, j as usize));
+            // Pixels near an edge of full light (3 pixels) or of the umbra (`umbra_margin`)
+            // are left to the filter.
+            let inside = |n: usize, m: i32| {
+                [(-m, 0), (m, 0), (0, -m), (0, m)]
+                    .iter()
+                    .all(|&(a, b)| at(a, b) == Some(n))
+            };
+            match at(0, 0) {
+                Some(0) if inside(0, umbra_margin) => {
+                    umbra += 1;
+                    assert!(
+                        value < 0.05 * lit_value,
+                        "pixel ({i}, {j}) in the umbra shows {value} (lit: {lit_value})"
+                    );
+                }
+                Some(n) if n == disc.len() && inside(n, 3) => {
+                    lit += 1;
+                    assert!(
+                        value > 0.9 * lit_value,
+                        "pixel ({i}, {j}) in full light shows {value} (lit: {lit_value})"
+                    );
+                }
+                _ => {}
+            }
+        }
+    }
+    (umbra, lit)
+}
+
+/// A 4 cm bar 1 m above the floor and a 3 cm pole under a sun-sized light: shadows a few
+/// shadow-map texels wide, which a filter that samples around a pixel but not at it misses.
+#[test]
+fn thin_occluders_cast_their_shadows() {
+    let geometry = floor_with(
+        4.0,
+        &[
+            (Vec3::new(-1.5, 0.98, -0.02), Vec3::new(1.5, 1.02, 0.02)),
+            (Vec3::new(1.0, 0.0, 1.0), Vec3::new(1.03, 1.2, 1.03)),
+        ],
+    );
+    let light = DirectionalLight {
+        direction: Vec3::new(0.0, 60f32.to_radians().sin(), 60f32.to_radians().cos()),
+        power: Rgb::splat(5.0),
+        cap_radius: 0.05,
+        angular_radius: 0.27f32.to_radians(),
+        share: 1.0,
+    };
+    // Straight down, 2.2 cm per pixel: the bar's umbra is about 1.5 pixels wide.
+    let cam = Camera {
+        up: Vec3::NEG_Z,
+        ..camera(
+            Vec3::new(0.0, 6.0, -0.3),
+            Vec3::new(0.0, 0.0, -0.3),
+            200,
+            200,
+        )
+    };
+    // Every umbra pixel counts, however thin the umbra.
+    let (umbra, lit) = shadow_agrees_with_ray_casting(&geometry, light, &cam, 0);
+    assert!(
+        umbra > 100 && lit > 10_000,
+        "umbra {umbra}, lit {lit} pixels"
+    );
+}
+
+/// Light 5° above the horizon over a low wall, seen obliquely: a shadow 3 m long across a
+/// floor 60 m wide, of which the camera sees a few metres. A map fitted to the whole floor has
+/// texels of 3 cm, stretched to 34 cm along the light on the floor.
+#[test]
+fn grazing_light_casts_a_clean_shadow() {
+    let geometry = floor_with(
+        30.0,
+        &[(Vec3::new(1.5, 0.0, -1.0), Vec3::new(1.7, 0.25, 1.0))],
+    );
+    let elevation = 5f32.to_radians();
+    let light = DirectionalLight {
+        direction: Vec3::new(elevation.cos(), elevation.sin(), 0.0),
+        power: Rgb::splat(20.0),
+        cap_radius: 0.05,
+        angular_radius: 0.27f32.to_radians(),
+        share: 1.0,
+    };
+    let cam = camera(
+        Vec3::new(-3.0, 4.5, 3.0),
+        Vec3::new(0.0, 0.0, 0.0),
+        192,
+        144,
+    );
+    // Along a 3 m shadow at 5°, one shadow-map texel spans several pixels of the floor.
+    let (umbra, lit) = shadow_agrees_with_ray_casting(&geometry, light, &cam, 3);
+    assert!(
+        umbra > 1000 && lit > 5000,
+        "umbra {umbra}, lit {lit} pixels"
+    );
 }
 
 /// Mean |Y(tonemap(a)) - Y(tonemap(b))| over the masked pixels.
@@ -403,4 +573,55 @@ fn vulkan_and_opengl_software_adapters_draw_the_same_image() {
         .map(|(a, b)| (*a - *b).abs().max_element())
         .fold(0.0f32, f32::max);
     assert!(worst < 1e-2, "largest pixel difference {worst}");
+}
+
+/// The background: the map along each pixel's ray, bilinear where magnified, averaged over the
+/// pixel where minified (a one-texel checkerboard shows its mean, not either square).
+#[test]
+fn background_shows_the_map_filtered() {
+    let geometry = floor_with(1.0, &[]);
+    let transfer = bake_of(&geometry, 2, 16, 0);
+    // Looking up and away from the floor: every pixel sees the sky.
+    let cam = camera(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.3, 2.0, -1.0), 64, 48);
+    let gpu = gpu();
+    let mut renderer =
+        Renderer::new(&gpu, &geometry, &transfer, &cam, ShadowSettings::default()).unwrap();
+    renderer
+        .set_lighting(&FrameLighting {
+            sh: ShCoeffs::zeros(2),
+            lights: Vec::new(),
+            lights_indirect: false,
+            shadows: false,
+        })
+        .unwrap();
+    renderer.background = true;
+    let basis = cam.basis();
+    let smooth = EnvMap::from_fn(256, 128, 1, |w| {
+        Rgb::new(1.0 + w.x, 1.0 + w.y, 1.0 + 0.5 * w.z)
+    });
+    let checker_texels = (0..1024)
+        .flat_map(|j| (0..2048).map(move |i| Rgb::splat(((i + j) % 2) as f32 * 2.0)))
+        .collect();
+    let checker = EnvMap::new(2048, 1024, checker_texels);
+    for (map, name) in [(&smooth, "smooth"), (&checker, "checker")] {
+        renderer.set_environment(map, 30.0);
+        renderer.render().unwrap();
+        let image = renderer.read_back().unwrap();
+        for j in 0..cam.height {
+            for i in 0..cam.width {
+                let ray = cam.pixel_direction(&basis, i, j);
+                // The map is turned 30° about +Y: look up R_y(−30°) ray.
+                let expected = if name == "smooth" {
+                    map.radiance(precompute::envmap::rotate_y(ray, -30f32.to_radians()))
+                } else {
+                    Rgb::ONE
+                };
+                let got = image.get(i as usize, j as usize);
+                assert!(
+                    ((got - expected) / expected).abs().max_element() < 0.03,
+                    "{name} map, pixel ({i}, {j}): {got} for {expected}"
+                );
+            }
+        }
+    }
 }

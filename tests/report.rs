@@ -15,6 +15,8 @@ struct Recomputed {
     std: f64,
     shadow_mean: f64,
     shadow_std: f64,
+    penumbra_mean: f64,
+    penumbra: usize,
     relative_rmse: f64,
     covered: usize,
     shadow: usize,
@@ -38,12 +40,18 @@ fn pixels(path: &Path) -> Vec<[f32; 3]> {
         .collect()
 }
 
-fn recompute(dir: &Path, method_file: &str, exposure: f64, shadow_threshold: f64) -> Recomputed {
+fn recompute(
+    dir: &Path,
+    method_file: &str,
+    exposure: f64,
+    shadow_threshold: f64,
+    penumbra: (f64, f64),
+) -> Recomputed {
     let reference = pixels(&dir.join("reference.exr"));
     let test = pixels(&dir.join(format!("{method_file}.exr")));
     let coverage = pixels(&dir.join("reference-coverage.exr"));
     let visibility = pixels(&dir.join("reference-visibility.exr"));
-    let (mut all, mut shadow) = (Vec::new(), Vec::new());
+    let (mut all, mut shadow, mut partly_lit) = (Vec::new(), Vec::new(), Vec::new());
     let (mut squared, mut reference_sum) = (0.0, 0.0);
     for i in 0..reference.len() {
         if coverage[i][0] <= 0.5 {
@@ -55,6 +63,10 @@ fn recompute(dir: &Path, method_file: &str, exposure: f64, shadow_threshold: f64
         all.push(error);
         if (visibility[i][0] as f64) < shadow_threshold {
             shadow.push(error);
+        }
+        let v = visibility[i][0] as f64;
+        if v > penumbra.0 && v < penumbra.1 {
+            partly_lit.push(error);
         }
         squared += (luminance(test[i]) - luminance(reference[i])).powi(2);
         reference_sum += luminance(reference[i]);
@@ -68,6 +80,8 @@ fn recompute(dir: &Path, method_file: &str, exposure: f64, shadow_threshold: f64
     let (shadow_mean, shadow_std) = mean_std(&shadow);
     let n = all.len() as f64;
     Recomputed {
+        penumbra_mean: mean_std(&partly_lit).0,
+        penumbra: partly_lit.len(),
         mean,
         std,
         shadow_mean,
@@ -162,6 +176,9 @@ fn report_measures_shadows_and_survives_bad_maps() {
     let map_dir = report_dir.join("sunrise");
     let exposure = sunrise_report["exposure"].as_f64().unwrap();
     let threshold = stats["shadow_visibility_threshold"].as_f64().unwrap();
+    let bounds = &stats["penumbra_visibility"];
+    let penumbra = (bounds[0].as_f64().unwrap(), bounds[1].as_f64().unwrap());
+    assert_eq!(penumbra, (0.05, 0.95), "CONVENTIONS.md's penumbra bounds");
     let methods = sunrise_report["methods"].as_array().unwrap();
     let names: Vec<&str> = methods
         .iter()
@@ -171,7 +188,13 @@ fn report_measures_shadows_and_survives_bad_maps() {
     let mut shadow_errors = Vec::new();
     for m in methods {
         let name = m["method"].as_str().unwrap();
-        let r = recompute(&map_dir, &name.replace('/', "-"), exposure, threshold);
+        let r = recompute(
+            &map_dir,
+            &name.replace('/', "-"),
+            exposure,
+            threshold,
+            penumbra,
+        );
         close(r.mean, &m["mean"], &format!("{name} mean"));
         close(r.std, &m["std"], &format!("{name} std"));
         close(
@@ -191,6 +214,12 @@ fn report_measures_shadows_and_survives_bad_maps() {
         );
         assert_eq!(m["covered_pixels"].as_u64(), Some(r.covered as u64));
         assert_eq!(m["shadow_pixels"].as_u64(), Some(r.shadow as u64));
+        close(
+            r.penumbra_mean,
+            &m["penumbra_mean"],
+            &format!("{name} penumbra mean"),
+        );
+        assert_eq!(m["penumbra_pixels"].as_u64(), Some(r.penumbra as u64));
         shadow_errors.push(r.shadow_mean);
         for file in [
             format!("{}.png", name.replace('/', "-")),

@@ -9,6 +9,7 @@
 //! - [`FrameLighting::for_mode`]: what each render mode draws.
 
 use crate::cubemap::{CubeMap, CubeSource};
+use crate::decompose::source_size::measure_sources;
 use crate::decompose::{
     DecomposeError, DecomposeMode, DecomposeSettings, Decomposer, Decomposition,
 };
@@ -270,7 +271,9 @@ impl EnvironmentLighting {
     pub fn redecompose(&mut self) -> &Decomposition {
         let cube = self.cube.get_or_insert_with(|| self.source.cube(0.0));
         self.tracked = None;
-        self.decomposition.insert(self.decomposer.decompose(cube))
+        let mut decomposition = self.decomposer.decompose(cube);
+        measure_sources(&self.map, &mut decomposition.lights);
+        self.decomposition.insert(decomposition)
     }
 
     /// The thesis' way for a turning map, kept for comparison: resample the map turned by
@@ -278,7 +281,16 @@ impl EnvironmentLighting {
     /// sources move against the cube's texels; [`Self::decompose`] does not.
     pub fn decompose_resampled(&mut self, rotation_deg: f32) -> Decomposition {
         let cube = self.source.cube(rotation_deg.to_radians());
-        self.decomposer.decompose(&cube)
+        let mut decomposition = self.decomposer.decompose(&cube);
+        let to_map = Quat::from_rotation_y(-rotation_deg.to_radians());
+        for light in &mut decomposition.lights {
+            light.direction = to_map * light.direction;
+        }
+        measure_sources(&self.map, &mut decomposition.lights);
+        for light in &mut decomposition.lights {
+            light.direction = (to_map.inverse() * light.direction).normalize();
+        }
+        decomposition
     }
 
     /// The SH part plus lights of the map at the current orientation; when tracking, the
@@ -557,9 +569,13 @@ mod tests {
         lighting.set_rotation(90.0);
         let frame = lighting.frame(RenderMode::Hybrid, None);
         // Decomposed in the map's frame, then turned.
-        let in_map_frame = Decomposer::new(settings)
+        let mut in_map_frame = Decomposer::new(settings)
             .unwrap()
             .decompose(&CubeSource::new(&map, 64).cube(0.0));
+        // The source's size measured on the full-resolution map: a disc of acos(0.999).
+        measure_sources(&map, &mut in_map_frame.lights);
+        let radius = in_map_frame.lights[0].angular_radius;
+        assert!((radius - 0.999f32.acos()).abs() < 0.2 * radius, "{radius}");
         let by_hand = rotate_decomposition(&in_map_frame, Quat::from_rotation_y(FRAC_PI_2));
         assert_eq!(frame.decomposition.as_ref(), Some(&by_hand));
         assert!(frame.lighting.lights_indirect);

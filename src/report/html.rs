@@ -58,7 +58,7 @@ fn figure(html: &mut String, src: &str, caption: &str) {
 fn summary_table(html: &mut String, maps: &[&MapReport]) {
     html.push_str(
         "<table><tr><th>map</th><th>method</th><th>mean ± std</th><th>shadow mean ± std</th>\
-         <th>relative RMSE</th><th>lights</th><th>decomposition (ms)</th><th>frame (ms)</th></tr>",
+         <th>penumbra mean ± std</th><th>relative RMSE</th><th>lights</th><th>decomposition (ms)</th><th>frame (ms)</th></tr>",
     );
     for map in maps {
         let best = |key: fn(&MethodResult) -> f64| {
@@ -70,6 +70,7 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
         };
         let best_mean = best(|m| m.stats.mean);
         let best_shadow = best(|m| m.stats.shadow_mean);
+        let best_penumbra = best(|m| m.stats.penumbra_mean);
         let best_rmse = best(|m| m.stats.relative_rmse);
         let cell = |value: f64, best: f64, text: String| {
             let class = if value == best { " class=\"best\"" } else { "" };
@@ -88,13 +89,18 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
             };
             let _ = write!(
                 html,
-                "<tr>{name}<td class=\"name\">{}</td>{}{}{}<td>{}</td><td>{:.2}</td><td>{:.1}</td></tr>",
+                "<tr>{name}<td class=\"name\">{}</td>{}{}{}{}<td>{}</td><td>{:.2}</td><td>{:.1}</td></tr>",
                 escape(&m.method),
                 cell(s.mean, best_mean, mean_std(s.mean, s.std)),
                 cell(
                     s.shadow_mean,
                     best_shadow,
                     mean_std(s.shadow_mean, s.shadow_std)
+                ),
+                cell(
+                    s.penumbra_mean,
+                    best_penumbra,
+                    mean_std(s.penumbra_mean, s.penumbra_std)
                 ),
                 cell(
                     s.relative_rmse,
@@ -199,12 +205,16 @@ pub fn page(report: &Report, out: &Path) -> anyhow::Result<String> {
          path-traced reference, as in Table 5.1 of the thesis. Errors are \
          |Y(tonemap(test)) − Y(tonemap(reference))| over pixels covered by geometry, one exposure \
          per map; the shadow region is the covered pixels whose direct visibility of the \
-         environment is below {threshold}; relative RMSE is of linear luminance, relative to the \
+         environment is below {threshold}, the penumbra region those whose visibility lies \
+         strictly between {low} and {high} (partly lit: where filter widths and source sizes \
+         show); relative RMSE is of linear luminance, relative to the \
          reference's mean. Bold: the lowest error per map.</p>\
          <p class=\"note\">{w}×{h} pixels · reference {spp} paths per pixel, {bounces} bounces, \
          seed {seed} · bake {bake} · adapter {adapter} · frame time: median of {frames} frames</p>",
         scene = escape(&report.scene),
         threshold = report.shadow_visibility_threshold,
+        low = report.penumbra_visibility.0,
+        high = report.penumbra_visibility.1,
         w = s.width,
         h = s.height,
         spp = s.spp,

@@ -151,6 +151,8 @@ pub struct Report {
     pub bake: String,
     pub settings: ReportSettings,
     pub shadow_visibility_threshold: f32,
+    /// Reference direct visibility bounds (exclusive) of the penumbra region.
+    pub penumbra_visibility: (f32, f32),
     pub maps: Vec<MapReport>,
 }
 
@@ -486,6 +488,7 @@ pub fn run_report(
         bake: bake.display().to_string(),
         settings: settings.clone(),
         shadow_visibility_threshold: stats::SHADOW_VISIBILITY,
+        penumbra_visibility: stats::PENUMBRA_VISIBILITY,
         maps,
     };
     write_atomic(
@@ -510,18 +513,24 @@ fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
         "std",
         "shadow_mean",
         "shadow_std",
+        "penumbra_mean",
+        "penumbra_std",
         "relative_rmse",
         "lights",
         "decomposition_ms",
         "frame_ms",
         "covered_pixels",
         "shadow_pixels",
+        "penumbra_pixels",
     ])?;
     for map in &report.maps {
         if map.methods.is_empty() {
             writer.write_record([
                 map.name.as_str(),
                 map.status.name(),
+                "",
+                "",
+                "",
                 "",
                 "",
                 "",
@@ -545,12 +554,15 @@ fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
                 format!("{:.6}", s.std),
                 format!("{:.6}", s.shadow_mean),
                 format!("{:.6}", s.shadow_std),
+                format!("{:.6}", s.penumbra_mean),
+                format!("{:.6}", s.penumbra_std),
                 format!("{:.6}", s.relative_rmse),
                 m.lights.to_string(),
                 format!("{:.3}", m.decomposition_ms),
                 format!("{:.3}", m.frame_ms),
                 s.covered_pixels.to_string(),
                 s.shadow_pixels.to_string(),
+                s.penumbra_pixels.to_string(),
             ])?;
         }
     }
@@ -577,8 +589,8 @@ pub fn write_report(
     let report = run_report(scene, &transfer, &bake_path, envs, &settings, output)?;
     println!();
     println!(
-        "{:<12} {:<18} {:>8} {:>8} {:>8} {:>6}",
-        "map", "method", "mean", "shadow", "rel.rmse", "lights"
+        "{:<12} {:<18} {:>8} {:>8} {:>8} {:>8} {:>6}",
+        "map", "method", "mean", "shadow", "penumbra", "rel.rmse", "lights"
     );
     for map in &report.maps {
         if map.methods.is_empty() {
@@ -586,11 +598,12 @@ pub fn write_report(
         }
         for m in &map.methods {
             println!(
-                "{:<12} {:<18} {:>8.4} {:>8.4} {:>8.4} {:>6}",
+                "{:<12} {:<18} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>6}",
                 map.name,
                 m.method,
                 m.stats.mean,
                 m.stats.shadow_mean,
+                m.stats.penumbra_mean,
                 m.stats.relative_rmse,
                 m.lights
             );

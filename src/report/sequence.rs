@@ -69,6 +69,7 @@ pub struct FrameResult {
     pub method: String,
     pub mean: f64,
     pub shadow_mean: f64,
+    pub penumbra_mean: f64,
     /// Mean over covered pixels of `|(M(t) − M(t−1)) − (R(t) − R(t−1))|` (none in frame 0).
     pub temporal: Option<f64>,
     /// Whether the frame pops (see `POP_SPIKE`).
@@ -303,6 +304,7 @@ pub fn write_sequence_report(
                 method: method.name().to_owned(),
                 mean: s.mean,
                 shadow_mean: s.shadow_mean,
+                penumbra_mean: s.penumbra_mean,
                 temporal: temporal_error,
                 popping: false,
                 lights,
@@ -456,6 +458,7 @@ fn write_outputs(
         "method",
         "mean",
         "shadow_mean",
+        "penumbra_mean",
         "temporal",
         "popping",
         "lights",
@@ -468,6 +471,7 @@ fn write_outputs(
                 r.method.clone(),
                 format!("{:.6}", r.mean),
                 format!("{:.6}", r.shadow_mean),
+                format!("{:.6}", r.penumbra_mean),
                 optional(r.temporal),
                 r.popping.to_string(),
                 r.lights.to_string(),

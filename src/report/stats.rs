@@ -1,12 +1,15 @@
 //! Error statistics of a test image against the reference (CONVENTIONS.md, "Error
 //! statistics"): `|Y(tonemap(test)) − Y(tonemap(reference))|` over covered pixels and over the
-//! shadow region, and the RMSE of linear luminance relative to the reference's mean.
+//! shadow region and the penumbra region, and the RMSE of linear luminance relative to the reference's mean.
 
 use precompute::image_io::{RgbImageF32, tonemap};
 use precompute::luminance;
 
 /// Pixels whose reference direct visibility is below this belong to the shadow region.
 pub const SHADOW_VISIBILITY: f32 = 0.5;
+/// Pixels whose reference direct visibility lies strictly between these belong to the
+/// penumbra region: partly lit, where a filter's width and the source's size show.
+pub const PENUMBRA_VISIBILITY: (f32, f32) = (0.05, 0.95);
 
 /// The statistics of one image.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -17,16 +20,21 @@ pub struct ErrorStats {
     /// The same over the shadow region (NaN when it is empty).
     pub shadow_mean: f64,
     pub shadow_std: f64,
+    /// The same over the penumbra region (NaN when it is empty).
+    pub penumbra_mean: f64,
+    pub penumbra_std: f64,
     /// RMSE of linear luminance over covered pixels, relative to the reference's mean there.
     pub relative_rmse: f64,
     pub covered_pixels: usize,
     pub shadow_pixels: usize,
+    pub penumbra_pixels: usize,
 }
 
 /// The masks the statistics use, from the reference's auxiliary images.
 pub struct Masks {
     pub covered: Vec<bool>,
     pub shadow: Vec<bool>,
+    pub penumbra: Vec<bool>,
 }
 
 impl Masks {
@@ -37,7 +45,17 @@ impl Masks {
             .zip(visibility)
             .map(|(c, v)| *c && *v < SHADOW_VISIBILITY)
             .collect();
-        Self { covered, shadow }
+        let (low, high) = PENUMBRA_VISIBILITY;
+        let penumbra = covered
+            .iter()
+            .zip(visibility)
+            .map(|(c, v)| *c && *v > low && *v < high)
+            .collect();
+        Self {
+            covered,
+            shadow,
+            penumbra,
+        }
     }
 }
 
@@ -93,8 +111,10 @@ pub fn error_stats(
     };
     let covered = masked(&masks.covered);
     let shadow = masked(&masks.shadow);
+    let penumbra = masked(&masks.penumbra);
     let (mean, std, covered_pixels) = mean_std(covered.iter().copied());
     let (shadow_mean, shadow_std, shadow_pixels) = mean_std(shadow.iter().copied());
+    let (penumbra_mean, penumbra_std, penumbra_pixels) = mean_std(penumbra.iter().copied());
     let (mut squared, mut reference_sum) = (0.0f64, 0.0f64);
     for ((t, r), _) in test
         .pixels
@@ -112,9 +132,12 @@ pub fn error_stats(
         std,
         shadow_mean,
         shadow_std,
+        penumbra_mean,
+        penumbra_std,
         relative_rmse: (squared / n).sqrt() / (reference_sum / n).max(1e-12),
         covered_pixels,
         shadow_pixels,
+        penumbra_pixels,
     }
 }
 
@@ -140,19 +163,25 @@ mod tests {
         let mut test = reference.clone();
         test.pixels[1] = Rgb::splat(2.0);
         test.pixels[3] = Rgb::splat(5.0); // not covered: ignored
-        let masks = Masks::new(&[1.0, 1.0, 1.0, 0.0], &[1.0, 0.2, 1.0, 1.0]);
+        test.pixels[2] = Rgb::splat(3.0);
+        // Visibility 0.2 (shadow and penumbra), 0.96 (lit), 0.6 (penumbra, lit).
+        let masks = Masks::new(&[1.0, 1.0, 1.0, 0.0], &[0.96, 0.2, 0.6, 0.5]);
         let stats = error_stats(&test, &reference, &masks, exposure);
-        let e = (1.0 - (-2.0f64).exp()) - (1.0 - (-1.0f64).exp());
-        assert!((stats.mean - e / 3.0).abs() < 1e-6);
+        let tonemapped = |l: f64| 1.0 - (-l).exp();
+        let e = tonemapped(2.0) - tonemapped(1.0);
+        let e3 = tonemapped(3.0) - tonemapped(1.0);
+        assert!((stats.mean - (e + e3) / 3.0).abs() < 1e-6);
         assert!((stats.shadow_mean - e).abs() < 1e-6 && stats.shadow_pixels == 1);
-        // One covered pixel off by 1 in luminance: RMSE √(1/3), reference mean 1.
-        assert!((stats.relative_rmse - (1.0f64 / 3.0).sqrt()).abs() < 1e-6);
+        assert!((stats.penumbra_mean - (e + e3) / 2.0).abs() < 1e-6);
+        assert_eq!(stats.penumbra_pixels, 2);
+        // Covered pixels off by 1 and 2 in luminance: RMSE √(5/3), reference mean 1.
+        assert!((stats.relative_rmse - (5.0f64 / 3.0).sqrt()).abs() < 1e-6);
         assert_eq!(stats.covered_pixels, 3);
         let empty = Masks::new(&[1.0; 4], &[1.0; 4]);
-        assert!(
-            error_stats(&test, &reference, &empty, exposure)
-                .shadow_mean
-                .is_nan()
-        );
+        let lit = error_stats(&test, &reference, &empty, exposure);
+        assert!(lit.shadow_mean.is_nan() && lit.penumbra_mean.is_nan());
+        // The penumbra's bounds are strict.
+        let bounds = Masks::new(&[1.0; 2], &[0.05, 0.95]);
+        assert_eq!(bounds.penumbra, [false, false]);
     }
 }

@@ -15,6 +15,7 @@ pub mod icosphere;
 pub mod peaks;
 pub mod projection;
 pub mod smoothing;
+pub mod source_size;
 pub mod visualize;
 pub mod weber;
 pub mod window;

@@ -117,6 +117,7 @@ fn bind_group(
         wgpu::BindingResource::Sampler(&inputs.shadow_maps.sampler),
         view(&inputs.environment.view),
         view(inputs.shadow_maps.depth_copy_array_view()),
+        wgpu::BindingResource::Sampler(&inputs.environment.sampler),
     ];
     let entries: Vec<wgpu::BindGroupEntry> = resources
         .into_iter()
@@ -133,7 +134,7 @@ fn bind_group(
     })
 }
 
-/// Bindings 0–8 of `shaders/lights.wgsl`, in order.
+/// Bindings 0–9 of `shaders/lights.wgsl`, in order.
 fn layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     use wgpu::{BindingType, TextureSampleType as S, TextureViewDimension as D};
     let uniform = BindingType::Buffer {
@@ -155,8 +156,9 @@ fn layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         texture(float, D::D2),                                      // albedo
         texture(S::Depth, D::D2Array),                              // shadow maps
         BindingType::Sampler(wgpu::SamplerBindingType::Comparison), // shadow sampler
-        texture(float, D::D2),                                      // environment
+        texture(S::Float { filterable: true }, D::D2),              // environment
         texture(float, D::D2Array),                                 // shadow depths
+        BindingType::Sampler(wgpu::SamplerBindingType::Filtering),  // environment sampler
     ]
     .into_iter()
     .enumerate()

@@ -39,7 +39,7 @@ use precompute::settings::InvalidSettings;
 use prt_pass::PrtPass;
 pub use shaders::{MAX_GPU_ORDER, MAX_LIGHTS};
 use shadow_maps::ShadowMaps;
-pub use shadow_maps::{BoundingSphere, ShadowSettings};
+pub use shadow_maps::{BoundingSphere, ShadowFit, ShadowSettings};
 use targets::Targets;
 use uniforms::{FrameBuffers, FrameParameters, FrameUniform};
 
@@ -105,6 +105,8 @@ pub struct Renderer {
     queue: wgpu::Queue,
     scene: GpuScene,
     bounds: BoundingSphere,
+    /// The scene's axis-aligned box (min, max), which shadow maps are fitted to.
+    scene_box: (glam::Vec3, glam::Vec3),
     buffers: FrameBuffers,
     targets: Targets,
     shadow_maps: ShadowMaps,
@@ -144,6 +146,7 @@ impl Renderer {
         let buffers = FrameBuffers::new(&device);
         Ok(Self {
             bounds: BoundingSphere::of_box(scene.bounds.0, scene.bounds.1),
+            scene_box: scene.bounds,
             prt_pass: PrtPass::new(&device, &buffers.frame),
             light_pass: LightPass::new(&device),
             shadow_maps: ShadowMaps::new(&device, shadow)?,
@@ -262,7 +265,12 @@ impl Renderer {
             background: self.background,
             pcf_taps: shadow.pcf_taps,
         });
-        let light_data = uniforms::light_uniforms(lights, &self.bounds, shadow.resolution);
+        let view_proj = uniforms::camera_view_proj(&self.frame.camera, &self.bounds);
+        let fits: Vec<ShadowFit> = lights
+            .iter()
+            .map(|l| ShadowFit::to_view(l.direction, self.scene_box, view_proj, shadow.resolution))
+            .collect();
+        let light_data = uniforms::light_uniforms(lights, &fits);
         self.buffers.write(&self.queue, &frame, &light_data);
         if shadows {
             if self.shadow_maps.reserve(&self.device, lights.len()) {

@@ -3,7 +3,7 @@
 
 use super::pass_helpers::writable_buffer;
 use super::shaders::MAX_LIGHTS;
-use super::shadow_maps::{BoundingSphere, shadow_matrix, shadow_texel_size};
+use super::shadow_maps::{BoundingSphere, ShadowFit};
 use crate::light::DirectionalLight;
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
@@ -50,13 +50,18 @@ pub struct FrameParameters<'a> {
     pub pcf_taps: u32,
 }
 
+/// World → clip space of `camera`, its depth range fitted to the scene's bounding sphere.
+pub fn camera_view_proj(camera: &Camera, bounds: &BoundingSphere) -> Mat4 {
+    let distance = (camera.position - bounds.center).length();
+    let near = (distance - bounds.radius).max(1e-3 * bounds.radius);
+    let far = (distance + bounds.radius) * 1.01;
+    camera.projection_matrix(near, far) * camera.view_matrix()
+}
+
 impl FrameUniform {
     pub fn new(p: &FrameParameters) -> Self {
         let (w, h) = (p.camera.width as f32, p.camera.height as f32);
-        let distance = (p.camera.position - p.bounds.center).length();
-        let near = (distance - p.bounds.radius).max(1e-3 * p.bounds.radius);
-        let far = (distance + p.bounds.radius) * 1.01;
-        let view_proj = p.camera.projection_matrix(near, far) * p.camera.view_matrix();
+        let view_proj = camera_view_proj(p.camera, p.bounds);
         let (sin, cos) = p.environment_rotation.sin_cos();
         Self {
             view_proj: view_proj.to_cols_array_2d(),
@@ -71,21 +76,17 @@ impl FrameUniform {
     }
 }
 
-/// Each light with its shadow matrix and filtering parameters.
-pub fn light_uniforms(
-    lights: &[DirectionalLight],
-    bounds: &BoundingSphere,
-    shadow_resolution: u32,
-) -> Vec<LightUniform> {
-    let texel = shadow_texel_size(bounds, shadow_resolution);
+/// Each light with its shadow map's placement (`fits[i]`) and filtering parameters.
+pub fn light_uniforms(lights: &[DirectionalLight], fits: &[ShadowFit]) -> Vec<LightUniform> {
     lights
         .iter()
+        .zip(fits)
         .enumerate()
-        .map(|(i, l)| LightUniform {
+        .map(|(i, (l, fit))| LightUniform {
             direction: l.direction.extend(0.0).to_array(),
             power: l.power.extend(0.0).to_array(),
-            shadow_matrix: shadow_matrix(l.direction, bounds).to_cols_array_2d(),
-            params: [texel, 2.0 * bounds.radius, l.angular_radius.tan(), i as f32],
+            shadow_matrix: fit.matrix.to_cols_array_2d(),
+            params: [fit.texel, fit.depth_range, l.angular_radius.tan(), i as f32],
         })
         .collect()
 }
