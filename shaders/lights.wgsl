@@ -49,8 +49,8 @@ fn shadow_coordinates(light: Light, position: vec3<f32>) -> vec3<f32> {
 // Samples of the blocker search and of the PCF kernel: the centre plus points of a Vogel
 // (golden-angle) spiral, which covers the unit disc evenly at any count. The spiral is turned
 // per pixel, so what falls between its points on one pixel is sampled on its neighbours.
-const BLOCKER_SAMPLES: u32 = 24u;
-const PCF_SAMPLES: u32 = 16u;
+const BLOCKER_SAMPLES: u32 = 12u;
+const PCF_SAMPLES: u32 = 12u;
 const GOLDEN_ANGLE: f32 = 2.39996323;
 
 // Point `i` of an `n`-point Vogel spiral on the unit disc, turned by `phase` radians.

@@ -337,6 +337,37 @@ fn thin_occluders_cast_their_shadows() {
         umbra > 100 && lit > 10_000,
         "umbra {umbra}, lit {lit} pixels"
     );
+
+    // A 3° source over 4 cm cubes 20 cm above the floor: umbrae 2 cm square, inside a
+    // blocker search and a PCF kernel several times wider than the occluder.
+    let cubes: Vec<(Vec3, Vec3)> = (-2..=2)
+        .map(|k| {
+            let x = 0.3 * k as f32;
+            (
+                Vec3::new(x - 0.02, 0.18, -0.02),
+                Vec3::new(x + 0.02, 0.22, 0.02),
+            )
+        })
+        .collect();
+    let wide = DirectionalLight {
+        angular_radius: 3f32.to_radians(),
+        ..light
+    };
+    let close = Camera {
+        up: Vec3::NEG_Z,
+        ..camera(
+            Vec3::new(0.0, 1.5, -0.12),
+            Vec3::new(0.0, 0.0, -0.12),
+            200,
+            200,
+        )
+    };
+    // One pixel in from the umbra's edge (a shadow-map texel spans a pixel here).
+    let (umbra, lit) = shadow_agrees_with_ray_casting(&floor_with(4.0, &cubes), wide, &close, 1);
+    assert!(
+        umbra >= 5 && lit > 10_000,
+        "umbra {umbra}, lit {lit} pixels"
+    );
 }
 
 /// Light 5° above the horizon over a low wall, seen obliquely: a shadow 3 m long across a

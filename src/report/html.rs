@@ -119,18 +119,21 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
 fn sweep_table(html: &mut String, map: &MapReport) {
     html.push_str(
         "<table><tr><th>mode</th><th>Weber threshold</th><th>lights</th><th>mean</th>\
-         <th>shadow mean</th></tr>",
+         <th>shadow mean</th><th>penumbra mean</th></tr>",
     );
     for (label, points) in &map.sweep {
         for p in points {
-            let shadow = if p.shadow_mean.is_finite() {
-                format!("{:.4}", p.shadow_mean)
-            } else {
-                "–".into()
+            let optional = |v: f64| {
+                if v.is_finite() {
+                    format!("{v:.4}")
+                } else {
+                    "–".into()
+                }
             };
+            let (shadow, penumbra) = (optional(p.shadow_mean), optional(p.penumbra_mean));
             let _ = write!(
                 html,
-                "<tr><td class=\"name\">{}</td><td>{}</td><td>{}</td><td>{:.4}</td><td>{shadow}</td></tr>",
+                "<tr><td class=\"name\">{}</td><td>{}</td><td>{}</td><td>{:.4}</td><td>{shadow}</td><td>{penumbra}</td></tr>",
                 escape(label),
                 p.threshold,
                 p.lights,

@@ -112,6 +112,7 @@ pub struct SweepPoint {
     pub lights: usize,
     pub mean: f64,
     pub shadow_mean: f64,
+    pub penumbra_mean: f64,
 }
 
 /// Whether a map's section was written (`"ok"`) or the map failed (`"failed"`, see `error`).
@@ -410,6 +411,7 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
                 lights,
                 mean: s.mean,
                 shadow_mean: s.shadow_mean,
+                penumbra_mean: s.penumbra_mean,
             });
         }
         curves.push(Curve {
