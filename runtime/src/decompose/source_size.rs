@@ -50,8 +50,6 @@ fn texels_within(map: &EnvMap, centre: Vec3, radius: f32) -> Vec<(usize, usize)>
             }
         }
     }
-    out.sort_unstable();
-    out.dedup();
     out
 }
 
@@ -125,8 +123,9 @@ pub fn measure_sources(map: &EnvMap, lights: &mut [crate::light::DirectionalLigh
     }
 }
 
-/// Solid angle of the texels connected to `seed` (4-neighbours, wrapping in azimuth) brighter
-/// than `level`, within [`MAX_SOURCE_RADIUS`] of `centre`, counting only those `owned`.
+/// Solid angle of the texels `owned` connected to `seed` (4-neighbours, wrapping in azimuth)
+/// brighter than `level`, within [`MAX_SOURCE_RADIUS`] of `centre`. A convex source cut by the
+/// convex cells of the lights nearest to its parts stays connected within each cell.
 fn half_maximum_region(
     map: &EnvMap,
     seed: (usize, usize),
@@ -141,9 +140,7 @@ fn half_maximum_region(
     seen.insert(seed);
     let mut omega = 0.0;
     while let Some((i, j)) = stack.pop() {
-        if owned((i, j)) {
-            omega += map.texel_solid_angle(j);
-        }
+        omega += map.texel_solid_angle(j);
         let mut neighbours = vec![((i + 1) % w, j), ((i + w - 1) % w, j)];
         if j > 0 {
             neighbours.push((i, j - 1));
@@ -155,6 +152,7 @@ fn half_maximum_region(
             if !seen.contains(&n)
                 && luminance(map.texel(n.0, n.1)) > level
                 && map.texel_direction(n.0, n.1).dot(centre) >= cos_max
+                && owned(n)
             {
                 seen.insert(n);
                 stack.push(n);
@@ -244,7 +242,8 @@ mod tests {
         let map = EnvMap::uniform(256, 128, Rgb::ONE);
         for centre in [Vec3::new(0.0, 0.2, 1.0).normalize(), Vec3::Y, Vec3::NEG_Z] {
             let radius = 12f32.to_radians();
-            let found = texels_within(&map, centre, radius);
+            let mut found = texels_within(&map, centre, radius);
+            found.sort_unstable();
             let brute: Vec<(usize, usize)> = (0..128)
                 .flat_map(|j| (0..256).map(move |i| (i, j)))
                 .filter(|&(i, j)| map.texel_direction(i, j).dot(centre) >= radius.cos())
