@@ -31,11 +31,11 @@ fn texels_within(map: &EnvMap, centre: Vec3, radius: f32) -> Vec<(usize, usize)>
     let first = (((theta - radius) / row_angle).floor().max(0.0)) as usize;
     let last = ((((theta + radius) / row_angle).ceil()) as usize).min(h);
     let cos_radius = radius.cos();
+    let centre_u = precompute::envmap::uv_of_direction(centre).0 * w as f32;
     let mut out = Vec::new();
     for j in first..last {
         // Columns to test: all of them near a pole, else an azimuth window around the centre's.
         let sin_row = ((j as f32 + 0.5) * row_angle).sin();
-        let centre_u = precompute::envmap::uv_of_direction(centre).0 * w as f32;
         let half_width = if sin_row * PI <= radius * 2.0 || theta < radius || PI - theta < radius {
             w as f32
         } else {

@@ -105,8 +105,6 @@ pub struct Renderer {
     queue: wgpu::Queue,
     scene: GpuScene,
     bounds: BoundingSphere,
-    /// The scene's axis-aligned box (min, max), which shadow maps are fitted to.
-    scene_box: (glam::Vec3, glam::Vec3),
     buffers: FrameBuffers,
     targets: Targets,
     shadow_maps: ShadowMaps,
@@ -146,7 +144,6 @@ impl Renderer {
         let buffers = FrameBuffers::new(&device);
         Ok(Self {
             bounds: BoundingSphere::of_box(scene.bounds.0, scene.bounds.1),
-            scene_box: scene.bounds,
             prt_pass: PrtPass::new(&device, &buffers.frame),
             light_pass: LightPass::new(&device),
             shadow_maps: ShadowMaps::new(&device, shadow)?,
@@ -257,18 +254,20 @@ impl Renderer {
             self.frame.radiance_dirty = false;
         }
         let shadow = self.shadow_maps.settings();
+        let view_proj = uniforms::camera_view_proj(&self.frame.camera, &self.bounds);
         let frame = FrameUniform::new(&FrameParameters {
             camera: &self.frame.camera,
-            bounds: &self.bounds,
+            view_proj,
             environment_rotation: self.environment.rotation,
             light_count: lights.len(),
             background: self.background,
             pcf_taps: shadow.pcf_taps,
         });
-        let view_proj = uniforms::camera_view_proj(&self.frame.camera, &self.bounds);
         let fits: Vec<ShadowFit> = lights
             .iter()
-            .map(|l| ShadowFit::to_view(l.direction, self.scene_box, view_proj, shadow.resolution))
+            .map(|l| {
+                ShadowFit::to_view(l.direction, self.scene.bounds, view_proj, shadow.resolution)
+            })
             .collect();
         let light_data = uniforms::light_uniforms(lights, &fits);
         self.buffers.write(&self.queue, &frame, &light_data);

@@ -42,7 +42,8 @@ impl LightUniform {
 /// What the frame uniform is made of.
 pub struct FrameParameters<'a> {
     pub camera: &'a Camera,
-    pub bounds: &'a BoundingSphere,
+    /// World → clip space ([`camera_view_proj`]).
+    pub view_proj: Mat4,
     /// Rotation of the background map about +Y, radians.
     pub environment_rotation: f32,
     pub light_count: usize,
@@ -61,7 +62,7 @@ pub fn camera_view_proj(camera: &Camera, bounds: &BoundingSphere) -> Mat4 {
 impl FrameUniform {
     pub fn new(p: &FrameParameters) -> Self {
         let (w, h) = (p.camera.width as f32, p.camera.height as f32);
-        let view_proj = camera_view_proj(p.camera, p.bounds);
+        let view_proj = p.view_proj;
         let (sin, cos) = p.environment_rotation.sin_cos();
         Self {
             view_proj: view_proj.to_cols_array_2d(),
