@@ -24,6 +24,9 @@ struct Light {
     // x: world size of a shadow-map texel, y: world depth range of the map,
     // z: tan of the source's angular radius, w: shadow-map layer.
     params: vec4<f32>,
+    // x: tan of the angular radius of the source's halo (at least the source's), y: fraction of
+    // the power from the source itself (the rest from the halo), zw unused.
+    source: vec4<f32>,
 };
 
 // A depth in [0, 1] split over two half floats (about 22 bits together), for colour targets

@@ -152,6 +152,8 @@ fn shadow_of_a_sphere_lands_where_geometry_predicts() {
         power: Rgb::splat(5.0),
         cap_radius: 0.05,
         angular_radius: 0.005,
+        halo_radius: 0.005,
+        core_fraction: 1.0,
         share: 1.0,
     };
     let lighting = FrameLighting {
@@ -319,6 +321,8 @@ fn thin_occluders_cast_their_shadows() {
         power: Rgb::splat(5.0),
         cap_radius: 0.05,
         angular_radius: 0.27f32.to_radians(),
+        halo_radius: 0.27f32.to_radians(),
+        core_fraction: 1.0,
         share: 1.0,
     };
     // Straight down, 2.2 cm per pixel: the bar's umbra is about 1.5 pixels wide.
@@ -385,6 +389,8 @@ fn grazing_light_casts_a_clean_shadow() {
         power: Rgb::splat(20.0),
         cap_radius: 0.05,
         angular_radius: 0.27f32.to_radians(),
+        halo_radius: 0.27f32.to_radians(),
+        core_fraction: 1.0,
         share: 1.0,
     };
     let cam = camera(
@@ -398,6 +404,121 @@ fn grazing_light_casts_a_clean_shadow() {
     assert!(
         umbra > 1000 && lit > 5000,
         "umbra {umbra}, lit {lit} pixels"
+    );
+}
+
+/// The fraction of a source seen from `p`: `fraction` of it over a disc of `core` radians
+/// around `d`, the rest over a disc of `halo` radians, each sampled by a 64-point spiral.
+fn source_visibility(bvh: &SceneBvh, p: Vec3, d: Vec3, core: f32, halo: f32, fraction: f32) -> f32 {
+    let (u, v) = (
+        d.any_orthonormal_vector(),
+        d.cross(d.any_orthonormal_vector()),
+    );
+    let seen = |radius: f32| {
+        let n = 64;
+        (0..n)
+            .filter(|&k| {
+                let r = ((k as f32 + 0.5) / n as f32).sqrt() * radius.tan();
+                let a = k as f32 * 2.399_963;
+                let ray = (d + (u * a.cos() + v * a.sin()) * r).normalize();
+                !bvh.occluded(p + Vec3::Y * 1e-4, ray, 0.0, f32::MAX, Skip::Nothing)
+            })
+            .count() as f32
+            / n as f32
+    };
+    fraction * seen(core) + (1.0 - fraction) * seen(halo)
+}
+
+/// A lamp whose power is 40% in a 0.3° core and 60% in a 5° halo, over a wall's edge: the
+/// floor's penumbra is a sharp step inside a wide ramp. The GPU's visibility across it (each
+/// image row, along the wall, averaged: the filter's per-pixel dither averages out) must follow
+/// ray casting against that source, and clearly better than a plain 0.3° disc would.
+#[test]
+fn a_source_with_a_halo_casts_its_wide_penumbra() {
+    let geometry = floor_with(
+        4.0,
+        &[(Vec3::new(-2.0, 0.0, 0.0), Vec3::new(2.0, 1.0, 0.1))],
+    );
+    let direction = Vec3::new(0.0, 1.0, 1.0).normalize();
+    let haloed = DirectionalLight {
+        direction,
+        power: Rgb::splat(5.0),
+        cap_radius: 0.14,
+        angular_radius: 0.3f32.to_radians(),
+        halo_radius: 5f32.to_radians(),
+        core_fraction: 0.4,
+        share: 1.0,
+    };
+    // Looking down at the shadow's far edge, a metre behind the wall.
+    let cam = Camera {
+        position: Vec3::new(0.0, 2.5, -1.0),
+        target: Vec3::new(0.0, 0.0, -1.0),
+        up: Vec3::Z,
+        fov_y_deg: 20.0,
+        width: 96,
+        height: 96,
+    };
+    let transfer = bake_of(&geometry, 2, 16, 0);
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let basis = cam.basis();
+    let lit_value = 0.5 / std::f32::consts::PI * 5.0 * direction.y;
+    let gpu = gpu();
+    let error_of = |light: DirectionalLight| {
+        let lighting = FrameLighting {
+            sh: ShCoeffs::zeros(2),
+            lights: vec![light],
+            lights_indirect: false,
+            shadows: true,
+        };
+        // Texels of about 3 mm: the halo's penumbra (±0.17 m) spans some 55 of them, within
+        // the filter's widest kernel.
+        let shadows = ShadowSettings {
+            resolution: 384,
+            ..ShadowSettings::default()
+        };
+        let mut renderer = Renderer::new(&gpu, &geometry, &transfer, &cam, shadows).unwrap();
+        renderer.background = false;
+        renderer.set_lighting(&lighting).unwrap();
+        renderer.render().unwrap();
+        let image = renderer.read_back().unwrap();
+        let (mut sum, mut rows) = (0.0, 0);
+        for j in 0..cam.height {
+            let (mut truth, mut drawn) = (0.0, 0.0);
+            for i in 0..cam.width {
+                let ray = cam.pixel_direction(&basis, i, j);
+                let hit = bvh
+                    .intersect(cam.position, ray, 0.0, f32::MAX)
+                    .expect("the floor");
+                let p = cam.position + ray * hit.t;
+                truth += source_visibility(
+                    &bvh,
+                    p,
+                    direction,
+                    0.3f32.to_radians(),
+                    5f32.to_radians(),
+                    0.4,
+                );
+                drawn += luminance(image.get(i as usize, j as usize)) / lit_value;
+            }
+            let (truth, drawn) = (truth / cam.width as f32, drawn / cam.width as f32);
+            if truth > 0.02 && truth < 0.98 {
+                sum += (drawn - truth).abs();
+                rows += 1;
+            }
+        }
+        assert!(rows > 20, "{rows} penumbra rows");
+        sum / rows as f32
+    };
+    let with_halo = error_of(haloed);
+    let disc_only = error_of(DirectionalLight {
+        halo_radius: haloed.angular_radius,
+        core_fraction: 1.0,
+        ..haloed
+    });
+    eprintln!("penumbra visibility error: {with_halo} with the halo, {disc_only} without");
+    assert!(
+        with_halo < 0.02 && with_halo < 0.25 * disc_only,
+        "mean |visibility error| over the penumbra: {with_halo} with the halo, {disc_only} without"
     );
 }
 
@@ -580,6 +701,8 @@ fn vulkan_and_opengl_software_adapters_draw_the_same_image() {
         power: Rgb::splat(4.0),
         cap_radius: 0.1,
         angular_radius: 0.02,
+        halo_radius: 0.02,
+        core_fraction: 1.0,
         share: 0.5,
     };
     let lighting = FrameLighting {

@@ -14,6 +14,11 @@ pub struct DirectionalLight {
     pub cap_radius: f32,
     /// Estimated angular radius of the source itself, in radians (sizes soft shadows).
     pub angular_radius: f32,
+    /// Angular radius of the disc standing for the glow or halo around the source, radians
+    /// (equal to `angular_radius` where it has none).
+    pub halo_radius: f32,
+    /// Fraction of the power from the source itself, the rest from its halo (1: none).
+    pub core_fraction: f32,
     /// Share of the map's total luminous power.
     pub share: f32,
 }

@@ -507,6 +507,8 @@ mod tests {
             power: Rgb::splat(2.0),
             cap_radius: 0.1,
             angular_radius: 0.01,
+            halo_radius: 0.01,
+            core_fraction: 1.0,
             share: 0.5,
         };
         let decomposition = Decomposition {

@@ -198,6 +198,8 @@ mod tests {
             power: Rgb::splat(power),
             cap_radius: 0.14,
             angular_radius: 0.01,
+            halo_radius: 0.01,
+            core_fraction: 1.0,
             share: 0.0,
         }
     }

@@ -51,6 +51,8 @@ struct LightJson {
     power: [f32; 3],
     cap_radius_deg: f32,
     angular_radius_deg: f32,
+    halo_radius_deg: f32,
+    core_fraction: f32,
     share: f32,
 }
 
@@ -110,6 +112,8 @@ pub fn run(args: DecomposeArgs) -> anyhow::Result<()> {
                 power: l.power.to_array(),
                 cap_radius_deg: l.cap_radius.to_degrees(),
                 angular_radius_deg: l.angular_radius.to_degrees(),
+                halo_radius_deg: l.halo_radius.to_degrees(),
+                core_fraction: l.core_fraction,
                 share: l.share,
             })
             .collect(),

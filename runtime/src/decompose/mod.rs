@@ -439,6 +439,8 @@ impl Decomposer {
                 power: p.rgb.max(Rgb::ZERO) * cap,
                 cap_radius: radius,
                 angular_radius: radius,
+                halo_radius: radius,
+                core_fraction: 1.0,
                 share: 0.0,
             })
             .collect()
@@ -559,12 +561,15 @@ impl Decomposer {
                     (2.0 * spread[i] / lum).sqrt()
                 } else {
                     0.0
-                };
+                }
+                .clamp(0.25f32.to_radians(), radius);
                 DirectionalLight {
                     direction: directions[i],
                     power: power[i],
                     cap_radius: radius,
-                    angular_radius: rho.clamp(0.25f32.to_radians(), radius),
+                    angular_radius: rho,
+                    halo_radius: rho,
+                    core_fraction: 1.0,
                     share: 0.0,
                 }
             })

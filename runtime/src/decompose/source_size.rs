@@ -10,6 +10,13 @@
 //! light split into several), each measures the part of it nearer to itself than to the
 //! others, so together they span the source. Below a texel the region is one texel; the
 //! estimate is then the radius of a texel's solid angle, within a texel of the truth.
+//!
+//! Many real sources are a bright core in a wide halo (a lamp and its shade, the sun through
+//! haze or leaves): the light carries the halo's power too, and a halo casts a wider penumbra
+//! than its core. So the measurement also gives the fraction of the light's excess in the core
+//! and the radius of a disc standing for the rest (the disc with the halo's mean angular
+//! distance from the light, `E[θ] = 2ρ/3` for a uniform disc); the shadow filter spreads its
+//! samples over both discs in proportion (CONVENTIONS.md, "Shadows and background on the GPU").
 
 use glam::Vec3;
 use precompute::envmap::EnvMap;
@@ -67,10 +74,25 @@ pub fn disc_radius(omega: f32) -> f32 {
     (1.0 - omega / (2.0 * PI)).clamp(-1.0, 1.0).acos()
 }
 
-/// The measured angular radius (radians) of the source behind each light `directions[k]`
-/// (unit, in the map's frame), searched from its peak within `cap_radius`; `None` where the
-/// map has no peak above its background there.
-pub fn source_radii(map: &EnvMap, directions: &[Vec3], cap_radius: f32) -> Vec<Option<f32>> {
+/// What the map shows of the source behind one light: a core disc in a halo disc.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SourceShape {
+    /// Angular radius of the core (the half-maximum region's disc), radians.
+    pub radius: f32,
+    /// Angular radius of the disc standing for the halo, radians (at least `radius`).
+    pub halo_radius: f32,
+    /// Fraction of the excess over the local background in the core, in (0, 1].
+    pub core_fraction: f32,
+}
+
+/// The measured shape of the source behind each light `directions[k]` (unit, in the map's
+/// frame), searched from its peak within `cap_radius`; `None` where the map has no peak above
+/// its background there.
+pub fn source_shapes(
+    map: &EnvMap,
+    directions: &[Vec3],
+    cap_radius: f32,
+) -> Vec<Option<SourceShape>> {
     let nearest_light = |w: Vec3| {
         directions
             .iter()
@@ -89,42 +111,69 @@ pub fn source_radii(map: &EnvMap, directions: &[Vec3], cap_radius: f32) -> Vec<O
                     .map(lum)
                     .collect(),
             );
-            let (peak_texel, peak) = texels_within(map, d, cap_radius)
+            let cell: Vec<(usize, usize)> = texels_within(map, d, cap_radius)
                 .into_iter()
                 .filter(|t| nearest_light(map.texel_direction(t.0, t.1)) == k)
-                .map(|t| (t, lum(t)))
+                .collect();
+            let (peak_texel, peak) = cell
+                .iter()
+                .map(|&t| (t, lum(t)))
                 .max_by(|a, b| a.1.total_cmp(&b.1))?;
             if peak.partial_cmp(&background) != Some(std::cmp::Ordering::Greater) {
                 return None;
             }
             let half = 0.5 * (background + peak);
-            let omega = half_maximum_region(map, peak_texel, d, half, |t| {
+            let core = half_maximum_region(map, peak_texel, d, half, |t| {
                 nearest_light(map.texel_direction(t.0, t.1)) == k
             });
-            Some(disc_radius(omega))
+            let omega: f32 = core.iter().map(|t| map.texel_solid_angle(t.1)).sum();
+            let radius = disc_radius(omega);
+            // The excess in the core, and the excess and its angular moment in the halo.
+            let excess =
+                |t: (usize, usize)| (lum(t) - background).max(0.0) * map.texel_solid_angle(t.1);
+            let core_excess: f32 = core.iter().map(|&t| excess(t)).sum();
+            let (mut halo_excess, mut halo_moment) = (0.0f32, 0.0f32);
+            for &t in cell.iter().filter(|t| !core.contains(t)) {
+                let e = excess(t);
+                halo_excess += e;
+                halo_moment += e * map.texel_direction(t.0, t.1).angle_between(d);
+            }
+            let halo_radius = if halo_excess > 0.0 {
+                (1.5 * halo_moment / halo_excess).clamp(radius, cap_radius.max(radius))
+            } else {
+                radius
+            };
+            Some(SourceShape {
+                radius,
+                halo_radius,
+                core_fraction: core_excess / (core_excess + halo_excess),
+            })
         })
         .collect()
 }
 
-/// Sets each light's angular radius (its directions in the map's frame) to the measured size
-/// of its source, where the map has one; the others keep the decomposition's estimate.
+/// Sets each light's angular radius, halo and core fraction (its directions in the map's
+/// frame) to the measured shape of its source, where the map has one; the others keep the
+/// decomposition's estimate.
 pub fn measure_sources(map: &EnvMap, lights: &mut [crate::light::DirectionalLight]) {
     let Some(cap_radius) = lights.iter().map(|l| l.cap_radius).reduce(f32::max) else {
         return;
     };
     let directions: Vec<Vec3> = lights.iter().map(|l| l.direction).collect();
-    for (light, radius) in lights
+    for (light, shape) in lights
         .iter_mut()
-        .zip(source_radii(map, &directions, cap_radius))
+        .zip(source_shapes(map, &directions, cap_radius))
     {
-        if let Some(radius) = radius {
-            light.angular_radius = radius;
+        if let Some(shape) = shape {
+            light.angular_radius = shape.radius;
+            light.halo_radius = shape.halo_radius;
+            light.core_fraction = shape.core_fraction;
         }
     }
 }
 
-/// Solid angle of the texels `owned` connected to `seed` (4-neighbours, wrapping in azimuth)
-/// brighter than `level`, within [`MAX_SOURCE_RADIUS`] of `centre`. A convex source cut by the
+/// The texels `owned` connected to `seed` (4-neighbours, wrapping in azimuth) brighter than
+/// `level`, within [`MAX_SOURCE_RADIUS`] of `centre`. A convex source cut by the
 /// convex cells of the lights nearest to its parts stays connected within each cell.
 fn half_maximum_region(
     map: &EnvMap,
@@ -132,15 +181,13 @@ fn half_maximum_region(
     centre: Vec3,
     level: f32,
     owned: impl Fn((usize, usize)) -> bool,
-) -> f32 {
+) -> std::collections::HashSet<(usize, usize)> {
     let (w, h) = (map.width(), map.height());
     let cos_max = MAX_SOURCE_RADIUS.cos();
     let mut seen = std::collections::HashSet::new();
     let mut stack = vec![seed];
     seen.insert(seed);
-    let mut omega = 0.0;
     while let Some((i, j)) = stack.pop() {
-        omega += map.texel_solid_angle(j);
         let mut neighbours = vec![((i + 1) % w, j), ((i + w - 1) % w, j)];
         if j > 0 {
             neighbours.push((i, j - 1));
@@ -159,7 +206,7 @@ fn half_maximum_region(
             }
         }
     }
-    omega
+    seen
 }
 
 #[cfg(test)]
@@ -168,9 +215,20 @@ mod tests {
     use precompute::Rgb;
 
     /// A map of `width × width/2` with a uniform disc of angular radius `radius` and radiance
-    /// 100 at `centre` over a sky of 1, plus a glow of 5 falling off over 3 radii around it;
-    /// each texel the average of 4 × 4 samples, as a camera integrates a pixel.
+    /// 100 at `centre` over a sky of 1, plus a glow of 5 falling off over 3 radii around it.
     fn disc_map(width: usize, centre: Vec3, radius: f32) -> EnvMap {
+        map_around(width, centre, |angle| {
+            if angle <= radius {
+                100.0
+            } else {
+                1.0 + 5.0 * (-(angle - radius) / (3.0 * radius)).exp()
+            }
+        })
+    }
+
+    /// A map of `width × width/2` whose radiance is `radiance(angle from centre)`, each texel
+    /// the average of 4 × 4 samples, as a camera integrates a pixel.
+    fn map_around(width: usize, centre: Vec3, radiance: impl Fn(f32) -> f32) -> EnvMap {
         let height = width / 2;
         let n = 4;
         let mut texels = Vec::with_capacity(width * height);
@@ -184,11 +242,7 @@ mod tests {
                         .dot(centre)
                         .clamp(-1.0, 1.0)
                         .acos();
-                    sum += if angle <= radius {
-                        100.0
-                    } else {
-                        1.0 + 5.0 * (-(angle - radius) / (3.0 * radius)).exp()
-                    };
+                    sum += radiance(angle);
                 }
                 texels.push(Rgb::splat(sum / (n * n) as f32));
             }
@@ -204,8 +258,9 @@ mod tests {
             for radius_deg in [0.25f32, 0.5, 1.0, 2.0, 5.0, 10.0] {
                 let radius = radius_deg.to_radians();
                 let map = disc_map(width, centre, radius);
-                let measured = source_radii(&map, &[centre], 8f32.to_radians())[0]
-                    .expect("a disc above its sky");
+                let measured = source_shapes(&map, &[centre], 8f32.to_radians())[0]
+                    .expect("a disc above its sky")
+                    .radius;
                 let error = (measured - radius).abs();
                 assert!(
                     error <= (0.2 * radius).max(texel),
@@ -216,6 +271,58 @@ mod tests {
         }
     }
 
+    /// A 1° disc of 100 in a uniform ring out to 3° of 6, over a sky of 1: the excess is
+    /// 99·πr² in the core and 5·8πr² in the ring, so the core holds 99/139 of it; the ring's
+    /// mean angle from the centre is (2/3)(27 − 1)/(9 − 1) r, a disc of 1.5 times that.
+    #[test]
+    fn measures_the_core_and_halo_of_a_lamp() {
+        let centre = Vec3::new(-0.2, 0.3, 0.8).normalize();
+        let r = 1f32.to_radians();
+        let map = map_around(1024, centre, |angle| {
+            if angle <= r {
+                100.0
+            } else if angle <= 3.0 * r {
+                6.0
+            } else {
+                1.0
+            }
+        });
+        let shape = source_shapes(&map, &[centre], 8f32.to_radians())[0].expect("a lamp");
+        let halo = 1.5 * (2.0 / 3.0) * (26.0 / 8.0) * r;
+        assert!(
+            (shape.radius - r).abs() < 0.1 * r,
+            "core {}°",
+            shape.radius.to_degrees()
+        );
+        assert!(
+            (shape.core_fraction - 99.0 / 139.0).abs() < 0.03,
+            "core fraction {}",
+            shape.core_fraction
+        );
+        assert!(
+            (shape.halo_radius - halo).abs() < 0.1 * halo,
+            "halo {}° (expected {}°)",
+            shape.halo_radius.to_degrees(),
+            halo.to_degrees()
+        );
+        // A disc with no halo holds nearly all of its excess: only the texels straddling its
+        // rim below half its level (a ring a texel wide, about a tenth of a 1° disc's excess
+        // at 0.35° texels) count as halo.
+        let plain = map_around(1024, centre, |angle| if angle <= r { 100.0 } else { 1.0 });
+        let shape = source_shapes(&plain, &[centre], 8f32.to_radians())[0].expect("a disc");
+        assert!(
+            shape.core_fraction > 0.9,
+            "core fraction {}",
+            shape.core_fraction
+        );
+        // That ring lies at the rim, so the disc standing for it is about 1.5 r.
+        assert!(
+            shape.halo_radius < 2.0 * r,
+            "halo {}°",
+            shape.halo_radius.to_degrees()
+        );
+    }
+
     #[test]
     fn lights_sharing_a_source_split_it() {
         // A 10° disc seen by two lights on either side of its centre: each measures about half
@@ -224,9 +331,9 @@ mod tests {
         let map = disc_map(512, centre, 10f32.to_radians());
         let side = Vec3::new(0.09, 0.0, 0.0);
         let lights = [(centre + side).normalize(), (centre - side).normalize()];
-        let radii = source_radii(&map, &lights, 8f32.to_radians());
+        let radii = source_shapes(&map, &lights, 8f32.to_radians());
         for r in radii {
-            let r = r.expect("a source").to_degrees();
+            let r = r.expect("a source").radius.to_degrees();
             assert!((r - 10.0 / 2f32.sqrt()).abs() < 0.6, "{r}°");
         }
     }
@@ -234,7 +341,7 @@ mod tests {
     #[test]
     fn a_map_without_a_peak_has_no_source() {
         let map = EnvMap::uniform(128, 64, Rgb::splat(2.0));
-        assert_eq!(source_radii(&map, &[Vec3::Y], 0.1), [None]);
+        assert_eq!(source_shapes(&map, &[Vec3::Y], 0.1), [None]);
     }
 
     #[test]

@@ -31,6 +31,7 @@ pub struct LightUniform {
     power: [f32; 4],
     shadow_matrix: [[f32; 4]; 4],
     params: [f32; 4],
+    source: [f32; 4],
 }
 
 impl LightUniform {
@@ -88,6 +89,12 @@ pub fn light_uniforms(lights: &[DirectionalLight], fits: &[ShadowFit]) -> Vec<Li
             power: l.power.extend(0.0).to_array(),
             shadow_matrix: fit.matrix.to_cols_array_2d(),
             params: [fit.texel, fit.depth_range, l.angular_radius.tan(), i as f32],
+            source: [
+                l.halo_radius.max(l.angular_radius).tan(),
+                l.core_fraction.clamp(0.0, 1.0),
+                0.0,
+                0.0,
+            ],
         })
         .collect()
 }
