@@ -55,8 +55,8 @@ const GOLDEN_ANGLE: f32 = 2.39996323;
 // Largest search and PCF radius, in shadow-map texels. Penumbra errors of the teapot under the
 // studio, hall and forest maps (2048² maps) were lowest at 32–64 texels and grew beyond (the
 // receiver's tangent plane and one mean blocker depth stand for less of a wider kernel); 64
-// lets an 8° source behind a 1 m occluder keep its width down to 2 mm texels.
-const MAX_KERNEL: f32 = 64.0;
+// cost half as much again on llvmpipe (CONVENTIONS.md).
+const MAX_KERNEL: f32 = 32.0;
 
 // Point `i` of an `n`-point Vogel spiral on the unit disc, turned by `phase` radians.
 fn vogel(i: u32, n: u32, phase: f32) -> vec2<f32> {
