@@ -125,9 +125,13 @@ impl DecomposeOptions {
 #[derive(Args, Clone, Debug)]
 pub struct RenderOptions {
     /// prt: the SH projection of the whole map (the thesis' baseline); hybrid: SH part +
-    /// shadow-mapped lights; lights / unshadowed: debug views.
+    /// shadow-mapped lights; lights / unshadowed: debug views; median-cut: --lights
+    /// median-cut lights alone; sh-sun: one shadowed light + unshadowed order-3 SH (peers).
     #[arg(long, default_value = "hybrid")]
     pub mode: RenderMode,
+    /// Lights of --mode median-cut: a power of two up to 32.
+    #[arg(long, default_value_t = 8, value_parser = parse_median_cut_lights)]
+    pub lights: usize,
     /// Shadow-map resolution.
     #[arg(long, default_value_t = ShadowSettings::default().resolution)]
     pub shadow_res: u32,
@@ -145,6 +149,20 @@ pub struct RenderOptions {
     /// Graphics backend: auto, vulkan or gl.
     #[arg(long, default_value = "auto")]
     pub backend: Backend,
+}
+
+/// A median-cut light count: a power of two the renderer can draw.
+pub fn parse_median_cut_lights(text: &str) -> Result<usize, String> {
+    let n: usize = text
+        .parse()
+        .map_err(|_| format!("`{text}` is not a whole number"))?;
+    if !n.is_power_of_two() || n > runtime::render::MAX_LIGHTS {
+        return Err(format!(
+            "median cut makes a power of two of lights, 1 to {}; got {n}",
+            runtime::render::MAX_LIGHTS
+        ));
+    }
+    Ok(n)
 }
 
 impl RenderOptions {

@@ -15,6 +15,7 @@ use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
 use precompute::scene::{Scene, SceneMesh};
 use precompute::sh::ShCoeffs;
 use precompute::{Rgb, luminance};
+use runtime::lighting::ShTransfer;
 use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
 use runtime::{CubeSource, DecomposeSettings, Decomposer, DirectionalLight};
 
@@ -83,6 +84,59 @@ fn uniform_sh(order: usize, value: f32) -> ShCoeffs<Rgb> {
     sh
 }
 
+/// The "SH + sun" peer's SH part goes through the unshadowed transfer: under a sky of
+/// `1 + ω_y` a surface of normal n shows `ρ/π (π + (2π/3) n_y)` whatever surrounds it, so the
+/// sphere's contact with the plane, dark through the bake, is as bright as the open plane.
+#[test]
+fn sh_through_the_unshadowed_transfer_ignores_occlusion() {
+    let geometry = sphere_on_plane();
+    let transfer = bake_of(&geometry, 3, 64, 1);
+    let sky = EnvMap::from_fn(256, 128, 2, |w| Rgb::splat(1.0 + w.y));
+    let cam = camera(Vec3::new(0.0, 5.0, 5.0), Vec3::ZERO, 96, 96);
+    let unshadowed = FrameLighting {
+        sh_transfer: ShTransfer::Unshadowed,
+        ..FrameLighting::prt(sky.sh_projection(3))
+    };
+    let image = render(&gpu(), &geometry, &transfer, &cam, &unshadowed);
+    let baked = render(
+        &gpu(),
+        &geometry,
+        &transfer,
+        &cam,
+        &FrameLighting::prt(sky.sh_projection(3)),
+    );
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let basis = cam.basis();
+    let (mut plane, mut darker_in_bake) = (0, 0);
+    for j in 0..cam.height {
+        for i in 0..cam.width {
+            let ray = cam.pixel_direction(&basis, i, j);
+            let Some(hit) = bvh.intersect(cam.position, ray, 0.0, f32::MAX) else {
+                continue;
+            };
+            let p = cam.position + ray * hit.t;
+            // The plane's top (y = 0): normal +y, E = π + 2π/3.
+            if p.y.abs() < 1e-3 && p.x.abs() < 3.5 && p.z.abs() < 3.5 {
+                plane += 1;
+                let want = Rgb::new(0.6, 0.5, 0.4) / std::f32::consts::PI
+                    * (std::f32::consts::PI * 5.0 / 3.0);
+                let got = image.get(i as usize, j as usize);
+                assert!(
+                    ((got - want) / want).abs().max_element() < 0.01,
+                    "plane at {p}: {got} vs {want}"
+                );
+                if luminance(baked.get(i as usize, j as usize)) < 0.8 * luminance(want) {
+                    darker_in_bake += 1;
+                }
+            }
+        }
+    }
+    assert!(
+        plane > 2000 && darker_in_bake > 50,
+        "{plane} plane pixels, {darker_in_bake} occluded in the bake"
+    );
+}
+
 #[test]
 fn furnace_prt_surfaces_equal_their_albedo() {
     let albedo = Rgb::new(0.8, 0.5, 0.3);
@@ -134,6 +188,7 @@ fn hybrid_without_lights_equals_prt_pixel_for_pixel() {
         lights: Vec::new(),
         lights_indirect: true,
         shadows: true,
+        sh_transfer: ShTransfer::Baked,
     };
     assert_eq!(prt, render(&gpu, &geometry, &transfer, &cam, &hybrid));
     assert!(prt.pixels.iter().any(|p| p.max_element() > 0.1));
@@ -161,6 +216,7 @@ fn shadow_of_a_sphere_lands_where_geometry_predicts() {
         lights: vec![light],
         lights_indirect: false,
         shadows: true,
+        sh_transfer: ShTransfer::Baked,
     };
     // Looking straight down at the plane.
     let cam = Camera {
@@ -235,6 +291,7 @@ fn shadow_agrees_with_ray_casting(
         lights: vec![light],
         lights_indirect: false,
         shadows: true,
+        sh_transfer: ShTransfer::Baked,
     };
     let image = render(&gpu(), geometry, &transfer, cam, &lighting);
     if let Ok(path) = std::env::var("HPRT_DEBUG_PNG") {
@@ -469,6 +526,7 @@ fn a_source_with_a_halo_casts_its_wide_penumbra() {
             lights: vec![light],
             lights_indirect: false,
             shadows: true,
+            sh_transfer: ShTransfer::Baked,
         };
         // Texels of about 4 mm: the halo's penumbra (±0.1 m) spans some 25 of them, within
         // the filter's widest kernel.
@@ -712,6 +770,7 @@ fn vulkan_and_opengl_software_adapters_draw_the_same_image() {
         lights: vec![light],
         lights_indirect: true,
         shadows: true,
+        sh_transfer: ShTransfer::Baked,
     };
     let cam = camera(Vec3::new(3.0, 4.0, 6.0), Vec3::new(0.0, 0.5, 0.0), 96, 72);
     let images: Vec<RgbImageF32> = [Backend::Vulkan, Backend::Gl]
@@ -748,6 +807,7 @@ fn background_shows_the_map_filtered() {
             lights: Vec::new(),
             lights_indirect: false,
             shadows: false,
+            sh_transfer: ShTransfer::Baked,
         })
         .unwrap();
     renderer.background = true;

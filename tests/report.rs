@@ -184,7 +184,17 @@ fn report_measures_shadows_and_survives_bad_maps() {
         .iter()
         .map(|m| m["method"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["prt", "hybrid/thesis", "hybrid/consistent"]);
+    assert_eq!(
+        names,
+        [
+            "prt",
+            "hybrid/thesis",
+            "hybrid/consistent",
+            "median-cut/8",
+            "median-cut/32",
+            "sh-sun"
+        ]
+    );
     let mut shadow_errors = Vec::new();
     for m in methods {
         let name = m["method"].as_str().unwrap();

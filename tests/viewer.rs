@@ -36,7 +36,8 @@ fn smoke_test_under_xvfb() {
     std::fs::write(
         d.join("smoke.script"),
         "wait 2\norbit 60 -15\nzoom 1\npan 5 5\nset rotation 30\nwait 2\nscreenshot scene.png\n\
-         window-screenshot window.png\ncommand render.sh\nset animate on\nset speed 90\nwait 3\nstate state.json\nquit\n",
+         window-screenshot window.png\ncommand render.sh\nset mode median-cut\n\
+         set median_cut_lights 4\nwait 2\nscreenshot mc.png\ncommand mc.sh\nset mode hybrid\nset animate on\nset speed 90\nwait 3\nstate state.json\nquit\n",
     )
     .unwrap();
     let out = view_under_xvfb(
@@ -106,27 +107,41 @@ fn smoke_test_under_xvfb() {
         "animation turns the map"
     );
 
-    // The saved command line draws exactly the saved screenshot.
-    let line = std::fs::read_to_string(d.join("render.sh")).unwrap();
-    let args: Vec<String> = line
-        .split_whitespace()
-        .skip(1)
-        .map(|w| w.trim_matches('\'').to_owned())
-        .collect();
-    let rendered = hprt(d, &args.iter().map(String::as_str).collect::<Vec<_>>());
-    assert!(rendered.status.success(), "{}", stderr(&rendered));
-    let (rw, rh, again) = image_rgb(&d.join("render.png"));
-    assert_eq!((rw, rh), (w, h));
-    let worst = rgb
-        .iter()
-        .zip(&again)
-        .map(|(a, b)| a.abs_diff(*b))
-        .max()
-        .unwrap();
-    assert!(
-        worst <= 1,
-        "the command line reproduces the viewer's image (worst difference {worst})"
-    );
+    // The saved command lines draw exactly the saved screenshots: the hybrid's, and the
+    // median-cut peer's with its 4 lights.
+    for (script, screenshot) in [("render.sh", "scene.png"), ("mc.sh", "mc.png")] {
+        let line = std::fs::read_to_string(d.join(script)).unwrap();
+        let args: Vec<String> = line
+            .split_whitespace()
+            .skip(1)
+            .map(|w| w.trim_matches('\'').to_owned())
+            .collect();
+        let output = args[args.iter().position(|a| a == "-o").unwrap() + 1].clone();
+        let rendered = hprt(d, &args.iter().map(String::as_str).collect::<Vec<_>>());
+        assert!(rendered.status.success(), "{}", stderr(&rendered));
+        if script == "mc.sh" {
+            assert!(
+                stdout(&rendered).contains("4 light(s)"),
+                "{}",
+                stdout(&rendered)
+            );
+        }
+        let (_, _, shown) = image_rgb(&d.join(screenshot));
+        let (rw, rh, again) = image_rgb(&d.join(&output));
+        assert_eq!((rw, rh), (w, h));
+        let worst = shown
+            .iter()
+            .zip(&again)
+            .map(|(a, b)| a.abs_diff(*b))
+            .max()
+            .unwrap();
+        assert!(
+            worst <= 1,
+            "{script} reproduces the viewer's image (worst difference {worst})"
+        );
+    }
+    let (_, _, peer) = image_rgb(&d.join("mc.png"));
+    assert_ne!(peer, rgb, "median cut draws another image");
 }
 
 /// The viewer plays an environment sequence, tracking its lights.

@@ -6,6 +6,7 @@ pub mod cubemap;
 pub mod decompose;
 pub mod light;
 pub mod lighting;
+pub mod peers;
 pub mod render;
 pub mod sequence;
 pub mod tracking;
@@ -15,5 +16,5 @@ pub use decompose::{
     DecomposeError, DecomposeMode, DecomposeSettings, Decomposer, Decomposition, Window,
 };
 pub use light::DirectionalLight;
-pub use lighting::{EnvironmentLighting, FrameLighting, LitFrame, RenderMode};
+pub use lighting::{EnvironmentLighting, FrameLighting, LitFrame, RenderMode, ShTransfer};
 pub use tracking::{LightTracker, TrackedLight, TrackingSettings};

@@ -14,6 +14,8 @@ use crate::decompose::{
     DecomposeError, DecomposeMode, DecomposeSettings, Decomposer, Decomposition,
 };
 use crate::light::DirectionalLight;
+use crate::peers::median_cut::{MedianCutError, analysis_map, median_cut};
+use crate::peers::sh_sun;
 use crate::tracking::{LightTracker, TrackedLight, TrackingSettings};
 use glam::{Mat3, Quat, Vec3};
 use precompute::Rgb;
@@ -36,6 +38,12 @@ precompute::named_enum! {
         Lights = "lights",
         /// Debug: the hybrid with the lights' shadows switched off.
         Unshadowed = "unshadowed",
+        /// Peer: median-cut lights alone (Debevec 2005), every one shadow-mapped
+        /// ([`crate::peers::median_cut`]).
+        MedianCut = "median-cut",
+        /// Peer: one shadowed light plus unshadowed order-3 SH irradiance
+        /// ([`crate::peers::sh_sun`]).
+        ShSun = "sh-sun",
     }
 }
 
@@ -44,6 +52,17 @@ impl RenderMode {
     pub fn uses_lights(self) -> bool {
         self != RenderMode::Prt
     }
+}
+
+/// Which per-vertex transfer the SH lighting goes through.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum ShTransfer {
+    /// The bake's (shadowed, interreflected).
+    #[default]
+    Baked,
+    /// Unshadowed diffuse transfer from the vertex normal, bands 0–2 (irradiance by the
+    /// normal, as engines apply SH without a bake).
+    Unshadowed,
 }
 
 /// Whether a mode's lights send their bounce light through the bake's indirect transfer unless
@@ -73,6 +92,8 @@ pub struct FrameLighting {
     pub lights_indirect: bool,
     /// Whether the lights cast shadows.
     pub shadows: bool,
+    /// The transfer the SH part goes through.
+    pub sh_transfer: ShTransfer,
 }
 
 impl FrameLighting {
@@ -83,11 +104,25 @@ impl FrameLighting {
             lights: Vec::new(),
             lights_indirect: false,
             shadows: true,
+            sh_transfer: ShTransfer::Baked,
+        }
+    }
+
+    /// Lights alone, shadowed, without bounce light (median cut).
+    pub fn lights_only(order: usize, lights: Vec<DirectionalLight>) -> Self {
+        Self {
+            sh: ShCoeffs::zeros(order),
+            lights,
+            lights_indirect: false,
+            shadows: true,
+            sh_transfer: ShTransfer::Baked,
         }
     }
 
     /// The lighting of `mode`: `projection` is the plain SH projection of the whole map (for
-    /// `prt`), `decomposition` its split into SH part and lights (for the other modes).
+    /// `prt`), `decomposition` its split into SH part and lights (for the other modes; for
+    /// `sh-sun`, made with [`crate::peers::sh_sun::settings`]). Median cut makes its own lights
+    /// ([`EnvironmentLighting::frame`]).
     pub fn for_mode(
         mode: RenderMode,
         projection: &ShCoeffs<Rgb>,
@@ -101,13 +136,19 @@ impl FrameLighting {
                 lights: decomposition.lights.clone(),
                 lights_indirect,
                 shadows: mode == RenderMode::Hybrid,
+                sh_transfer: ShTransfer::Baked,
             },
             RenderMode::Lights => Self {
                 sh: ShCoeffs::zeros(decomposition.sh.order()),
                 lights: decomposition.lights.clone(),
                 lights_indirect,
                 shadows: true,
+                sh_transfer: ShTransfer::Baked,
             },
+            RenderMode::MedianCut => {
+                Self::lights_only(decomposition.sh.order(), decomposition.lights.clone())
+            }
+            RenderMode::ShSun => crate::peers::sh_sun::lighting(decomposition),
         }
     }
 
@@ -158,6 +199,12 @@ pub struct EnvironmentLighting {
     projection: Option<ShCoeffs<Rgb>>,
     /// The tracked lighting of the current map and orientation.
     tracked: Option<Decomposition>,
+    /// Lights of the median-cut peer.
+    median_cut_lights: usize,
+    /// The peers' lighting in the map's frame: median cut (its light count and lights) and
+    /// the "SH + sun" decomposition.
+    median_cut: Option<(usize, Vec<DirectionalLight>)>,
+    sh_sun: Option<Decomposition>,
 }
 
 impl EnvironmentLighting {
@@ -176,7 +223,51 @@ impl EnvironmentLighting {
             decomposition: None,
             projection: None,
             tracked: None,
+            median_cut_lights: 8,
+            median_cut: None,
+            sh_sun: None,
         })
+    }
+
+    /// Lights of the median-cut peer ([`RenderMode::MedianCut`]); a power of two.
+    pub fn set_median_cut_lights(&mut self, count: usize) -> Result<(), MedianCutError> {
+        if !count.is_power_of_two() {
+            return Err(MedianCutError::NotAPowerOfTwo(count));
+        }
+        self.median_cut_lights = count;
+        Ok(())
+    }
+
+    /// The median-cut lights of the map at the current orientation, and the time they took
+    /// (0 when cached). Cut on the map averaged to 256 texels wide, in its own frame.
+    pub fn median_cut(&mut self) -> Vec<DirectionalLight> {
+        let count = self.median_cut_lights;
+        if self.median_cut.as_ref().map(|m| m.0) != Some(count) {
+            let lights = median_cut(&analysis_map(&self.map), count)
+                .expect("set_median_cut_lights keeps a power of two");
+            self.median_cut = Some((count, lights));
+        }
+        let (_, lights) = self.median_cut.as_ref().expect("cut above");
+        lights
+            .iter()
+            .map(|l| DirectionalLight {
+                direction: (self.orientation * l.direction).normalize(),
+                ..*l
+            })
+            .collect()
+    }
+
+    /// The "SH + sun" peer's decomposition at the current orientation.
+    pub fn sh_sun(&mut self) -> Decomposition {
+        if self.sh_sun.is_none() {
+            let mut decomposer = Decomposer::new(sh_sun::settings(self.settings.order))
+                .expect("the peer's settings are valid at any supported order");
+            let cube = self.cube.get_or_insert_with(|| self.source.cube(0.0));
+            let mut decomposition = decomposer.decompose(cube);
+            measure_sources(&self.map, &mut decomposition.lights);
+            self.sh_sun = Some(decomposition);
+        }
+        rotate_decomposition(self.sh_sun.as_ref().expect("made above"), self.orientation)
     }
 
     /// The map at full resolution, as given.
@@ -246,6 +337,8 @@ impl EnvironmentLighting {
         self.decomposition = None;
         self.projection = None;
         self.tracked = None;
+        self.median_cut = None;
+        self.sh_sun = None;
     }
 
     /// Rotates the map about +Y (degrees, counter-clockwise seen from above).
@@ -339,6 +432,22 @@ impl EnvironmentLighting {
     /// projection) when the map or settings changed, else only the rotation.
     pub fn frame(&mut self, mode: RenderMode, lights_indirect: Option<bool>) -> LitFrame {
         let start = Instant::now();
+        if mode == RenderMode::MedianCut {
+            let lights = self.median_cut();
+            return LitFrame {
+                lighting: FrameLighting::lights_only(self.settings.order, lights),
+                decomposition: None,
+                ms: start.elapsed().as_secs_f64() * 1e3,
+            };
+        }
+        if mode == RenderMode::ShSun {
+            let decomposition = self.sh_sun();
+            return LitFrame {
+                lighting: sh_sun::lighting(&decomposition),
+                decomposition: Some(decomposition),
+                ms: start.elapsed().as_secs_f64() * 1e3,
+            };
+        }
         if !mode.uses_lights() {
             let projection = self.project();
             return LitFrame {

@@ -96,6 +96,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             lighting
         }
     };
+    lighting.set_median_cut_lights(args.render.lights)?;
     let frame = lighting.frame(args.render.mode, args.render.lights_indirect());
     let gpu = GpuContext::headless(args.render.backend)?;
     println!("adapter: {}", gpu.description());

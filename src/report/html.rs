@@ -55,9 +55,22 @@ fn figure(html: &mut String, src: &str, caption: &str) {
 }
 
 /// The per-map rows of the Table 5.1-style summary; the lowest error of each statistic bold.
+/// Each method's place (1: lowest) by mean error among `methods`; ties share a place.
+fn ranks_by_mean(methods: &[MethodResult]) -> Vec<usize> {
+    methods
+        .iter()
+        .map(|m| {
+            1 + methods
+                .iter()
+                .filter(|other| other.stats.mean < m.stats.mean)
+                .count()
+        })
+        .collect()
+}
+
 fn summary_table(html: &mut String, maps: &[&MapReport]) {
     html.push_str(
-        "<table><tr><th>map</th><th>method</th><th>mean ± std</th><th>shadow mean ± std</th>\
+        "<table><tr><th>map</th><th>method</th><th>rank</th><th>mean ± std</th><th>shadow mean ± std</th>\
          <th>penumbra mean ± std</th><th>relative RMSE</th><th>lights</th><th>decomposition (ms)</th><th>frame (ms)</th></tr>",
     );
     for map in maps {
@@ -76,6 +89,7 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
             let class = if value == best { " class=\"best\"" } else { "" };
             format!("<td{class}>{text}</td>")
         };
+        let ranks = ranks_by_mean(&map.methods);
         for (k, m) in map.methods.iter().enumerate() {
             let s = &m.stats;
             let name = if k == 0 {
@@ -89,8 +103,9 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
             };
             let _ = write!(
                 html,
-                "<tr>{name}<td class=\"name\">{}</td>{}{}{}{}<td>{}</td><td>{:.2}</td><td>{:.1}</td></tr>",
+                "<tr>{name}<td class=\"name\">{}</td><td>{}</td>{}{}{}{}<td>{}</td><td>{:.2}</td><td>{:.1}</td></tr>",
                 escape(&m.method),
+                ranks[k],
                 cell(s.mean, best_mean, mean_std(s.mean, s.std)),
                 cell(
                     s.shadow_mean,
@@ -264,6 +279,7 @@ pub fn page(report: &Report, out: &Path) -> anyhow::Result<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::report::stats::ErrorStats;
 
     #[test]
     fn escapes_markup() {
@@ -271,6 +287,22 @@ mod tests {
             escape("<a href=\"x\">&</a>"),
             "&lt;a href=&quot;x&quot;&gt;&amp;&lt;/a&gt;"
         );
+    }
+
+    #[test]
+    fn methods_rank_by_mean_error_with_ties_sharing_a_place() {
+        let result = |mean| MethodResult {
+            method: String::new(),
+            stats: ErrorStats {
+                mean,
+                ..ErrorStats::default()
+            },
+            lights: 0,
+            decomposition_ms: 0.0,
+            frame_ms: 0.0,
+        };
+        let methods = [result(0.3), result(0.1), result(0.2), result(0.1)];
+        assert_eq!(ranks_by_mean(&methods), [4, 1, 3, 1]);
     }
 
     #[test]

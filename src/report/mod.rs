@@ -69,13 +69,22 @@ pub enum Method {
     Prt,
     /// SH part + shadow-mapped lights, from a decomposition in the given mode.
     Hybrid(DecomposeMode),
+    /// Peer: 8 median-cut lights, shadow-mapped, nothing else.
+    MedianCut8,
+    /// Peer: 32 median-cut lights.
+    MedianCut32,
+    /// Peer: one shadowed light plus unshadowed order-3 SH irradiance.
+    ShSun,
 }
 
 impl Method {
-    pub const ALL: [Method; 3] = [
+    pub const ALL: [Method; 6] = [
         Method::Prt,
         Method::Hybrid(DecomposeMode::Thesis),
         Method::Hybrid(DecomposeMode::Consistent),
+        Method::MedianCut8,
+        Method::MedianCut32,
+        Method::ShSun,
     ];
 
     pub fn name(self) -> &'static str {
@@ -83,6 +92,9 @@ impl Method {
             Method::Prt => "prt",
             Method::Hybrid(DecomposeMode::Thesis) => "hybrid/thesis",
             Method::Hybrid(DecomposeMode::Consistent) => "hybrid/consistent",
+            Method::MedianCut8 => "median-cut/8",
+            Method::MedianCut32 => "median-cut/32",
+            Method::ShSun => "sh-sun",
         }
     }
 
@@ -92,7 +104,15 @@ impl Method {
             Method::Prt => "prt",
             Method::Hybrid(DecomposeMode::Thesis) => "hybrid-thesis",
             Method::Hybrid(DecomposeMode::Consistent) => "hybrid-consistent",
+            Method::MedianCut8 => "median-cut-8",
+            Method::MedianCut32 => "median-cut-32",
+            Method::ShSun => "sh-sun",
         }
+    }
+
+    /// Whether the method depends on the Weber threshold (the sweep's methods).
+    pub fn is_hybrid(self) -> bool {
+        matches!(self, Method::Hybrid(_))
     }
 }
 
@@ -293,6 +313,17 @@ fn method_lighting(
     let (mode, render_mode) = match method {
         Method::Prt => (DecomposeMode::Consistent, RenderMode::Prt),
         Method::Hybrid(mode) => (mode, RenderMode::Hybrid),
+        Method::MedianCut8 | Method::MedianCut32 | Method::ShSun => {
+            let (mode, count) = match method {
+                Method::MedianCut8 => (RenderMode::MedianCut, 8),
+                Method::MedianCut32 => (RenderMode::MedianCut, 32),
+                _ => (RenderMode::ShSun, 1),
+            };
+            lighting.set_median_cut_lights(count)?;
+            let frame = lighting.frame(mode, None);
+            let lights = frame.lighting.lights.len();
+            return Ok((frame.lighting, lights, frame.ms));
+        }
     };
     lighting.set_settings(DecomposeSettings {
         threshold,
@@ -398,7 +429,7 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
     // Error against the Weber threshold, for both hybrid modes.
     let mut sweep = Vec::new();
     let mut curves = Vec::new();
-    for method in &Method::ALL[1..] {
+    for method in Method::ALL.iter().filter(|m| m.is_hybrid()) {
         let mut points = Vec::new();
         for &threshold in &job.settings.thresholds {
             let (frame, lights, _) = method_lighting(&mut lighting, order, *method, threshold)?;

@@ -12,7 +12,7 @@ pub const SHADOW_VISIBILITY: f32 = 0.5;
 pub const PENUMBRA_VISIBILITY: (f32, f32) = (0.05, 0.95);
 
 /// The statistics of one image.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ErrorStats {
     /// Mean and standard deviation of the tone-mapped luminance error over covered pixels.
     pub mean: f64,

@@ -220,6 +220,7 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         order,
         shadow: ShadowSettings::default(),
         lights_indirect: lights_indirect_default(decompose_mode),
+        median_cut_lights: 8,
         exposure: 1.0,
     };
     let event_loop = EventLoop::new().map_err(|e| {
@@ -386,6 +387,7 @@ impl App {
                     || previous.decompose_settings() != self.settings.decompose_settings()
                     || previous.mode != self.settings.mode
                     || previous.lights_indirect != self.settings.lights_indirect
+                    || previous.median_cut_lights != self.settings.median_cut_lights
                     || previous.env != self.settings.env
             }
             None => true,
@@ -395,6 +397,7 @@ impl App {
         }
         env.set_settings(self.settings.decompose_settings())?;
         env.set_rotation(self.settings.rotation_deg);
+        env.set_median_cut_lights(self.settings.median_cut_lights)?;
         let frame = env.frame(self.settings.mode, Some(self.settings.lights_indirect));
         // The panel shows the lights in every mode, plain PRT included.
         let decomposition = match frame.decomposition {

@@ -20,6 +20,8 @@ pub struct ViewSettings {
     pub order: usize,
     pub shadow: ShadowSettings,
     pub lights_indirect: bool,
+    /// Lights of the median-cut peer (a power of two).
+    pub median_cut_lights: usize,
     pub exposure: f32,
 }
 
@@ -60,6 +62,10 @@ impl ViewSettings {
             "pcf" => self.shadow.pcf_taps = number()? as u32,
             "pcf_from_radius" => self.shadow.from_angular_radius = switch()?,
             "lights_indirect" => self.lights_indirect = switch()?,
+            "median_cut_lights" => {
+                self.median_cut_lights = crate::cli::parse_median_cut_lights(value)
+                    .map_err(|m| anyhow::anyhow!("{name}: {m}"))?
+            }
             "exposure" => self.exposure = number()?,
             "env" => self.env = PathBuf::from(value),
             _ => anyhow::bail!("unknown setting {name:?}"),
@@ -102,6 +108,8 @@ impl ViewSettings {
             on_off(self.shadow.from_angular_radius),
             "--lights-indirect".into(),
             on_off(self.lights_indirect),
+            "--lights".into(),
+            self.median_cut_lights.to_string(),
             format!("--camera-position={}", v(camera.position)),
             format!("--camera-target={}", v(camera.target)),
             "--fov".into(),
@@ -147,6 +155,7 @@ mod tests {
             order: 5,
             shadow: ShadowSettings::default(),
             lights_indirect: true,
+            median_cut_lights: 8,
             exposure: 0.6,
         }
     }

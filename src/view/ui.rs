@@ -302,6 +302,15 @@ impl Panel<'_> {
                 ui.radio_value(&mut self.settings.mode, mode, mode.name());
             }
         });
+        if self.settings.mode == RenderMode::MedianCut {
+            egui::ComboBox::from_label("median-cut lights")
+                .selected_text(self.settings.median_cut_lights.to_string())
+                .show_ui(ui, |ui| {
+                    for n in [1, 2, 4, 8, 16, 32] {
+                        ui.selectable_value(&mut self.settings.median_cut_lights, n, n.to_string());
+                    }
+                });
+        }
         ui.add(
             egui::Slider::new(&mut self.settings.exposure, 0.01..=100.0)
                 .logarithmic(true)

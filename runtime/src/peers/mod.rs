@@ -1,0 +1,6 @@
+//! The methods a user would weigh against the hybrid, as lighting configurations of the same
+//! renderer (its shadow-map and light passes): [`median_cut`] lights alone, and
+//! [`sh_sun`], one shadowed light plus unshadowed low-order SH irradiance.
+
+pub mod median_cut;
+pub mod sh_sun;

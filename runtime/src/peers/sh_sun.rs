@@ -1,0 +1,135 @@
+//! "SH + one sun", common game-engine practice: the strongest source of the map becomes one
+//! shadow-mapped light carrying its cap's energy, and the rest is order-3 SH irradiance
+//! (bands 0–2) applied by the surface normal, unshadowed: no transfer, no interreflection.
+//!
+//! The light and the remainder come from the consistent decomposition limited to one light
+//! (the brightest peak, whatever its Weber ratio), so the light's power and the SH part add up
+//! to the map; the SH part is then cut to order 3.
+
+use crate::decompose::{DecomposeMode, DecomposeSettings, Decomposition};
+use crate::lighting::{FrameLighting, ShTransfer};
+use glam::Vec3;
+use precompute::Rgb;
+use precompute::sh::{ShBasis, clamped_cosine_bands};
+use std::f32::consts::PI;
+
+/// Order of the SH irradiance (bands 0–2).
+pub const SH_ORDER: usize = 3;
+
+/// The decomposition that finds the sun: consistent mode, one light, no Weber cut-off.
+pub fn settings(order: usize) -> DecomposeSettings {
+    DecomposeSettings {
+        max_lights: 1,
+        threshold: 0.0,
+        ..DecomposeSettings::for_mode(DecomposeMode::Consistent, order)
+    }
+}
+
+/// The frame's lighting from a decomposition made with [`settings`].
+pub fn lighting(decomposition: &Decomposition) -> FrameLighting {
+    FrameLighting {
+        sh: decomposition.sh.with_order(SH_ORDER),
+        lights: decomposition.lights.iter().take(1).copied().collect(),
+        lights_indirect: false,
+        shadows: true,
+        sh_transfer: ShTransfer::Unshadowed,
+    }
+}
+
+/// Unshadowed diffuse transfer of bands 0–2 per vertex, laid out `[vertex][channel][k]` with
+/// `k < 9`: `t_k = ρ/π · A_l · Y_k(n)`, so that `dot(t, L)` is `ρ/π` times the irradiance of
+/// the SH lighting `L` on a surface of normal `n` with nothing around it.
+pub fn unshadowed_transfer(normals: &[Vec3], albedo: &[Rgb]) -> Vec<f32> {
+    let basis = ShBasis::new(SH_ORDER).expect("order 3 is supported");
+    let bands = clamped_cosine_bands(SH_ORDER);
+    let n = basis.num_coeffs();
+    let mut y = vec![0.0; n];
+    let mut out = Vec::with_capacity(normals.len() * 3 * n);
+    for (normal, rho) in normals.iter().zip(albedo) {
+        basis.eval(*normal, &mut y);
+        for c in 0..3 {
+            let scale = rho[c] / PI;
+            out.extend((0..n).map(|k| scale * bands[band_of(k)] * y[k]));
+        }
+    }
+    out
+}
+
+/// The band `l` of SH index `k = l(l+1) + m`.
+fn band_of(k: usize) -> usize {
+    (k as f32).sqrt() as usize
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use precompute::envmap::EnvMap;
+    use precompute::luminance;
+
+    /// Under a sky `L(ω) = 1 + ω_y` (exactly bands 0 and 1), a surface of normal n receives
+    /// `E(n) = π + (2π/3) n_y`; the transfer gives ρ/π of that.
+    /// A 2° sun over a sky: the one light sits on the sun, carries its power, turns with the
+    /// map, and the rest is order-3 SH through the unshadowed transfer, adding up to the map.
+    #[test]
+    fn the_light_is_on_the_disc_and_carries_it() {
+        use crate::lighting::{EnvironmentLighting, RenderMode};
+        let sun = Vec3::new(-0.4, 0.7, 0.5).normalize();
+        let radius = 2f32.to_radians();
+        let (sky, disc) = (0.4, 300.0);
+        let map = EnvMap::from_fn(512, 256, 4, |w| {
+            Rgb::splat(if w.dot(sun) >= radius.cos() {
+                disc
+            } else {
+                sky * (1.2 + w.y)
+            })
+        });
+        let mut lighting = EnvironmentLighting::new(&map, DecomposeSettings::default()).unwrap();
+        let frame = lighting.frame(RenderMode::ShSun, None).lighting;
+        assert_eq!(frame.lights.len(), 1);
+        assert_eq!(frame.sh.order(), SH_ORDER);
+        assert_eq!(frame.sh_transfer, ShTransfer::Unshadowed);
+        assert!(!frame.lights_indirect);
+        let light = frame.lights[0];
+        assert!(light.direction.angle_between(sun) < 0.5f32.to_radians());
+        let sun_power = (disc - sky * (1.2 + sun.y)) * 2.0 * PI * (1.0 - radius.cos());
+        let power = luminance(light.power);
+        assert!(
+            (power - sun_power).abs() < 0.05 * sun_power,
+            "{power} vs {sun_power}"
+        );
+        lighting.set_rotation(90.0);
+        let turned = lighting.frame(RenderMode::ShSun, None).lighting.lights[0];
+        let expected = glam::Quat::from_rotation_y(90f32.to_radians()) * sun;
+        assert!(turned.direction.angle_between(expected) < 0.5f32.to_radians());
+    }
+
+    #[test]
+    fn unshadowed_transfer_gives_the_irradiance_by_the_normal() {
+        let map = EnvMap::from_fn(256, 128, 2, |w| Rgb::splat(1.0 + w.y));
+        let sh = map.sh_projection(SH_ORDER);
+        let normals = [
+            Vec3::Y,
+            Vec3::NEG_Y,
+            Vec3::X,
+            Vec3::new(0.3, 0.5, -0.8).normalize(),
+        ];
+        let albedo = [Rgb::new(0.5, 0.25, 1.0); 4];
+        let t = unshadowed_transfer(&normals, &albedo);
+        for (v, normal) in normals.iter().enumerate() {
+            let expected = PI + 2.0 * PI / 3.0 * normal.y;
+            for c in 0..3 {
+                let row = &t[(v * 3 + c) * 9..(v * 3 + c + 1) * 9];
+                let radiance: f32 = row.iter().zip(sh.as_slice()).map(|(t, l)| t * l[c]).sum();
+                let want = albedo[v][c] / PI * expected;
+                assert!(
+                    (radiance - want).abs() < 2e-3 * want.max(0.1),
+                    "{normal} {c}: {radiance} vs {want}"
+                );
+            }
+        }
+        assert_eq!(
+            (0..9).map(band_of).collect::<Vec<_>>(),
+            [0, 1, 1, 1, 2, 2, 2, 2, 2]
+        );
+    }
+}
