@@ -204,7 +204,12 @@ pub struct EnvironmentLighting {
     /// The peers' lighting in the map's frame: median cut (its light count and lights) and
     /// the "SH + sun" decomposition.
     median_cut: Option<(usize, Vec<DirectionalLight>)>,
+    /// The map averaged down for median cut (made on first use, once per map).
+    median_cut_map: Option<EnvMap>,
     sh_sun: Option<Decomposition>,
+    /// The "SH + sun" decomposer (made on first use, kept across maps while the settings it
+    /// follows stay).
+    sh_sun_decomposer: Option<Decomposer>,
 }
 
 impl EnvironmentLighting {
@@ -225,7 +230,9 @@ impl EnvironmentLighting {
             tracked: None,
             median_cut_lights: 8,
             median_cut: None,
+            median_cut_map: None,
             sh_sun: None,
+            sh_sun_decomposer: None,
         })
     }
 
@@ -238,13 +245,16 @@ impl EnvironmentLighting {
         Ok(())
     }
 
-    /// The median-cut lights of the map at the current orientation, and the time they took
-    /// (0 when cached). Cut on the map averaged to 256 texels wide, in its own frame.
+    /// The median-cut lights of the map at the current orientation, cut on the map averaged
+    /// to 256 texels wide, in its own frame.
     pub fn median_cut(&mut self) -> Vec<DirectionalLight> {
         let count = self.median_cut_lights;
         if self.median_cut.as_ref().map(|m| m.0) != Some(count) {
-            let lights = median_cut(&analysis_map(&self.map), count)
-                .expect("set_median_cut_lights keeps a power of two");
+            let map = self
+                .median_cut_map
+                .get_or_insert_with(|| analysis_map(&self.map));
+            let lights =
+                median_cut(map, count).expect("set_median_cut_lights keeps a power of two");
             self.median_cut = Some((count, lights));
         }
         let (_, lights) = self.median_cut.as_ref().expect("cut above");
@@ -257,17 +267,29 @@ impl EnvironmentLighting {
             .collect()
     }
 
+    /// The "SH + sun" decomposer for the current settings (made when they change).
+    fn sh_sun_decomposer(&mut self) -> Result<&mut Decomposer, DecomposeError> {
+        let settings = sh_sun::settings(&self.settings);
+        if self.sh_sun_decomposer.as_ref().map(|d| d.settings()) != Some(&settings) {
+            self.sh_sun_decomposer = Some(Decomposer::new(settings)?);
+        }
+        Ok(self.sh_sun_decomposer.as_mut().expect("made above"))
+    }
+
     /// The "SH + sun" peer's decomposition at the current orientation.
-    pub fn sh_sun(&mut self) -> Decomposition {
+    pub fn sh_sun(&mut self) -> Result<Decomposition, DecomposeError> {
         if self.sh_sun.is_none() {
-            let mut decomposer = Decomposer::new(sh_sun::settings(self.settings.order))
-                .expect("the peer's settings are valid at any supported order");
+            self.sh_sun_decomposer()?;
+            let decomposer = self.sh_sun_decomposer.as_mut().expect("made above");
             let cube = self.cube.get_or_insert_with(|| self.source.cube(0.0));
             let mut decomposition = decomposer.decompose(cube);
             measure_sources(&self.map, &mut decomposition.lights);
             self.sh_sun = Some(decomposition);
         }
-        rotate_decomposition(self.sh_sun.as_ref().expect("made above"), self.orientation)
+        Ok(rotate_decomposition(
+            self.sh_sun.as_ref().expect("made above"),
+            self.orientation,
+        ))
     }
 
     /// The map at full resolution, as given.
@@ -338,6 +360,7 @@ impl EnvironmentLighting {
         self.projection = None;
         self.tracked = None;
         self.median_cut = None;
+        self.median_cut_map = None;
         self.sh_sun = None;
     }
 
@@ -431,6 +454,11 @@ impl EnvironmentLighting {
     /// ([`lights_indirect_default`]). `ms` is what this call cost: a decomposition (or
     /// projection) when the map or settings changed, else only the rotation.
     pub fn frame(&mut self, mode: RenderMode, lights_indirect: Option<bool>) -> LitFrame {
+        if mode == RenderMode::ShSun {
+            // Setting up its decomposer (icosphere, bases) is not per-frame work, as for the
+            // hybrid's.
+            let _ = self.sh_sun_decomposer();
+        }
         let start = Instant::now();
         if mode == RenderMode::MedianCut {
             let lights = self.median_cut();
@@ -441,7 +469,10 @@ impl EnvironmentLighting {
             };
         }
         if mode == RenderMode::ShSun {
-            let decomposition = self.sh_sun();
+            // Its settings follow this lighting's, which were validated.
+            let decomposition = self
+                .sh_sun()
+                .expect("the peer's settings derive from valid settings");
             return LitFrame {
                 lighting: sh_sun::lighting(&decomposition),
                 decomposition: Some(decomposition),

@@ -16,12 +16,16 @@ use std::f32::consts::PI;
 /// Order of the SH irradiance (bands 0–2).
 pub const SH_ORDER: usize = 3;
 
-/// The decomposition that finds the sun: consistent mode, one light, no Weber cut-off.
-pub fn settings(order: usize) -> DecomposeSettings {
+/// The decomposition that finds the sun: consistent mode, one light, no Weber cut-off; the
+/// analysis (cube size, icosphere, smoothing) and order of `base`.
+pub fn settings(base: &DecomposeSettings) -> DecomposeSettings {
     DecomposeSettings {
         max_lights: 1,
         threshold: 0.0,
-        ..DecomposeSettings::for_mode(DecomposeMode::Consistent, order)
+        face_size: base.face_size,
+        ico_level: base.ico_level,
+        smoothing_deg: base.smoothing_deg,
+        ..DecomposeSettings::for_mode(DecomposeMode::Consistent, base.order)
     }
 }
 
