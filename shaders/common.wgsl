@@ -12,6 +12,9 @@ struct Frame {
     // PCF kernel: taps per side (odd).
     pcf_taps: u32,
     _pad: u32,
+    // Bit 2 of flags: the first pass shades by the normal with these (A_l L_k / π, RGB in
+    // xyz, bands 0–2) instead of the per-vertex radiance.
+    sh_irradiance: array<vec4<f32>, 9>,
 };
 
 struct Light {

@@ -54,13 +54,13 @@ impl RenderMode {
     }
 }
 
-/// Which per-vertex transfer the SH lighting goes through.
+/// How the SH lighting reaches the surfaces.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum ShTransfer {
     /// The bake's (shadowed, interreflected).
     #[default]
     Baked,
-    /// Unshadowed diffuse transfer from the vertex normal, bands 0–2 (irradiance by the
+    /// None: bands 0–2 applied per pixel by the normal, unshadowed (irradiance by the
     /// normal, as engines apply SH without a bake).
     Unshadowed,
 }

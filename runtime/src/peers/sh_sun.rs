@@ -1,6 +1,7 @@
 //! "SH + one sun", common game-engine practice: the strongest source of the map becomes one
 //! shadow-mapped light carrying its cap's energy, and the rest is order-3 SH irradiance
-//! (bands 0–2) applied by the surface normal, unshadowed: no transfer, no interreflection.
+//! (bands 0–2) applied per pixel by the surface normal, unshadowed: no transfer, no
+//! interreflection (`shaders/geometry.wgsl`).
 //!
 //! The light and the remainder come from the consistent decomposition limited to one light
 //! (the brightest peak, whatever its Weber ratio), so the light's power and the SH part add up
@@ -8,10 +9,6 @@
 
 use crate::decompose::{DecomposeMode, DecomposeSettings, Decomposition};
 use crate::lighting::{FrameLighting, ShTransfer};
-use glam::Vec3;
-use precompute::Rgb;
-use precompute::sh::{ShBasis, clamped_cosine_bands};
-use std::f32::consts::PI;
 
 /// Order of the SH irradiance (bands 0–2).
 pub const SH_ORDER: usize = 3;
@@ -40,40 +37,18 @@ pub fn lighting(decomposition: &Decomposition) -> FrameLighting {
     }
 }
 
-/// Unshadowed diffuse transfer of bands 0–2 per vertex, laid out `[vertex][channel][k]` with
-/// `k < 9`: `t_k = ρ/π · A_l · Y_k(n)`, so that `dot(t, L)` is `ρ/π` times the irradiance of
-/// the SH lighting `L` on a surface of normal `n` with nothing around it.
-pub fn unshadowed_transfer(normals: &[Vec3], albedo: &[Rgb]) -> Vec<f32> {
-    let basis = ShBasis::new(SH_ORDER).expect("order 3 is supported");
-    let bands = clamped_cosine_bands(SH_ORDER);
-    let n = basis.num_coeffs();
-    let mut y = vec![0.0; n];
-    let mut out = Vec::with_capacity(normals.len() * 3 * n);
-    for (normal, rho) in normals.iter().zip(albedo) {
-        basis.eval(*normal, &mut y);
-        for c in 0..3 {
-            let scale = rho[c] / PI;
-            out.extend((0..n).map(|k| scale * bands[band_of(k)] * y[k]));
-        }
-    }
-    out
-}
-
-/// The band `l` of SH index `k = l(l+1) + m`.
-fn band_of(k: usize) -> usize {
-    (k as f32).sqrt() as usize
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
     use precompute::envmap::EnvMap;
-    use precompute::luminance;
+    use precompute::{Rgb, luminance};
+    use std::f32::consts::PI;
 
     /// Under a sky `L(ω) = 1 + ω_y` (exactly bands 0 and 1), a surface of normal n receives
     /// `E(n) = π + (2π/3) n_y`; the transfer gives ρ/π of that.
     /// A 2° sun over a sky: the one light sits on the sun, carries its power, turns with the
-    /// map, and the rest is order-3 SH through the unshadowed transfer, adding up to the map.
+    /// map, and the rest is order-3 SH applied unshadowed, adding up to the map.
     #[test]
     fn the_light_is_on_the_disc_and_carries_it() {
         use crate::lighting::{EnvironmentLighting, RenderMode};
@@ -105,35 +80,5 @@ mod tests {
         let turned = lighting.frame(RenderMode::ShSun, None).lighting.lights[0];
         let expected = glam::Quat::from_rotation_y(90f32.to_radians()) * sun;
         assert!(turned.direction.angle_between(expected) < 0.5f32.to_radians());
-    }
-
-    #[test]
-    fn unshadowed_transfer_gives_the_irradiance_by_the_normal() {
-        let map = EnvMap::from_fn(256, 128, 2, |w| Rgb::splat(1.0 + w.y));
-        let sh = map.sh_projection(SH_ORDER);
-        let normals = [
-            Vec3::Y,
-            Vec3::NEG_Y,
-            Vec3::X,
-            Vec3::new(0.3, 0.5, -0.8).normalize(),
-        ];
-        let albedo = [Rgb::new(0.5, 0.25, 1.0); 4];
-        let t = unshadowed_transfer(&normals, &albedo);
-        for (v, normal) in normals.iter().enumerate() {
-            let expected = PI + 2.0 * PI / 3.0 * normal.y;
-            for c in 0..3 {
-                let row = &t[(v * 3 + c) * 9..(v * 3 + c + 1) * 9];
-                let radiance: f32 = row.iter().zip(sh.as_slice()).map(|(t, l)| t * l[c]).sum();
-                let want = albedo[v][c] / PI * expected;
-                assert!(
-                    (radiance - want).abs() < 2e-3 * want.max(0.1),
-                    "{normal} {c}: {radiance} vs {want}"
-                );
-            }
-        }
-        assert_eq!(
-            (0..9).map(band_of).collect::<Vec<_>>(),
-            [0, 1, 1, 1, 2, 2, 2, 2, 2]
-        );
     }
 }

@@ -4,12 +4,11 @@
 use super::RenderError;
 use super::shaders::{MAX_GPU_COEFFS, MAX_GPU_ORDER, Shader, TRANSFER_WORKGROUP};
 use crate::lighting::{FrameLighting, ShTransfer};
-use crate::peers::sh_sun::{self, unshadowed_transfer};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use precompute::bake::Transfer;
 use precompute::scene::SceneMesh;
-use precompute::sh::{ShCoeffs, num_coeffs};
+use precompute::sh::num_coeffs;
 use wgpu::util::DeviceExt;
 
 #[repr(C)]
@@ -44,8 +43,6 @@ pub struct GpuScene {
     lighting_buffer: wgpu::Buffer,
     transfer_pipeline: wgpu::ComputePipeline,
     transfer_bind_group: wgpu::BindGroup,
-    /// The same pass through the unshadowed transfer of bands 0–2 ([`ShTransfer::Unshadowed`]).
-    unshadowed_bind_group: wgpu::BindGroup,
 }
 
 pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
@@ -146,42 +143,28 @@ impl GpuScene {
             compilation_options: Default::default(),
             cache: None,
         });
-        let bind_group = |label, full: &wgpu::Buffer, indirect: &wgpu::Buffer| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(label),
-                layout: &transfer_pipeline.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: lighting_buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: full.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: indirect.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: radiance_buffer.as_entire_binding(),
-                    },
-                ],
-            })
-        };
-        let transfer_bind_group = bind_group("transfer", &full_buffer, &indirect_buffer);
-        // No bounce light goes through it: the same buffer stands in for the indirect part.
-        let unshadowed_buffer = init(
-            "unshadowed transfer",
-            bytemuck::cast_slice(&unshadowed_transfer(&mesh.normals, &geometry.albedo)),
-            wgpu::BufferUsages::STORAGE,
-        );
-        let unshadowed_bind_group = bind_group(
-            "unshadowed transfer",
-            &unshadowed_buffer,
-            &unshadowed_buffer,
-        );
+        let transfer_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("transfer"),
+            layout: &transfer_pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: lighting_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: full_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: indirect_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: radiance_buffer.as_entire_binding(),
+                },
+            ],
+        });
         Ok(Self {
             vertex_buffer,
             radiance_buffer,
@@ -193,7 +176,6 @@ impl GpuScene {
             lighting_buffer,
             transfer_pipeline,
             transfer_bind_group,
-            unshadowed_bind_group,
         })
     }
 
@@ -204,20 +186,16 @@ impl GpuScene {
         encoder: &mut wgpu::CommandEncoder,
         lighting: &FrameLighting,
     ) {
-        // The unshadowed transfer holds bands 0–2 only, and no bounce light.
-        let (order, bind_group) = match lighting.sh_transfer {
-            ShTransfer::Baked => (self.order, &self.transfer_bind_group),
-            ShTransfer::Unshadowed => (sh_sun::SH_ORDER, &self.unshadowed_bind_group),
-        };
-        let n = num_coeffs(order);
+        // Unshadowed SH is applied per pixel by the first pass (`shaders/geometry.wgsl`).
+        if lighting.sh_transfer == ShTransfer::Unshadowed {
+            return;
+        }
+        let n = num_coeffs(self.order);
         let mut uniform = LightingUniform::zeroed();
         uniform.vertex_count = self.vertex_count;
         uniform.coeff_count = n as u32;
-        let sh = lighting.sh.with_order(order);
-        let lights_sh = match lighting.sh_transfer {
-            ShTransfer::Baked => lighting.lights_sh(order),
-            ShTransfer::Unshadowed => ShCoeffs::zeros(order),
-        };
+        let sh = lighting.sh.with_order(self.order);
+        let lights_sh = lighting.lights_sh(self.order);
         for k in 0..n {
             uniform.sh[k] = sh.as_slice()[k].extend(0.0).to_array();
             uniform.lights_sh[k] = lights_sh.as_slice()[k].extend(0.0).to_array();
@@ -228,7 +206,7 @@ impl GpuScene {
             timestamp_writes: None,
         });
         pass.set_pipeline(&self.transfer_pipeline);
-        pass.set_bind_group(0, bind_group, &[]);
+        pass.set_bind_group(0, &self.transfer_bind_group, &[]);
         pass.dispatch_workgroups(self.vertex_count.div_ceil(TRANSFER_WORKGROUP), 1, 1);
     }
 

@@ -25,6 +25,7 @@ pub mod shadow_maps;
 pub mod targets;
 pub mod uniforms;
 
+use crate::lighting::ShTransfer;
 use environment::EnvironmentTexture;
 pub use gpu::{Backend, GpuContext, GpuError};
 use gpu_scene::GpuScene;
@@ -262,6 +263,7 @@ impl Renderer {
             light_count: lights.len(),
             background: self.background,
             pcf_taps: shadow.pcf_taps,
+            sh_per_pixel: (lighting.sh_transfer == ShTransfer::Unshadowed).then_some(&lighting.sh),
         });
         let fits: Vec<ShadowFit> = lights
             .iter()

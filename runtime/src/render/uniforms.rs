@@ -7,7 +7,9 @@ use super::shadow_maps::{BoundingSphere, ShadowFit};
 use crate::light::DirectionalLight;
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
+use precompute::Rgb;
 use precompute::camera::Camera;
+use precompute::sh::{ShCoeffs, clamped_cosine_bands};
 
 /// Matches `Frame` in `shaders/common.wgsl`.
 #[repr(C)]
@@ -21,6 +23,8 @@ pub struct FrameUniform {
     flags: u32,
     pcf_taps: u32,
     _pad: u32,
+    /// Per-pixel irradiance of bands 0–2 over π, `A_l L_k / π` (RGB in xyz), when flag bit 2.
+    sh_irradiance: [[f32; 4]; 9],
 }
 
 /// Matches `Light` in `shaders/common.wgsl`.
@@ -50,6 +54,9 @@ pub struct FrameParameters<'a> {
     pub light_count: usize,
     pub background: bool,
     pub pcf_taps: u32,
+    /// SH lighting (bands 0–2 used) applied per pixel by the normal, unshadowed, instead of
+    /// the per-vertex transfer ([`crate::lighting::ShTransfer::Unshadowed`]).
+    pub sh_per_pixel: Option<&'a ShCoeffs<Rgb>>,
 }
 
 /// World → clip space of `camera`, its depth range fitted to the scene's bounding sphere.
@@ -71,11 +78,24 @@ impl FrameUniform {
             viewport: [w, h, 1.0 / w, 1.0 / h],
             env_rotation: [cos, sin, 0.0, 0.0],
             light_count: p.light_count as u32,
-            flags: u32::from(p.background) << 1,
+            flags: (u32::from(p.background) << 1) | (u32::from(p.sh_per_pixel.is_some()) << 2),
             pcf_taps: p.pcf_taps,
             _pad: 0,
+            sh_irradiance: p.sh_per_pixel.map_or([[0.0; 4]; 9], irradiance_over_pi),
         }
     }
+}
+
+/// `A_l L_k / π` for k < 9: with the basis at the normal and the albedo, the unshadowed
+/// diffuse radiance `ρ/π E(n)`.
+fn irradiance_over_pi(sh: &ShCoeffs<Rgb>) -> [[f32; 4]; 9] {
+    let mut sh = sh.with_order(3);
+    sh.scale_bands(&clamped_cosine_bands(3));
+    let mut out = [[0.0; 4]; 9];
+    for (o, c) in out.iter_mut().zip(sh.as_slice()) {
+        *o = (*c / std::f32::consts::PI).extend(0.0).to_array();
+    }
+    out
 }
 
 /// Each light with its shadow map's placement (`fits[i]`) and filtering parameters.
