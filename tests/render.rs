@@ -230,13 +230,7 @@ fn shadow_of_a_sphere_lands_where_geometry_predicts() {
         core_fraction: 1.0,
         share: 1.0,
     };
-    let lighting = FrameLighting {
-        sh: ShCoeffs::zeros(2),
-        lights: vec![light],
-        lights_indirect: false,
-        shadows: true,
-        sh_transfer: ShTransfer::Baked,
-    };
+    let lighting = FrameLighting::lights_only(2, vec![light]);
     // Looking straight down at the plane.
     let cam = Camera {
         up: Vec3::NEG_Z,
@@ -305,13 +299,7 @@ fn shadow_agrees_with_ray_casting(
     umbra_margin: i32,
 ) -> (usize, usize) {
     let transfer = bake_of(geometry, 2, 16, 0);
-    let lighting = FrameLighting {
-        sh: ShCoeffs::zeros(2),
-        lights: vec![light],
-        lights_indirect: false,
-        shadows: true,
-        sh_transfer: ShTransfer::Baked,
-    };
+    let lighting = FrameLighting::lights_only(2, vec![light]);
     let image = render(&gpu(), geometry, &transfer, cam, &lighting);
     if let Ok(path) = std::env::var("HPRT_DEBUG_PNG") {
         precompute::image_io::write_png(std::path::Path::new(&path), &image, 1.0).unwrap();
@@ -540,13 +528,7 @@ fn a_source_with_a_halo_casts_its_wide_penumbra() {
     let lit_value = 0.5 / std::f32::consts::PI * 5.0 * direction.y;
     let gpu = gpu();
     let error_of = |light: DirectionalLight| {
-        let lighting = FrameLighting {
-            sh: ShCoeffs::zeros(2),
-            lights: vec![light],
-            lights_indirect: false,
-            shadows: true,
-            sh_transfer: ShTransfer::Baked,
-        };
+        let lighting = FrameLighting::lights_only(2, vec![light]);
         // Texels of about 4 mm: the halo's penumbra (±0.1 m) spans some 25 of them, within
         // the filter's widest kernel.
         let shadows = ShadowSettings {
