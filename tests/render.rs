@@ -156,6 +156,68 @@ fn unshadowed_sh_shades_each_pixel_by_its_normal() {
     );
 }
 
+/// The GPU's PRT pass against the CPU's `TransferVectors::radiance`, at every order the GPU
+/// supports, under lighting with every coefficient different: each pixel must show the
+/// transfer's radiance interpolated at its point (a coefficient read at the wrong index, a
+/// wrong channel or stride, shows at once).
+#[test]
+fn gpu_prt_matches_the_transfer_at_every_order() {
+    let geometry = sphere_on_plane();
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let cam = camera(Vec3::new(2.0, 4.0, 5.0), Vec3::new(0.0, 0.5, 0.0), 64, 64);
+    let basis = cam.basis();
+    let gpu = gpu();
+    for order in 1..=runtime::render::MAX_GPU_ORDER {
+        let transfer = bake_of(&geometry, order, 16, 1);
+        let full = transfer.full();
+        // A strong constant term keeps the radiance positive; the rest differ per index and
+        // channel.
+        let mut sh = ShCoeffs::zeros(order);
+        for (k, c) in sh.as_mut_slice().iter_mut().enumerate() {
+            let wave = |phase: f32| 0.4 * ((k as f32 * 1.7 + phase).sin());
+            *c = if k == 0 {
+                Rgb::new(3.0, 2.5, 2.0)
+            } else {
+                Rgb::new(wave(0.0), wave(1.0), wave(2.0))
+            };
+        }
+        let image = render(
+            &gpu,
+            &geometry,
+            &transfer,
+            &cam,
+            &FrameLighting::prt(sh.clone()),
+        );
+        let (mut covered, mut off) = (0, 0);
+        for j in 0..cam.height {
+            for i in 0..cam.width {
+                let ray = cam.pixel_direction(&basis, i, j);
+                let Some(hit) = bvh.intersect(cam.position, ray, 0.0, f32::MAX) else {
+                    continue;
+                };
+                let triangle = geometry.mesh.triangles[hit.triangle as usize];
+                let want: Rgb = triangle
+                    .iter()
+                    .zip(hit.barycentrics())
+                    .map(|(&v, w)| full.radiance(v as usize, &sh) * w)
+                    .sum();
+                let got = image.get(i as usize, j as usize);
+                covered += 1;
+                // Half-float target: a relative 1e-3; silhouette pixels may take the other
+                // object.
+                if (got - want).abs().max_element() > 5e-3 * want.max_element() + 1e-3 {
+                    off += 1;
+                }
+            }
+        }
+        assert!(covered > 2000, "order {order}: {covered} covered pixels");
+        assert!(
+            off * 100 < covered,
+            "order {order}: {off} of {covered} pixels differ from the transfer's radiance"
+        );
+    }
+}
+
 #[test]
 fn furnace_prt_surfaces_equal_their_albedo() {
     let albedo = Rgb::new(0.8, 0.5, 0.3);
