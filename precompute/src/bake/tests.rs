@@ -144,29 +144,45 @@ fn same_result_whatever_the_thread_count() {
     assert_eq!(in_pool(1), in_pool(3));
 }
 
+/// At the centre of the open box's floor, the sky is seen through the 2 × 2 opening 1 above:
+/// the unoccluded cosine-weighted solid angle is π F, with F the form factor of a square of
+/// half-side a at height h, `4 · (1/2π) · 2 · X/√(1+X²) · atan(X/√(1+X²))` for X = a/h = 1
+/// (0.5541). So the direct transfer's first coefficient is `ρ F Y₀`, whether the bake traces
+/// occlusion rays only (bounces = 0) or records hits for the bounces (bounces = 1).
 #[test]
-fn occlusion_only_and_hit_recording_paths_agree() {
-    // bounces = 0 traces occlusion rays only; its direct transfer must equal the direct part
-    // of a bake that records hits.
-    let geometry = scene_of(&open_box(), Rgb::splat(0.6));
-    let settings = BakeSettings {
-        order: 3,
-        samples: 64,
-        bounces: 0,
-        seed: 5,
-    };
-    let (a, _) = run(&geometry, settings);
-    let (b, _) = run(
-        &geometry,
-        BakeSettings {
-            bounces: 1,
-            ..settings
-        },
-    );
-    for (x, y) in a.direct.as_slice().iter().zip(b.direct.as_slice()) {
-        assert!((x - y).abs() < 1e-6);
+fn direct_transfer_under_an_opening_is_its_form_factor() {
+    let albedo = 0.6;
+    let geometry = scene_of(&open_box(), Rgb::splat(albedo));
+    let x: f64 = 1.0;
+    let root = (1.0 + x * x).sqrt();
+    let form_factor = 4.0 / std::f64::consts::PI * (x / root) * (x / root).atan();
+    let expected = albedo as f64 * form_factor / (4.0 * std::f64::consts::PI).sqrt();
+    // Every vertex at the floor's centre (the mesh does not share vertices between faces).
+    let centre: Vec<usize> = (0..geometry.mesh.vertex_count())
+        .filter(|&v| geometry.mesh.positions[v].length() < 1e-6)
+        .collect();
+    assert!(!centre.is_empty());
+    for bounces in [0, 1] {
+        let settings = BakeSettings {
+            order: 3,
+            samples: 4096,
+            bounces,
+            seed: 5,
+        };
+        let (transfer, _) = run(&geometry, settings);
+        let mean = centre
+            .iter()
+            .map(|&v| f64::from(transfer.direct.vector(v, 0)[0]))
+            .sum::<f64>()
+            / centre.len() as f64;
+        assert!(
+            (mean - expected).abs() < 0.005 * expected,
+            "bounces {bounces}: t₀ = {mean}, form factor gives {expected}"
+        );
+        if bounces == 0 {
+            assert!(transfer.indirect.as_slice().iter().all(|x| *x == 0.0));
+        }
     }
-    assert!(a.indirect.as_slice().iter().all(|x| *x == 0.0));
 }
 
 #[test]
