@@ -5,7 +5,7 @@ mod common;
 use common::*;
 use glam::Vec3;
 use precompute::bake::{BakeSettings, Transfer};
-use precompute::bvh::{SceneBvh, Skip};
+use precompute::bvh::{Hit, SceneBvh, Skip};
 use precompute::camera::Camera;
 use precompute::envmap::EnvMap;
 use precompute::image_io::{RgbImageF32, tonemap};
@@ -156,6 +156,44 @@ fn unshadowed_sh_shades_each_pixel_by_its_normal() {
     );
 }
 
+/// `f` at the vertices of the triangle `hit` found, interpolated at the hit point.
+fn interpolate(geometry: &SceneMesh, hit: &Hit, f: impl Fn(usize) -> Vec3) -> Vec3 {
+    geometry.mesh.triangles[hit.triangle as usize]
+        .iter()
+        .zip(hit.barycentrics())
+        .map(|(&v, w)| f(v as usize) * w)
+        .sum()
+}
+
+/// Each pixel of `image` that sees `geometry` (a ray through its centre) against `expected`
+/// at the ray's hit: (covered pixels, pixels off by more than the half-float target's
+/// precision, 0.5% + 1e-3; silhouette pixels may take the other object).
+fn compare_with_cpu(
+    image: &RgbImageF32,
+    geometry: &SceneMesh,
+    cam: &Camera,
+    expected: impl Fn(&Hit) -> Rgb,
+) -> (usize, usize) {
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let basis = cam.basis();
+    let (mut covered, mut off) = (0, 0);
+    for j in 0..cam.height {
+        for i in 0..cam.width {
+            let ray = cam.pixel_direction(&basis, i, j);
+            let Some(hit) = bvh.intersect(cam.position, ray, 0.0, f32::MAX) else {
+                continue;
+            };
+            let want = expected(&hit);
+            let got = image.get(i as usize, j as usize);
+            covered += 1;
+            if (got - want).abs().max_element() > 5e-3 * want.max_element() + 1e-3 {
+                off += 1;
+            }
+        }
+    }
+    (covered, off)
+}
+
 /// The GPU's PRT pass against the CPU's `TransferVectors::radiance`, at every order the GPU
 /// supports, under lighting with every coefficient different: each pixel must show the
 /// transfer's radiance interpolated at its point (a coefficient read at the wrong index, a
@@ -163,9 +201,7 @@ fn unshadowed_sh_shades_each_pixel_by_its_normal() {
 #[test]
 fn gpu_prt_matches_the_transfer_at_every_order() {
     let geometry = sphere_on_plane();
-    let bvh = SceneBvh::build(&geometry.mesh);
     let cam = camera(Vec3::new(2.0, 4.0, 5.0), Vec3::new(0.0, 0.5, 0.0), 64, 64);
-    let basis = cam.basis();
     let gpu = gpu();
     for order in 1..=runtime::render::MAX_GPU_ORDER {
         let transfer = bake_of(&geometry, order, 16, 1);
@@ -188,28 +224,9 @@ fn gpu_prt_matches_the_transfer_at_every_order() {
             &cam,
             &FrameLighting::prt(sh.clone()),
         );
-        let (mut covered, mut off) = (0, 0);
-        for j in 0..cam.height {
-            for i in 0..cam.width {
-                let ray = cam.pixel_direction(&basis, i, j);
-                let Some(hit) = bvh.intersect(cam.position, ray, 0.0, f32::MAX) else {
-                    continue;
-                };
-                let triangle = geometry.mesh.triangles[hit.triangle as usize];
-                let want: Rgb = triangle
-                    .iter()
-                    .zip(hit.barycentrics())
-                    .map(|(&v, w)| full.radiance(v as usize, &sh) * w)
-                    .sum();
-                let got = image.get(i as usize, j as usize);
-                covered += 1;
-                // Half-float target: a relative 1e-3; silhouette pixels may take the other
-                // object.
-                if (got - want).abs().max_element() > 5e-3 * want.max_element() + 1e-3 {
-                    off += 1;
-                }
-            }
-        }
+        let (covered, off) = compare_with_cpu(&image, &geometry, &cam, |hit| {
+            interpolate(&geometry, hit, |v| full.radiance(v, &sh))
+        });
         assert!(covered > 2000, "order {order}: {covered} covered pixels");
         assert!(
             off * 100 < covered,
@@ -281,44 +298,14 @@ fn unshadowed_hybrid_is_prt_plus_each_lights_lambert_term() {
     let full = transfer.full();
     let mut bounce = ShCoeffs::zeros(order);
     bounce.add_delta(light.direction, light.power);
-    let bvh = SceneBvh::build(&geometry.mesh);
-    let basis = cam.basis();
-    let (mut covered, mut off) = (0, 0);
-    for j in 0..cam.height {
-        for i in 0..cam.width {
-            let ray = cam.pixel_direction(&basis, i, j);
-            let Some(hit) = bvh.intersect(cam.position, ray, 0.0, f32::MAX) else {
-                continue;
-            };
-            let corners = geometry.mesh.triangles[hit.triangle as usize];
-            let weights = hit.barycentrics();
-            let at = |f: &dyn Fn(usize) -> Rgb| -> Rgb {
-                corners
-                    .iter()
-                    .zip(weights)
-                    .map(|(&v, w)| f(v as usize) * w)
-                    .sum()
-            };
-            let prt =
-                at(&|v| full.radiance(v, &lighting.sh) + transfer.indirect.radiance(v, &bounce));
-            let albedo = at(&|v| geometry.albedo[v]);
-            let normal = corners
-                .iter()
-                .zip(weights)
-                .map(|(&v, w)| geometry.mesh.normals[v as usize] * w)
-                .sum::<Vec3>()
-                .normalize();
-            let want = prt
-                + albedo / std::f32::consts::PI
-                    * light.power
-                    * normal.dot(light.direction).max(0.0);
-            let got = image.get(i as usize, j as usize);
-            covered += 1;
-            if (got - want).abs().max_element() > 5e-3 * want.max_element() + 1e-3 {
-                off += 1;
-            }
-        }
-    }
+    let (covered, off) = compare_with_cpu(&image, &geometry, &cam, |hit| {
+        let prt = interpolate(&geometry, hit, |v| {
+            full.radiance(v, &lighting.sh) + transfer.indirect.radiance(v, &bounce)
+        });
+        let albedo = interpolate(&geometry, hit, |v| geometry.albedo[v]);
+        let normal = interpolate(&geometry, hit, |v| geometry.mesh.normals[v]).normalize();
+        prt + albedo / std::f32::consts::PI * light.power * normal.dot(light.direction).max(0.0)
+    });
     assert!(covered > 1500, "{covered} covered pixels");
     assert!(
         off * 100 < covered,
