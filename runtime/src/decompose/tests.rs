@@ -64,12 +64,29 @@ fn decompose(map: &EnvMap, rotation: f32, settings: DecomposeSettings) -> Decomp
     Decomposer::new(settings).unwrap().decompose(&cube)
 }
 
+/// At the default 64-texel faces and at 128 and 256, which the decomposer averages down to its
+/// 64-texel analysis for the peak search while it measures the lights on the full cube.
 #[test]
 fn finds_each_source_with_its_direction_and_power() {
     let scene = three_suns();
     let map = scene.env_map();
-    let result = decompose(&map, 0.0, DecomposeSettings::default());
-    assert_eq!(result.lights.len(), 3, "{:?}", result.lights);
+    for face_size in [64, 128, 256] {
+        let settings = DecomposeSettings {
+            face_size,
+            ..DecomposeSettings::default()
+        };
+        let result = decompose(&map, 0.0, settings);
+        assert_finds_three_suns(&scene, &result, face_size);
+    }
+}
+
+fn assert_finds_three_suns(scene: &Synthetic, result: &Decomposition, face_size: usize) {
+    assert_eq!(
+        result.lights.len(),
+        3,
+        "face {face_size}: {:?}",
+        result.lights
+    );
     for (i, (centre, _, _)) in scene.discs.iter().enumerate() {
         let light = result
             .lights
@@ -81,12 +98,15 @@ fn finds_each_source_with_its_direction_and_power() {
             })
             .unwrap();
         let error = light.direction.angle_between(*centre).to_degrees();
-        assert!(error < 1.0, "source {i}: direction off by {error}°");
+        assert!(
+            error < 1.0,
+            "face {face_size}, source {i}: direction off by {error}°"
+        );
         let expected = scene.disc_power(i);
         let relative = ((light.power - expected) / expected).abs().max_element();
         assert!(
             relative < 0.05,
-            "source {i}: power {} vs {expected}",
+            "face {face_size}, source {i}: power {} vs {expected}",
             light.power
         );
     }
