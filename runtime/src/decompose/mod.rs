@@ -217,6 +217,8 @@ pub struct Decomposer {
     settings: DecomposeSettings,
     /// The input maps' geometry.
     geometry: CubeGeometry,
+    /// The analysis cube's geometry (smoothing, peak search, projection).
+    analysis: CubeGeometry,
     /// For each analysis texel, the input texels it averages (empty when not downsampling).
     downsample: Vec<(Vec<u32>, Vec<f32>)>,
     analysis_map: CubeMap,
@@ -274,6 +276,7 @@ impl Decomposer {
             sh_window: settings.sh_window().factors(settings.order),
             settings,
             geometry,
+            analysis,
             ico,
             smoothing,
             projector,
@@ -406,16 +409,22 @@ impl Decomposer {
             .collect();
         maxima.sort_by(|a, b| residual[*b as usize].total_cmp(&residual[*a as usize]));
         maxima.truncate(MAX_CANDIDATES);
+        let sigma = self.settings.smoothing_deg.to_radians();
         let mut peaks: Vec<Peak> = maxima
             .into_iter()
             .map(|v| {
-                let (direction, value) =
-                    peaks::refine_peak(&self.ico, &residual, v, &mut self.ring);
-                let at_vertex = residual[v as usize];
+                let (direction, _) = peaks::refine_peak(&self.ico, &residual, v, &mut self.ring);
+                // λ − P(Ξ) at the refined direction itself: the map smoothed there (one more
+                // kernel) minus the SH part. The fitted quadric's apex would overshoot a
+                // flat-topped peak (a source wider than the kernel) by tens of percent.
+                let mut smoothed = Vec::with_capacity(1);
+                GaussianSmoothing::new(&self.analysis, &[direction], sigma)
+                    .apply(analysis, &mut smoothed);
+                let rgb = smoothed[0] - detection.eval(direction);
                 Peak {
                     direction,
-                    value,
-                    rgb: residual_rgb[v as usize] * (value / at_vertex),
+                    value: luminance(rgb),
+                    rgb,
                 }
             })
             .collect();

@@ -135,6 +135,64 @@ fn consistent_mode_conserves_energy_and_irradiance() {
     assert!(worst < 0.03, "irradiance error {worst}");
 }
 
+/// The thesis' light power `2π(1 − cos R)(λ − P(Ξ))` against a hand computation: an 8° disc
+/// of excess D over a uniform background B, centred on an icosahedron vertex. The 2° Gaussian
+/// (cut at 6°) sees only the disc there, so λ = B + D; the Hanning-windowed order-5 SH part of
+/// the disc is zonal, so at its centre `P = B + D Σ_l w_l (2l+1)/2 ∫_{cos 8°}^1 P_l(x) dx`.
+#[test]
+fn thesis_light_power_matches_a_hand_computation() {
+    let settings = DecomposeSettings::for_mode(DecomposeMode::Thesis, 5);
+    let decomposer = Decomposer::new(settings.clone()).unwrap();
+    let centre = decomposer.icosphere().vertices[37];
+    let disc_radius = 8f32.to_radians();
+    let (background, excess) = (Rgb::new(1.0, 1.2, 1.5), Rgb::new(50.0, 40.0, 30.0));
+    let map = EnvMap::from_fn(2048, 1024, 2, |w| {
+        if w.angle_between(centre) < disc_radius {
+            background + excess
+        } else {
+            background
+        }
+    });
+    let result = decompose(&map, 0.0, settings.clone());
+    let light = result
+        .lights
+        .iter()
+        .find(|l| l.direction.angle_between(centre) < 1f32.to_radians())
+        .expect("a light on the disc");
+    // Legendre polynomials P_0..P_5 at x, by the three-term recurrence.
+    let legendre = |x: f64| {
+        let mut p = vec![1.0, x];
+        for l in 1..5 {
+            let next = ((2 * l + 1) as f64 * x * p[l] - l as f64 * p[l - 1]) / (l + 1) as f64;
+            p.push(next);
+        }
+        p
+    };
+    let x = f64::from(disc_radius).cos();
+    let p = legendre(x);
+    let windows = Window::Hanning.factors(5);
+    // ∫_x^1 P_l = (P_{l−1}(x) − P_{l+1}(x)) / (2l+1) for l ≥ 1, 1 − x for l = 0.
+    let fraction: f64 = (0..5)
+        .map(|l| {
+            let integral = if l == 0 {
+                1.0 - x
+            } else {
+                (p[l - 1] - p[l + 1]) / (2 * l + 1) as f64
+            };
+            f64::from(windows[l]) * (2 * l + 1) as f64 / 2.0 * integral
+        })
+        .sum();
+    let cap = 2.0 * PI * (1.0 - settings.radius_deg.to_radians().cos());
+    // λ − P = (B + D) − (B + D · fraction).
+    let expected = excess * ((1.0 - fraction) as f32 * cap);
+    let relative = ((light.power - expected) / expected).abs().max_element();
+    assert!(
+        relative < 0.02,
+        "power {} vs {expected} (SH part holds {fraction:.4} of the disc at its centre)",
+        light.power
+    );
+}
+
 #[test]
 fn thesis_mode_uses_the_thesis_power_formula() {
     let map = three_suns().env_map();
