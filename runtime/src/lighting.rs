@@ -120,9 +120,9 @@ impl FrameLighting {
     }
 
     /// The lighting of `mode`: `projection` is the plain SH projection of the whole map (for
-    /// `prt`), `decomposition` its split into SH part and lights (for the other modes; for
-    /// `sh-sun`, made with [`crate::peers::sh_sun::settings`]). Median cut makes its own lights
-    /// ([`EnvironmentLighting::frame`]).
+    /// `prt`), `decomposition` its split into SH part and lights for the other modes: the
+    /// decomposer's, or the peers' own ([`EnvironmentLighting::median_cut`],
+    /// [`EnvironmentLighting::sh_sun`]).
     pub fn for_mode(
         mode: RenderMode,
         projection: &ShCoeffs<Rgb>,
@@ -201,9 +201,9 @@ pub struct EnvironmentLighting {
     tracked: Option<Decomposition>,
     /// Lights of the median-cut peer.
     median_cut_lights: usize,
-    /// The peers' lighting in the map's frame: median cut (its light count and lights) and
-    /// the "SH + sun" decomposition.
-    median_cut: Option<(usize, Vec<DirectionalLight>)>,
+    /// The peers' lighting in the map's frame: median cut (its light count, and its lights
+    /// as a decomposition without SH part) and the "SH + sun" decomposition.
+    median_cut: Option<(usize, Decomposition)>,
     /// The map averaged down for median cut (made on first use, once per map).
     median_cut_map: Option<EnvMap>,
     sh_sun: Option<Decomposition>,
@@ -245,9 +245,9 @@ impl EnvironmentLighting {
         Ok(())
     }
 
-    /// The median-cut lights of the map at the current orientation, cut on the map averaged
-    /// to 256 texels wide, in its own frame.
-    pub fn median_cut(&mut self) -> Vec<DirectionalLight> {
+    /// The median-cut lights of the map at the current orientation (cut on the map averaged
+    /// to 256 texels wide, in its own frame), as a decomposition with no SH part.
+    pub fn median_cut(&mut self) -> Decomposition {
         let count = self.median_cut_lights;
         if self.median_cut.as_ref().map(|m| m.0) != Some(count) {
             let map = self
@@ -255,16 +255,16 @@ impl EnvironmentLighting {
                 .get_or_insert_with(|| analysis_map(&self.map));
             let lights =
                 median_cut(map, count).expect("set_median_cut_lights keeps a power of two");
-            self.median_cut = Some((count, lights));
+            let decomposition = Decomposition {
+                sh: ShCoeffs::zeros(self.settings.order),
+                candidates: lights.len(),
+                lights,
+                total_power: map.total_power(),
+            };
+            self.median_cut = Some((count, decomposition));
         }
-        let (_, lights) = self.median_cut.as_ref().expect("cut above");
-        lights
-            .iter()
-            .map(|l| DirectionalLight {
-                direction: (self.orientation * l.direction).normalize(),
-                ..*l
-            })
-            .collect()
+        let (_, base) = self.median_cut.as_ref().expect("cut above");
+        rotate_decomposition(base, self.orientation)
     }
 
     /// The "SH + sun" decomposer for the current settings (made when they change).
@@ -460,25 +460,6 @@ impl EnvironmentLighting {
             let _ = self.sh_sun_decomposer();
         }
         let start = Instant::now();
-        if mode == RenderMode::MedianCut {
-            let lights = self.median_cut();
-            return LitFrame {
-                lighting: FrameLighting::lights_only(self.settings.order, lights),
-                decomposition: None,
-                ms: start.elapsed().as_secs_f64() * 1e3,
-            };
-        }
-        if mode == RenderMode::ShSun {
-            // Its settings follow this lighting's, which were validated.
-            let decomposition = self
-                .sh_sun()
-                .expect("the peer's settings derive from valid settings");
-            return LitFrame {
-                lighting: sh_sun::lighting(&decomposition),
-                decomposition: Some(decomposition),
-                ms: start.elapsed().as_secs_f64() * 1e3,
-            };
-        }
         if !mode.uses_lights() {
             let projection = self.project();
             return LitFrame {
@@ -487,7 +468,14 @@ impl EnvironmentLighting {
                 ms: start.elapsed().as_secs_f64() * 1e3,
             };
         }
-        let decomposition = self.decompose();
+        let decomposition = match mode {
+            RenderMode::MedianCut => self.median_cut(),
+            // Its settings follow this lighting's, which were validated.
+            RenderMode::ShSun => self
+                .sh_sun()
+                .expect("the peer's settings derive from valid settings"),
+            _ => self.decompose(),
+        };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         let indirect =
             lights_indirect.unwrap_or_else(|| lights_indirect_default(self.settings().mode));
