@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # The whole test suite on a fresh Debian machine with Rust: installs the system packages the
-# tests need (software Vulkan, a virtual X server, numpy for the bake-format test), then runs
-# every test of the workspace.
+# tests need (software Vulkan, a virtual X server, numpy for the bake-format test) and Mitsuba 3
+# (pip, into target/mitsuba-venv), then runs every test of the workspace.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth python3 python3-numpy)
+packages=(mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth python3 python3-numpy python3-venv)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -17,6 +17,21 @@ if ((${#missing[@]})); then
     $sudo apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
+
+# Mitsuba 3 for the cross-check in tests/mitsuba.rs, in a private virtual environment. If it
+# cannot be installed, that test fails and shows this log; it never skips.
+venv="$PWD/target/mitsuba-venv"
+log="$PWD/target/mitsuba-install.log"
+mkdir -p target
+if ! "$venv/bin/python" -c "import mitsuba" >/dev/null 2>&1; then
+    echo "installing Mitsuba 3 into $venv"
+    rm -rf "$venv"
+    if ! { python3 -m venv "$venv" &&
+        "$venv/bin/pip" install --quiet --disable-pip-version-check "mitsuba==3.9.1"; } >"$log" 2>&1; then
+        echo "Mitsuba 3 could not be installed (see $log); tests/mitsuba.rs will fail"
+    fi
+fi
+export HPRT_MITSUBA_PYTHON="$venv/bin/python" HPRT_MITSUBA_INSTALL_LOG="$log"
 
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 cargo test --workspace --locked "$@"

@@ -1,0 +1,277 @@
+//! hprt's path-traced reference against Mitsuba 3, on every test run.
+//!
+//! `tests/run.sh` installs Mitsuba 3 into a private virtual environment (`target/mitsuba-venv`)
+//! and points `HPRT_MITSUBA_PYTHON` at its interpreter. Without it the test fails and says why:
+//! a cross-check that skips itself silently protects nothing.
+//!
+//! The scene is small and deliberately asymmetric: a cube on a floor, seen from one side, under
+//! a sky with one bright sun off every axis, so a mirrored or rotated map, a flipped camera or a
+//! wrong sign anywhere moves the shadow and the shading and fails block by block.
+
+mod common;
+
+use common::*;
+use glam::Vec3;
+use precompute::color::Rgb;
+use precompute::image_io::{RgbImageF32, read_exr, write_exr};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const WIDTH: usize = 128;
+const HEIGHT: usize = 96;
+/// Samples per pixel of each of the two independent renders per renderer.
+const SPP: u32 = 128;
+const BLOCKS: usize = 8;
+/// Systematic differences allowed per block, relative: Mitsuba jitters samples over the pixel
+/// (hprt uses its centre) and interpolates the map bilinearly (hprt: constant per texel).
+/// Measured on this scene: hprt is 0.6% darker on average, and 1.7% at most in one block and
+/// channel. The blocks' noise (one standard error: 0.3–0.5%)
+/// comes from the samples themselves, so the tolerance needs no tuning when `SPP` changes.
+const BIAS: f32 = 0.02;
+/// Noise allowance: this many standard errors of the difference of the two block means.
+const SIGMAS: f32 = 4.0;
+
+/// The sun in the map: 4° in radius, 30° high, off every axis; it carries most of the map's
+/// power. The scene turns the map by 70°, so the test also pins the rotation's sense.
+fn sun_direction() -> Vec3 {
+    let (elevation, azimuth) = (30f32.to_radians(), 305f32.to_radians());
+    Vec3::new(
+        elevation.cos() * azimuth.sin(),
+        elevation.sin(),
+        -elevation.cos() * azimuth.cos(),
+    )
+}
+
+fn sky(w: Vec3) -> Rgb {
+    if w.angle_between(sun_direction()) < 4f32.to_radians() {
+        return Rgb::new(400.0, 360.0, 300.0);
+    }
+    if w.y >= 0.0 {
+        Rgb::new(0.3, 0.4, 0.6) * (0.5 + 0.5 * w.y) + Rgb::splat(0.1 * w.x.max(0.0))
+    } else {
+        Rgb::new(0.15, 0.12, 0.1)
+    }
+}
+
+/// The map as an equirectangular EXR (CONVENTIONS.md's mapping), 512 × 256.
+fn write_map(path: &Path) {
+    let (w, h) = (512, 256);
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let u = (x as f32 + 0.5) / w as f32;
+            let v = (y as f32 + 0.5) / h as f32;
+            sky(precompute::envmap::direction_of_uv(u, v))
+        })
+        .collect();
+    write_exr(path, &RgbImageF32::new(w, h, pixels)).unwrap();
+}
+
+fn write_scene_file(dir: &Path) -> PathBuf {
+    let path = dir.join("cube.toml");
+    std::fs::write(
+        &path,
+        format!(
+            r#"[camera]
+position = [2.2, 2.6, 3.6]
+target = [-0.2, 0.3, 0.0]
+fov_y_deg = 45
+width = {WIDTH}
+height = {HEIGHT}
+
+[environment]
+map = "sky.exr"
+rotation_deg = 70
+
+[[object]]
+name = "floor"
+box = {{ min = [-4, -0.05, -4], max = [4, 0, 4], skip_faces = ["-y"] }}
+albedo = [0.6, 0.6, 0.6]
+
+[[object]]
+name = "cube"
+box = {{ min = [-0.5, 0, -0.6], max = [0.5, 1.2, 0.4], skip_faces = ["-y"] }}
+albedo = [0.7, 0.35, 0.2]
+"#
+        ),
+    )
+    .unwrap();
+    path
+}
+
+/// The Python interpreter with Mitsuba 3, or a panic that says how to get one.
+fn mitsuba_python() -> String {
+    let python = std::env::var("HPRT_MITSUBA_PYTHON").unwrap_or_else(|_| "python3".into());
+    let check = Command::new(&python)
+        .args(["-c", "import mitsuba; print(mitsuba.__version__)"])
+        .output();
+    match check {
+        Ok(out) if out.status.success() => {
+            println!("Mitsuba {}", String::from_utf8_lossy(&out.stdout).trim());
+            python
+        }
+        other => {
+            let reason = match other {
+                Ok(out) => String::from_utf8_lossy(&out.stderr).into_owned(),
+                Err(e) => e.to_string(),
+            };
+            let log = std::env::var("HPRT_MITSUBA_INSTALL_LOG")
+                .ok()
+                .and_then(|p| std::fs::read_to_string(p).ok())
+                .unwrap_or_default();
+            panic!(
+                "Mitsuba 3 is not available to {python}: {reason}\n\
+                 tests/run.sh installs it into target/mitsuba-venv (pip install mitsuba); \
+                 or set HPRT_MITSUBA_PYTHON to an interpreter that has it.\n{log}"
+            );
+        }
+    }
+}
+
+/// Mean and variance of the mean of each block, from two independent renders `a` and `b`:
+/// the estimate is their average; each pixel's variance of that average is `(a − b)² / 4`.
+fn block_statistics(
+    a: &RgbImageF32,
+    b: &RgbImageF32,
+    channel: usize,
+    mask: &[bool],
+) -> Vec<(f32, f32, usize)> {
+    let (bw, bh) = (WIDTH / BLOCKS, HEIGHT / BLOCKS);
+    let mut blocks = vec![(0.0f64, 0.0f64, 0usize); BLOCKS * BLOCKS];
+    for y in 0..HEIGHT {
+        for x in 0..WIDTH {
+            let i = y * WIDTH + x;
+            if !mask[i] {
+                continue;
+            }
+            let (la, lb) = (a.pixels[i][channel], b.pixels[i][channel]);
+            let block = &mut blocks[(y / bh) * BLOCKS + x / bw];
+            block.0 += f64::from(0.5 * (la + lb));
+            block.1 += f64::from((la - lb) * (la - lb) / 4.0);
+            block.2 += 1;
+        }
+    }
+    blocks
+        .into_iter()
+        .map(|(sum, var, n)| {
+            let n_f = n.max(1) as f64;
+            ((sum / n_f) as f32, (var / (n_f * n_f)) as f32, n)
+        })
+        .collect()
+}
+
+/// The mean luminance of the pixels in `mask`, from two renders, and the variance of that mean.
+fn masked_statistics(a: &RgbImageF32, b: &RgbImageF32, mask: &[bool]) -> (f32, f32) {
+    let (mut sum, mut var, mut n) = (0.0f64, 0.0f64, 0usize);
+    for i in 0..a.pixels.len() {
+        if mask[i] {
+            let la = precompute::luminance(a.pixels[i]);
+            let lb = precompute::luminance(b.pixels[i]);
+            sum += f64::from(0.5 * (la + lb));
+            var += f64::from((la - lb) * (la - lb) / 4.0);
+            n += 1;
+        }
+    }
+    let n = n.max(1) as f64;
+    ((sum / n) as f32, (var / (n * n)) as f32)
+}
+
+#[test]
+fn mitsuba_agrees_with_the_reference_block_by_block() {
+    let python = mitsuba_python();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_map(&d.join("sky.exr"));
+    let scene = write_scene_file(d);
+    let s = scene.to_str().unwrap();
+    let spp = SPP.to_string();
+    let common = ["--spp", spp.as_str(), "--bounces", "2"];
+
+    let mut export = vec!["export", s, "-o", "mts"];
+    export.extend(common);
+    let out = hprt(d, &export);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for seed in ["0", "1"] {
+        let file = format!("hprt-{seed}.exr");
+        let mut args = vec!["reference", s, "--seed", seed, "-o", &file];
+        args.extend(common);
+        if seed == "0" {
+            args.extend(["--aux", "aux"]);
+        }
+        let out = hprt(d, &args);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let script = r#"
+import mitsuba as mi
+mi.set_variant("scalar_rgb")
+scene = mi.load_file("mts/scene.xml")
+for seed in (0, 1):
+    mi.util.write_bitmap(f"mitsuba-{seed}.exr", mi.render(scene, seed=seed))
+"#;
+    let out = Command::new(&python)
+        .args(["-c", script])
+        .current_dir(d)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "Mitsuba failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    let read = |name: &str| read_exr(&d.join(name)).unwrap();
+    let (h0, h1) = (read("hprt-0.exr"), read("hprt-1.exr"));
+    let (m0, m1) = (read("mitsuba-0.exr"), read("mitsuba-1.exr"));
+    assert_eq!((m0.width, m0.height), (WIDTH, HEIGHT));
+    let visibility = read("aux/visibility.exr");
+    let coverage = read("aux/coverage.exr");
+
+    // Each colour channel of each block of an 8 × 8 grid.
+    let everything = vec![true; WIDTH * HEIGHT];
+    let mut failures = Vec::new();
+    let (mut worst, mut largest) = (0.0f32, 0.0f32);
+    for channel in 0..3 {
+        let ours = block_statistics(&h0, &h1, channel, &everything);
+        let theirs = block_statistics(&m0, &m1, channel, &everything);
+        for (i, ((h, hv, _), (m, mv, _))) in ours.iter().zip(&theirs).enumerate() {
+            let tolerance = BIAS * m + SIGMAS * (hv + mv).sqrt();
+            let off = (h - m).abs();
+            largest = largest.max(off / m);
+            worst = worst.max(off / tolerance);
+            if off > tolerance {
+                failures.push(format!(
+                    "block ({}, {}), {}: hprt {h:.4} Mitsuba {m:.4}, tolerance {tolerance:.4}",
+                    i % BLOCKS,
+                    i / BLOCKS,
+                    ["red", "green", "blue"][channel]
+                ));
+            }
+        }
+    }
+    println!(
+        "largest difference {:.2}% of a block's mean; worst block at {worst:.2} of its tolerance",
+        100.0 * largest
+    );
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+
+    // The shadow: the pixels hprt finds in shadow (direct visibility below 0.5) are as dark in
+    // Mitsuba's image, and there are enough of them to matter.
+    let shadow: Vec<bool> = (0..WIDTH * HEIGHT)
+        .map(|i| coverage.pixels[i].x > 0.5 && visibility.pixels[i].x < 0.5)
+        .collect();
+    let lit: Vec<bool> = (0..WIDTH * HEIGHT)
+        .map(|i| coverage.pixels[i].x > 0.5 && visibility.pixels[i].x > 0.9)
+        .collect();
+    let shadow_pixels = shadow.iter().filter(|s| **s).count();
+    assert!(shadow_pixels > 500, "only {shadow_pixels} shadow pixels");
+    let (h, hv) = masked_statistics(&h0, &h1, &shadow);
+    let (m, mv) = masked_statistics(&m0, &m1, &shadow);
+    let tolerance = BIAS * m + SIGMAS * (hv + mv).sqrt();
+    println!("shadow ({shadow_pixels} pixels): hprt {h:.4} Mitsuba {m:.4} ± {tolerance:.4}");
+    assert!((h - m).abs() < tolerance, "shadow: hprt {h} Mitsuba {m}");
+    let (lit_mean, _) = masked_statistics(&m0, &m1, &lit);
+    assert!(
+        m < 0.5 * lit_mean,
+        "Mitsuba's image is not dark in hprt's shadow: {m} vs lit {lit_mean}"
+    );
+}
