@@ -235,6 +235,75 @@ fn gpu_prt_matches_the_transfer_at_every_order() {
     }
 }
 
+/// A square of side 2 centred on `centre`, facing `normal`.
+fn plane_facing(centre: Vec3, normal: Vec3) -> precompute::mesh::TriangleMesh {
+    let (u, v) = normal.any_orthonormal_pair();
+    precompute::mesh::TriangleMesh {
+        positions: [-u - v, u - v, u + v, -u + v].map(|c| centre + c).to_vec(),
+        normals: vec![normal; 4],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+    }
+}
+
+/// Closed-form PRT through the bake and the GPU: an unoccluded sphere and an unoccluded tilted
+/// plane under a sky of one SH band (plus a constant that keeps it positive), `L = c Y₀₀ +
+/// Σ_m a_m Y_lm`. Each point of normal n reflects `ρ/π (π c Y₀₀ + Â_l Σ_m a_m Y_lm(n))`
+/// (Funk–Hecke, `Â_l` = π, 2π/3, π/4, 0, −π/24 by hand), interpolated from the vertices.
+#[test]
+fn gpu_prt_of_single_sh_bands_on_open_surfaces_is_funk_hecke() {
+    use std::f32::consts::PI;
+    const CLAMPED_COSINE: [f32; 5] = [PI, 2.0 * PI / 3.0, PI / 4.0, 0.0, -PI / 24.0];
+    let albedo = Rgb::new(0.8, 0.6, 0.4);
+    let normal = Vec3::new(0.4, 0.8, -0.45).normalize();
+    let scenes = [
+        (
+            sphere_mesh(Vec3::ZERO, 1.0, 3),
+            camera(Vec3::new(1.5, 1.2, 3.0), Vec3::ZERO, 64, 64),
+        ),
+        (
+            plane_facing(Vec3::ZERO, normal),
+            camera(2.5 * normal + Vec3::new(0.7, 0.3, 0.2), Vec3::ZERO, 64, 64),
+        ),
+    ];
+    let basis = precompute::sh::ShBasis::new(5).unwrap();
+    let gpu = gpu();
+    for (mesh, cam) in scenes {
+        let mut geometry = SceneMesh::default();
+        geometry.push_object("open".into(), &mesh, albedo);
+        let transfer = bake_of(&geometry, 5, 4096, 1);
+        for l in 0..5usize {
+            let mut sh = ShCoeffs::zeros(5);
+            sh.as_mut_slice()[0] = Rgb::splat(3.0);
+            let weights: Vec<(usize, f32)> = (-(l as isize)..=l as isize)
+                .map(|m| (precompute::sh::index(l, m), 0.6 + 0.25 * m as f32))
+                .collect();
+            if l > 0 {
+                for &(k, a) in &weights {
+                    sh.as_mut_slice()[k] = Rgb::splat(a);
+                }
+            }
+            let closed_form = |n: Vec3| {
+                let y = basis.eval_vec(n);
+                let band: f32 = weights.iter().map(|&(k, a)| a * y[k]).sum();
+                let band = if l > 0 { band } else { 0.0 };
+                albedo * ((PI * 3.0 * y[0] + CLAMPED_COSINE[l] * band) / PI)
+            };
+            let image = render(&gpu, &geometry, &transfer, &cam, &FrameLighting::prt(sh));
+            let (covered, off) = compare_with_cpu(&image, &geometry, &cam, |hit| {
+                interpolate(&geometry, hit, |v| {
+                    Vec3::from(closed_form(geometry.mesh.normals[v]))
+                })
+                .into()
+            });
+            assert!(covered > 1000, "band {l}: {covered} covered pixels");
+            assert!(
+                off * 100 < covered,
+                "band {l}: {off} of {covered} pixels differ from the closed form"
+            );
+        }
+    }
+}
+
 #[test]
 fn furnace_prt_surfaces_equal_their_albedo() {
     let albedo = Rgb::new(0.8, 0.5, 0.3);
