@@ -29,6 +29,16 @@ impl Synthetic {
         EnvMap::from_fn(2048, 1024, 2, |w| self.radiance(w))
     }
 
+    /// The map's exact power, from its definition: the background's mean over the sphere is
+    /// its constant term (the `w.y` and `w.x` terms integrate to zero), each disc adds its
+    /// radiance times its cap.
+    fn exact_power(&self) -> Rgb {
+        let background = Rgb::new(0.4, 0.5, 0.7) * (4.0 * PI);
+        (0..self.discs.len())
+            .map(|i| self.disc_power(i))
+            .fold(background, |sum, p| sum + p)
+    }
+
     /// Exact power of disc `i`: radiance times the cap's solid angle.
     fn disc_power(&self, i: usize) -> Rgb {
         let (_, r, l) = self.discs[i];
@@ -118,9 +128,12 @@ fn assert_finds_three_suns(scene: &Synthetic, result: &Decomposition, face_size:
 fn consistent_mode_conserves_energy_and_irradiance() {
     let map = three_suns().env_map();
     let result = decompose(&map, 0.0, DecomposeSettings::default());
-    let total = map.total_power();
+    // Against the map's definition, not its texels: the decomposition's SH part and lights
+    // together hold the map's power, whatever the cube conversion and projection do.
+    let total = three_suns().exact_power();
     let relative = ((result.total() - total) / total).abs().max_element();
-    assert!(relative < 0.01, "{} vs {total}", result.total());
+    // 2e-3: the 2 × 2 supersampled disc edges leave 4.5e-4.
+    assert!(relative < 2e-3, "{} vs {total}", result.total());
     let mut worst = 0.0f32;
     for n in [
         Vec3::Y,
