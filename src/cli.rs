@@ -76,8 +76,9 @@ pub struct DecomposeOptions {
     /// the brighter ones.
     #[arg(long, default_value_t = DecomposeSettings::default().threshold)]
     pub threshold: f32,
-    /// Radius of the SRBF / light caps in degrees (default: 8 for consistent, √2 × the
-    /// smoothing for thesis, which keeps a point source's power under the thesis' formula).
+    /// Radius of the SRBF / light caps in degrees (default: 8 for consistent; for thesis, √2 ×
+    /// the smoothing widened by the analysis texel, 2.89° at 2°, which keeps a point source's
+    /// power under the thesis' formula).
     #[arg(long)]
     pub radius: Option<f32>,
     /// Cube-map face resolution.

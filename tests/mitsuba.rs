@@ -163,10 +163,16 @@ fn block_statistics(
 /// The mean luminance of the pixels in `mask`, from two renders, and the variance of that mean.
 fn masked_statistics(a: &RgbImageF32, b: &RgbImageF32, mask: &[bool]) -> (f32, f32) {
     let (mut sum, mut var, mut n) = (0.0f64, 0.0f64, 0usize);
-    for i in 0..a.pixels.len() {
-        if mask[i] {
-            let la = precompute::luminance(a.pixels[i]);
-            let lb = precompute::luminance(b.pixels[i]);
+    for ((pa, pb), _) in a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .zip(mask)
+        .filter(|(_, m)| **m)
+    {
+        {
+            let la = precompute::luminance(*pa);
+            let lb = precompute::luminance(*pb);
             sum += f64::from(0.5 * (la + lb));
             var += f64::from((la - lb) * (la - lb) / 4.0);
             n += 1;

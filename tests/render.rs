@@ -17,7 +17,7 @@ use precompute::sh::ShCoeffs;
 use precompute::{Rgb, luminance};
 use runtime::lighting::ShTransfer;
 use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
-use runtime::{CubeSource, DecomposeSettings, Decomposer, DirectionalLight};
+use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer, DirectionalLight};
 
 fn gpu() -> GpuContext {
     GpuContext::headless(Backend::Auto)
@@ -271,7 +271,7 @@ fn gpu_prt_of_single_sh_bands_on_open_surfaces_is_funk_hecke() {
         let mut geometry = SceneMesh::default();
         geometry.push_object("open".into(), &mesh, albedo);
         let transfer = bake_of(&geometry, 5, 4096, 1);
-        for l in 0..5usize {
+        for (l, clamped_cosine) in CLAMPED_COSINE.into_iter().enumerate() {
             let mut sh = ShCoeffs::zeros(5);
             sh.as_mut_slice()[0] = Rgb::splat(3.0);
             let weights: Vec<(usize, f32)> = (-(l as isize)..=l as isize)
@@ -286,14 +286,11 @@ fn gpu_prt_of_single_sh_bands_on_open_surfaces_is_funk_hecke() {
                 let y = basis.eval_vec(n);
                 let band: f32 = weights.iter().map(|&(k, a)| a * y[k]).sum();
                 let band = if l > 0 { band } else { 0.0 };
-                albedo * ((PI * 3.0 * y[0] + CLAMPED_COSINE[l] * band) / PI)
+                albedo * ((PI * 3.0 * y[0] + clamped_cosine * band) / PI)
             };
             let image = render(&gpu, &geometry, &transfer, &cam, &FrameLighting::prt(sh));
             let (covered, off) = compare_with_cpu(&image, &geometry, &cam, |hit| {
-                interpolate(&geometry, hit, |v| {
-                    Vec3::from(closed_form(geometry.mesh.normals[v]))
-                })
-                .into()
+                interpolate(&geometry, hit, |v| closed_form(geometry.mesh.normals[v]))
             });
             assert!(covered > 1000, "band {l}: {covered} covered pixels");
             assert!(
@@ -827,6 +824,62 @@ fn hybrid_beats_prt_in_the_shadows_against_the_reference() {
         hybrid_shadow < prt_shadow,
         "shadow region: hybrid {hybrid_shadow} vs prt {prt_shadow}"
     );
+
+    // hybrid/thesis, the thesis' own method at its own default radius. Its SH part keeps the
+    // whole map and its lights add the sources again: by design it double counts them. On the
+    // table's lit pixels (reference visibility above 0.97, normal +Y) its lights alone must
+    // add their Lambert term `ρ/π Σ Φ_i max(0, d_i·y)` on top of what the SH part gives, so
+    // it is brighter than the truth by at least `Σ Φ_i max(0, d_i·y) / E(y)`.
+    let thesis_settings = DecomposeSettings::for_mode(DecomposeMode::Thesis, 5);
+    let thesis = Decomposer::new(thesis_settings).unwrap().decompose(&cube);
+    assert!(!thesis.lights.is_empty());
+    let thesis_images: Vec<RgbImageF32> = [RenderMode::Hybrid, RenderMode::Lights]
+        .into_iter()
+        .map(|mode| {
+            let lighting = FrameLighting::for_mode(mode, &projection, &thesis, false);
+            render(&gpu, &teapot.geometry, &transfer, &cam, &lighting)
+        })
+        .collect();
+    let table_albedo = Rgb::new(0.6, 0.48, 0.36);
+    let lambert: Rgb = thesis
+        .lights
+        .iter()
+        .map(|l| l.power * (l.direction.y.max(0.0) / std::f32::consts::PI))
+        .sum::<Rgb>()
+        * table_albedo;
+    let basis = cam.basis();
+    let mut lit_table = vec![false; truth.radiance.pixels.len()];
+    for (i, lit) in lit_table.iter_mut().enumerate() {
+        let (x, y) = (
+            (i % cam.width as usize) as u32,
+            (i / cam.width as usize) as u32,
+        );
+        let ray = cam.pixel_direction(&basis, x, y);
+        *lit = truth.visibility[i] > 0.97
+            && bvh
+                .intersect(cam.position, ray, 0.0, f32::MAX)
+                .is_some_and(|h| (cam.position + ray * h.t).y.abs() < 1e-3);
+    }
+    let lit_pixels = lit_table.iter().filter(|l| **l).count();
+    assert!(lit_pixels > 1000, "{lit_pixels} lit table pixels");
+    let mean_in = |image: &RgbImageF32| {
+        let sum: f32 = (0..lit_table.len())
+            .filter(|&i| lit_table[i])
+            .map(|i| luminance(image.pixels[i]))
+            .sum();
+        sum / lit_pixels as f32
+    };
+    let lights_alone = mean_in(&thesis_images[1]) / luminance(lambert);
+    let excess = mean_in(&thesis_images[0]) / mean_in(&truth.radiance);
+    let predicted = 1.0
+        + luminance(lambert)
+            / luminance(table_albedo * (map.irradiance(Vec3::Y) / std::f32::consts::PI));
+    println!(
+        "hybrid/thesis on the lit table: lights {lights_alone:.4} of their Lambert term; \
+         {excess:.3} × the reference (double count alone: {predicted:.3})"
+    );
+    assert!((lights_alone - 1.0).abs() < 0.02, "{lights_alone}");
+    assert!(excess > predicted - 0.05, "{excess} vs {predicted}");
 }
 
 #[test]

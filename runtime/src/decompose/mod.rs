@@ -151,11 +151,16 @@ impl DecomposeSettings {
     /// The default SRBF radius of a mode. `consistent`: a cap of 8°, wide enough for the
     /// bundled maps' suns and lamps. `thesis` leaves R open; its power `2π(1 − cos R) λ` with λ
     /// the Gaussian-smoothed peak gives a point source of power Φ the power `≈ (R²/2σ²) Φ`
-    /// (σ: the smoothing), so `R = √2 σ` is the choice that keeps point sources' power.
+    /// (σ: the smoothing), so `R = √2 σ` is the choice that keeps point sources' power. The
+    /// smoothing runs on the analysis cube, whose texels (Δ = 90°/64 across) first spread a
+    /// point over a box of variance Δ²/12, so σ² there is `σ² + Δ²/12` (4% more at 2°).
     pub fn default_radius(mode: DecomposeMode, smoothing_deg: f32) -> f32 {
         match mode {
             DecomposeMode::Consistent => 8.0,
-            DecomposeMode::Thesis => std::f32::consts::SQRT_2 * smoothing_deg,
+            DecomposeMode::Thesis => {
+                let texel_deg = 90.0 / ANALYSIS_FACE_SIZE as f32;
+                (2.0 * (smoothing_deg * smoothing_deg + texel_deg * texel_deg / 12.0)).sqrt()
+            }
         }
     }
 
@@ -349,7 +354,14 @@ impl Decomposer {
         let peaks = self.find_peaks(map, &detection, luminance(total_power) / (4.0 * PI));
         let candidates = peaks.len();
         let (sh, mut lights) = match self.settings.mode {
-            DecomposeMode::Thesis => (detection, self.thesis_lights(&peaks)),
+            DecomposeMode::Thesis => {
+                // The thesis' SH part: the whole map, windowed by the chosen window (the
+                // peaks are always found on the Hanning-windowed detection expansion).
+                let mut sh = full.clone();
+                sh.scale_bands(&self.sh_window);
+                let lights = self.thesis_lights(&peaks, &detection, &sh);
+                (sh, lights)
+            }
             DecomposeMode::Consistent => self.consistent_lights(map, &full, &peaks),
         };
         let total_luminance = luminance(total_power).max(f32::MIN_POSITIVE);
@@ -437,15 +449,30 @@ impl Decomposer {
     }
 
     /// Thesis: power `2π(1 − cos R)(λ_i − P(Ξ_i))` per light.
-    fn thesis_lights(&self, peaks: &[Peak]) -> Vec<DirectionalLight> {
+    /// The thesis' lights: `2π(1 − cos R)(λ − P(Ξ))` at each kept peak, with P the SH part
+    /// `sh` (the peaks' residuals were measured above the `detection` expansion; when the SH
+    /// part has another window, the residual is moved onto it).
+    fn thesis_lights(
+        &self,
+        peaks: &[Peak],
+        detection: &ShCoeffs<Rgb>,
+        sh: &ShCoeffs<Rgb>,
+    ) -> Vec<DirectionalLight> {
         let radius = self.settings.radius_deg.to_radians();
         let cap = 2.0 * PI * (1.0 - radius.cos());
         let values: Vec<f32> = peaks.iter().map(|p| p.value).collect();
+        let same_window = self.sh_window == self.detection_window;
         peaks[..self.keep_count(&values)]
             .iter()
             .map(|p| DirectionalLight {
                 direction: p.direction,
-                power: p.rgb.max(Rgb::ZERO) * cap,
+                power: if same_window {
+                    p.rgb
+                } else {
+                    p.rgb + detection.eval(p.direction) - sh.eval(p.direction)
+                }
+                .max(Rgb::ZERO)
+                    * cap,
                 cap_radius: radius,
                 angular_radius: radius,
                 halo_radius: radius,
