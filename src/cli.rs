@@ -198,6 +198,18 @@ pub struct ReportOptions {
     /// Seed of the reference.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Random numbers of the reference's light paths: sobol or independent.
+    #[arg(long, default_value_t = precompute::reference::SamplerKind::default())]
+    pub sampler: precompute::reference::SamplerKind,
+    /// Render the reference progressively (doubling its samples, continuing the cached ones)
+    /// until its noise floor, in the mean error's units, is at most this: a number (0.001) or
+    /// a share of the best method's mean error (20%).
+    #[arg(long)]
+    pub target_noise: Option<crate::report::NoiseTarget>,
+    /// With --target-noise: stop before a pass that would end after this many seconds of
+    /// rendering one map's reference.
+    #[arg(long, value_parser = parse_positive_f64)]
+    pub reference_time_limit: Option<f64>,
     /// Weber thresholds of the error-against-threshold plot.
     #[arg(long, num_args = 1.., default_values_t = [0.0, 0.02, 0.05, 0.1, 0.2, 0.4])]
     pub thresholds: Vec<f32>,
@@ -219,6 +231,14 @@ pub fn parse_vec3(text: &str) -> Result<glam::Vec3, String> {
     match parts[..] {
         [x, y, z] => Ok(glam::Vec3::new(x, y, z)),
         _ => Err(format!("expected three numbers \"x,y,z\", got {text:?}")),
+    }
+}
+
+/// A finite number above zero, in double precision.
+pub fn parse_positive_f64(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("expected a finite number above 0, got {text:?}")),
     }
 }
 

@@ -374,7 +374,7 @@ fn outputs_keep_links_refuse_collisions_and_clean_up_on_signals() {
                 "--env",
                 env,
                 "--spp",
-                "100000",
+                "60000",
                 "-o",
                 "long.exr",
             ])

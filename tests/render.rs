@@ -779,11 +779,7 @@ fn hybrid_beats_prt_in_the_shadows_against_the_reference() {
     // The reference at test time: small and noisy, but unbiased.
     let bvh = SceneBvh::build(&teapot.geometry.mesh);
     let light = EnvironmentLight::new(&map, rotation);
-    let settings = ReferenceSettings {
-        spp: 96,
-        bounces: 2,
-        seed: 1,
-    };
+    let settings = ReferenceSettings::new(96, 2, 1);
     let truth = reference::render(&teapot.geometry, &bvh, &light, &cam, &settings, &NoProgress);
 
     let decompose = DecomposeSettings::default();

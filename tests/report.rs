@@ -252,6 +252,41 @@ fn report_measures_shadows_and_survives_bad_maps() {
         assert!(map_dir.join(file).exists(), "{file} missing");
     }
 
+    // The reference's noise floor is what its two halves give, and the warning follows it.
+    let floor = recompute_noise(&map_dir, exposure);
+    let noise = &sunrise_report["noise"];
+    close(floor.0, &noise["mean"], "noise floor");
+    close(
+        floor.1,
+        &noise["relative_rmse"],
+        "noise floor of the relative RMSE",
+    );
+    assert_eq!(sunrise_report["reference_spp"], 128);
+    let best = methods
+        .iter()
+        .map(|m| m["mean"].as_f64().unwrap())
+        .fold(f64::INFINITY, f64::min);
+    let warned = floor.0 > 0.2 * best;
+    assert_eq!(sunrise_report["noise_warning"], warned);
+    assert_eq!(
+        stdout(&out).contains("warning: sunrise: the reference's noise floor"),
+        warned
+    );
+    assert_eq!(
+        html.contains("Warning: the reference's own noise floor"),
+        warned
+    );
+    assert!(
+        warned,
+        "128 spp: the floor {} should be a large part of {best}",
+        floor.0
+    );
+    for m in methods {
+        let rmse = m["relative_rmse"].as_f64().unwrap();
+        let corrected = (rmse * rmse - floor.1 * floor.1).max(0.0).sqrt();
+        close(corrected, &m["relative_rmse_corrected"], "corrected RMSE");
+    }
+
     // A rerun with the same inputs takes the reference from the cache.
     let out = hprt_with_env(&dir, &args, &[("HPRT_CACHE", &cache)]);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -263,6 +298,61 @@ fn report_measures_shadows_and_survives_bad_maps() {
         again["maps"][0]["methods"][0]["mean"],
         stats["maps"][0]["methods"][0]["mean"]
     );
+
+    // A stricter target continues the cached samples instead of starting over.
+    let target = format!("{}", 0.8 * floor.0);
+    let mut stricter = args.to_vec();
+    stricter.extend(["--target-noise", target.as_str()]);
+    let out = hprt_with_env(&dir, &stricter, &[("HPRT_CACHE", &cache)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("2 × 64 → 2 × 128"),
+        "{}",
+        stdout(&out)
+    );
+    let continued: Value =
+        serde_json::from_slice(&std::fs::read(report_dir.join("stats.json")).unwrap()).unwrap();
+    let map = &continued["maps"][0];
+    assert!(map["reference_spp"].as_u64().unwrap() >= 256);
+    let continued_floor = map["noise"]["mean"].as_f64().unwrap();
+    assert!(
+        continued_floor <= 0.8 * floor.0,
+        "{continued_floor} vs {}",
+        floor.0
+    );
+    close(
+        recompute_noise(&map_dir, exposure).0,
+        &map["noise"]["mean"],
+        "continued noise floor",
+    );
+}
+
+/// The noise floor of `dir`'s reference from its halves (CONVENTIONS.md): the mean over
+/// covered pixels of half the tone-mapped difference, and `√(mean (ΔY)²/4) / mean Y`.
+fn recompute_noise(dir: &Path, exposure: f64) -> (f64, f64) {
+    let a = pixels(&dir.join("reference-half0.exr"));
+    let b = pixels(&dir.join("reference-half1.exr"));
+    let reference = pixels(&dir.join("reference.exr"));
+    let coverage = pixels(&dir.join("reference-coverage.exr"));
+    let (mut sum, mut variance, mut level, mut n) = (0.0, 0.0, 0.0, 0usize);
+    for i in 0..a.len() {
+        for c in 0..3 {
+            assert!(
+                (0.5 * (a[i][c] + b[i][c]) - reference[i][c]).abs()
+                    <= 1e-3 * reference[i][c].abs().max(1e-3)
+            );
+        }
+        if coverage[i][0] > 0.5 {
+            sum += 0.5
+                * (tonemapped_luminance(a[i], exposure) - tonemapped_luminance(b[i], exposure))
+                    .abs();
+            variance += (luminance(a[i]) - luminance(b[i])).powi(2) / 4.0;
+            level += 0.5 * (luminance(a[i]) + luminance(b[i]));
+            n += 1;
+        }
+    }
+    let n = n as f64;
+    (sum / n, (variance / n).sqrt() / (level / n))
 }
 
 /// Bakes the teapot at test settings.

@@ -99,6 +99,9 @@ pub struct BenchReferenceArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Skip the comparison with Mitsuba 3 (run when its Python package is found).
+    #[arg(long)]
+    pub no_mitsuba: bool,
 }
 
 #[derive(Args)]
@@ -178,21 +181,14 @@ fn bench_bake(args: BenchBakeArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Mitsuba 3's `path` integrator, `scalar_rgb` variant, on this machine class (2 cores): about
-/// 1.0 s per megapixel per sample at max depth 5 (the figure the reference is held to).
-const MITSUBA_SCALAR_SECONDS_PER_MEGAPIXEL_SAMPLE: f64 = 1.0;
-
 fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
     use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
     let scene = load_scene(&args.scene)?;
     let env = environment::choose(&scene, None, None, None)?;
     let camera = scene.camera.with_size(args.width, args.height);
     camera.validate()?;
-    let settings = ReferenceSettings {
-        spp: args.spp,
-        bounces: args.bounces,
-        seed: 0,
-    };
+    let settings = ReferenceSettings::new(args.spp, args.bounces, 0);
+    settings.validate().map_err(anyhow::Error::msg)?;
     let runs = with_threads(args.threads, || {
         let bvh = SceneBvh::build(&scene.geometry.mesh);
         let light = EnvironmentLight::new(&env.loaded.map, env.rotation_deg);
@@ -206,12 +202,11 @@ fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
                     &settings,
                     &NoProgress,
                 )
-                .stats
             })
             .collect::<Vec<_>>()
     })?;
-    let seconds = median(runs.iter().map(|r| r.seconds).collect());
-    let rays_per_second = median(runs.iter().map(|r| r.rays_per_second()).collect());
+    let seconds = median(runs.iter().map(|r| r.stats.seconds).collect());
+    let rays_per_second = median(runs.iter().map(|r| r.stats.rays_per_second()).collect());
     let megapixel_samples = args.width as f64 * args.height as f64 * args.spp as f64 / 1e6;
     let per = seconds / megapixel_samples;
     println!(
@@ -225,10 +220,48 @@ fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
         args.repeat
     );
     println!(
-        "time {seconds:.2} s, {:.2} M rays/s, {per:.3} s per megapixel per sample \
-         ({:.2}x the speed of Mitsuba 3 scalar_rgb's ~{MITSUBA_SCALAR_SECONDS_PER_MEGAPIXEL_SAMPLE} s)",
+        "hprt: {seconds:.2} s, {:.2} M rays/s, {per:.3} s per megapixel per sample",
         rays_per_second / 1e6,
-        MITSUBA_SCALAR_SECONDS_PER_MEGAPIXEL_SAMPLE / per
+    );
+    if args.no_mitsuba {
+        return Ok(());
+    }
+    let Some(mitsuba) = super::mitsuba::Mitsuba::find() else {
+        println!(
+            "Mitsuba 3 not found (pip install mitsuba, or set HPRT_MITSUBA_PYTHON): no comparison"
+        );
+        return Ok(());
+    };
+    let dir = tempfile::tempdir()?;
+    let export = precompute::export::ExportSettings {
+        camera,
+        rotation_deg: env.rotation_deg,
+        spp: args.spp,
+        bounces: args.bounces,
+    };
+    let (times, image) = mitsuba.render(
+        dir.path(),
+        &scene.geometry,
+        &env.loaded.map,
+        &export,
+        args.repeat.max(1) + 1,
+    )?;
+    anyhow::ensure!(times.len() >= 2, "Mitsuba reported no timings");
+    // The first render compiles the LLVM variant's kernels; the rest are steady state.
+    let steady = median(times[1..].to_vec());
+    let last = runs.last().expect("at least one run");
+    let difference =
+        super::mitsuba::covered_mean_difference(&last.radiance, &image, &last.coverage);
+    println!(
+        "Mitsuba {} {}: {steady:.2} s (median of {}; the first, with kernel compilation, \
+         {:.2} s); hprt takes {:.2}x Mitsuba's time; mean radiance of covered pixels: hprt \
+         {:+.2}% from Mitsuba",
+        mitsuba.version,
+        mitsuba.variant,
+        times.len() - 1,
+        times[0],
+        seconds / steady,
+        100.0 * difference
     );
     Ok(())
 }

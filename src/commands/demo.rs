@@ -20,9 +20,18 @@ pub struct DemoArgs {
     /// Light paths per pixel of the references.
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
     pub spp: u32,
-    #[arg(long, default_value_t = 400)]
+    /// Render each reference further until its noise floor reaches this: a floor (0.001) or a
+    /// share of the best method's mean error (the default, 20%: the statistics then measure
+    /// the methods, not the reference).
+    #[arg(long, default_value = "20%")]
+    pub target_noise: crate::report::NoiseTarget,
+    /// Stop at --spp (no noise target): a quick look in a few minutes, with the noise floors
+    /// stated and warned about.
+    #[arg(long)]
+    pub quick: bool,
+    #[arg(long, default_value_t = 200)]
     pub width: u32,
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 150)]
     pub height: u32,
     /// Graphics backend: auto, vulkan or gl.
     #[arg(long, default_value = "auto")]
@@ -54,6 +63,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
             height: Some(args.height),
         },
         seed: 0,
+        sampler: Default::default(),
+        target_noise: (!args.quick).then_some(args.target_noise),
+        reference_time_limit: None,
         thresholds: vec![0.0, 0.02, 0.05, 0.1, 0.2, 0.4],
         frames: 5,
         backend: args.backend,

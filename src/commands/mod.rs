@@ -7,6 +7,7 @@ pub mod bench;
 pub mod decompose;
 pub mod demo;
 pub mod export;
+mod mitsuba;
 pub mod reference;
 pub mod render;
 pub mod report;

@@ -8,7 +8,9 @@ use clap::Args;
 use precompute::atomic_file::AtomicOutput;
 use precompute::bvh::SceneBvh;
 use precompute::image_io::{RgbImageF32, exr_bytes, write_exr, write_png};
-use precompute::reference::{self, EnvironmentLight, ReferenceImage, ReferenceSettings};
+use precompute::reference::{
+    self, EnvironmentLight, ReferenceImage, ReferenceSettings, SamplerKind,
+};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -27,6 +29,10 @@ pub struct ReferenceArgs {
     pub bounces: u32,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Random numbers of the light paths: sobol (Owen-scrambled, per pixel; at most 65536
+    /// samples per pixel) or independent.
+    #[arg(long, default_value_t = SamplerKind::default())]
+    pub sampler: SamplerKind,
     /// Worker threads (default: all cores); the image does not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -67,6 +73,11 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let env = args.environment.choose(&scene)?;
     let camera = args.size.camera(&scene)?;
+    let settings = ReferenceSettings {
+        sampler: args.sampler,
+        ..ReferenceSettings::new(args.spp, args.bounces, args.seed)
+    };
+    settings.validate().map_err(anyhow::Error::msg)?;
     crate::support::distinct_outputs(&[
         ("-o", Some(&args.output)),
         ("--png", args.png.as_deref()),
@@ -76,11 +87,6 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
     if let Some(dir) = &args.aux {
         crate::support::create_folder(dir)?;
     }
-    let settings = ReferenceSettings {
-        spp: args.spp,
-        bounces: args.bounces,
-        seed: args.seed,
-    };
     println!(
         "{}: {}x{}, {} spp, {} bounces, lit by {} rotated {}°",
         scene.name,

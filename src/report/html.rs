@@ -19,7 +19,7 @@ td.best { font-weight: bold; background: #e8f5e9; }
 .grid img { width: 100%; } svg { max-width: 100%; height: auto; }
 figure { margin: 0; } figcaption { font-size: 0.9em; text-align: center; color: #555; }
 img { image-rendering: pixelated; max-width: 100%; }
-.failed { color: #b00020; } .note { color: #555; font-size: 0.9em; }
+.failed { color: #b00020; } .warning { color: #8a4b00; background: #fff4e0; padding: 0.5em; } tr.noise td { color: #555; font-style: italic; } .note { color: #555; font-size: 0.9em; }
 ";
 
 /// Escapes text for HTML.
@@ -71,7 +71,7 @@ fn ranks_by_mean(methods: &[MethodResult]) -> Vec<usize> {
 fn summary_table(html: &mut String, maps: &[&MapReport]) {
     html.push_str(
         "<table><tr><th>map</th><th>method</th><th>rank</th><th>mean ± std</th><th>shadow mean ± std</th>\
-         <th>penumbra mean ± std</th><th>relative RMSE</th><th>lights</th><th>decomposition (ms)</th><th>frame (ms)</th></tr>",
+         <th>penumbra mean ± std</th><th>relative RMSE</th><th>relative RMSE, noise-corrected</th><th>lights</th><th>decomposition (ms)</th><th>frame (ms)</th></tr>",
     );
     for map in maps {
         let best = |key: fn(&MethodResult) -> f64| {
@@ -103,7 +103,7 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
             };
             let _ = write!(
                 html,
-                "<tr>{name}<td class=\"name\">{}</td><td>{}</td>{}{}{}{}<td>{}</td><td>{:.2}</td><td>{:.1}</td></tr>",
+                "<tr>{name}<td class=\"name\">{}</td><td>{}</td>{}{}{}{}<td>{:.4}</td><td>{}</td><td>{:.2}</td><td>{:.1}</td></tr>",
                 escape(&m.method),
                 ranks[k],
                 cell(s.mean, best_mean, mean_std(s.mean, s.std)),
@@ -122,9 +122,30 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
                     best_rmse,
                     format!("{:.4}", s.relative_rmse)
                 ),
+                m.relative_rmse_corrected,
                 m.lights,
                 m.decomposition_ms,
                 m.frame_ms,
+            );
+        }
+        if !map.methods.is_empty() {
+            let n = &map.noise;
+            let optional = |v: f64| {
+                if v.is_finite() {
+                    format!("{v:.4}")
+                } else {
+                    "–".into()
+                }
+            };
+            let _ = write!(
+                html,
+                "<tr class=\"noise\"><td class=\"name\" colspan=\"2\">reference noise floor ({} spp)</td><td></td>\
+                 <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td colspan=\"4\"></td></tr>",
+                map.reference_spp,
+                optional(n.mean),
+                optional(n.shadow_mean),
+                optional(n.penumbra_mean),
+                optional(n.relative_rmse),
             );
         }
     }
@@ -168,11 +189,30 @@ fn map_section(html: &mut String, map: &MapReport, out: &Path) -> anyhow::Result
         escape(&map.path),
         map.exposure,
         if map.reference_cached {
-            "from the cache".to_owned()
+            format!("{} spp, from the cache", map.reference_spp)
         } else {
-            format!("rendered in {:.1} s", map.reference_seconds)
+            format!(
+                "{} spp, rendered in {:.1} s",
+                map.reference_spp, map.reference_seconds
+            )
         }
     );
+    if map.noise_warning {
+        let best = map
+            .methods
+            .iter()
+            .map(|m| m.stats.mean)
+            .fold(f64::INFINITY, f64::min);
+        let _ = write!(
+            html,
+            "<p class=\"warning\">Warning: the reference's own noise floor ({:.4}) is {:.0}% of \
+             the best method's mean error ({best:.4}): on this map the statistics measure the \
+             reference as much as the methods. Render it with more samples (<code>--spp</code>, \
+             or <code>--target-noise</code>).</p>",
+            map.noise.mean,
+            100.0 * map.noise.mean / best
+        );
+    }
     html.push_str("<div class=\"grid\">");
     figure(
         html,
@@ -297,6 +337,7 @@ mod tests {
                 mean,
                 ..ErrorStats::default()
             },
+            relative_rmse_corrected: 0.0,
             lights: 0,
             decomposition_ms: 0.0,
             frame_ms: 0.0,

@@ -5,25 +5,26 @@
 
 pub mod figures;
 mod html;
+mod reference;
 pub mod sequence;
 pub mod stats;
 
-use crate::bake_cache::{self, cache_dir};
+use crate::bake_cache;
 use crate::cli::ReportOptions;
 use crate::environment::{default_exposure, load_map, scene_rotation};
-use crate::support::{TerminalProgress, median};
+use crate::support::median;
 use figures::Curve;
 use precompute::atomic_file::write_atomic;
 use precompute::bake::Transfer;
-use precompute::bvh::SceneBvh;
 use precompute::camera::Camera;
-use precompute::envmap::EnvMap;
-use precompute::image_io::{RgbImageF32, read_exr, write_exr, write_png};
-use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
+use precompute::image_io::{RgbImageF32, write_exr, write_png};
+use precompute::reference::SamplerKind;
 use precompute::scene::Scene;
+pub use reference::NoiseTarget;
+pub(crate) use reference::{ReferenceImages, ReferenceRequest, reference_images};
 use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
-use stats::{ErrorStats, Masks, error_stats};
+use stats::{ErrorStats, Masks, NoiseFloor, error_stats};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -37,6 +38,10 @@ pub struct ReportSettings {
     /// Indirect bounces of the reference (the bake has its own).
     pub bounces: u32,
     pub seed: u64,
+    pub sampler: SamplerKind,
+    /// Render each reference until its noise floor reaches this (see `ReferenceRequest`).
+    pub target_noise: Option<NoiseTarget>,
+    pub reference_time_limit: Option<f64>,
     /// Weber thresholds of the error-against-threshold plot.
     pub thresholds: Vec<f32>,
     /// Frames timed per method (median reported).
@@ -46,6 +51,19 @@ pub struct ReportSettings {
 }
 
 impl ReportSettings {
+    /// The reference these settings ask for, with the statistics' exposure.
+    pub(crate) fn reference_request(&self, exposure: f32) -> ReferenceRequest {
+        ReferenceRequest {
+            spp: self.spp,
+            bounces: self.bounces,
+            seed: self.seed,
+            sampler: self.sampler,
+            target_noise: self.target_noise,
+            max_seconds: self.reference_time_limit,
+            exposure,
+        }
+    }
+
     /// The settings `options` ask for at `camera`'s size; the reference's bounces default to
     /// the bake's, so both see the same light.
     pub fn new(options: &ReportOptions, camera: &Camera, transfer: &Transfer) -> Self {
@@ -55,6 +73,9 @@ impl ReportSettings {
             spp: options.spp,
             bounces: options.bounces.unwrap_or(transfer.settings.bounces),
             seed: options.seed,
+            sampler: options.sampler,
+            target_noise: options.target_noise,
+            reference_time_limit: options.reference_time_limit,
             thresholds: options.thresholds.clone(),
             frames: options.frames as usize,
             backend: options.backend,
@@ -121,6 +142,8 @@ pub struct MethodResult {
     pub method: String,
     #[serde(flatten)]
     pub stats: ErrorStats,
+    /// `relative_rmse` without the reference's variance (`stats::corrected_relative_rmse`).
+    pub relative_rmse_corrected: f64,
     pub lights: usize,
     pub decomposition_ms: f64,
     pub frame_ms: f64,
@@ -161,6 +184,12 @@ pub struct MapReport {
     pub exposure: f32,
     pub reference_cached: bool,
     pub reference_seconds: f64,
+    /// Samples per pixel of the reference, both halves together.
+    pub reference_spp: u32,
+    /// The reference's own noise in the statistics' units.
+    pub noise: NoiseFloor,
+    /// The floor is above `stats::NOISE_WARNING` of the best method's mean error.
+    pub noise_warning: bool,
     pub methods: Vec<MethodResult>,
     pub sweep: Vec<(String, Vec<SweepPoint>)>,
 }
@@ -175,81 +204,6 @@ pub struct Report {
     /// Reference direct visibility bounds (exclusive) of the penumbra region.
     pub penumbra_visibility: (f32, f32),
     pub maps: Vec<MapReport>,
-}
-
-/// Everything that determines a reference image, hashed: the cache key (the map by its
-/// content, so generated maps are cached too).
-fn reference_key(
-    scene: &Scene,
-    camera: &Camera,
-    map: &EnvMap,
-    rotation_deg: f32,
-    settings: &ReferenceSettings,
-) -> anyhow::Result<String> {
-    let mut hasher = blake3::Hasher::new();
-    hasher.update(b"hprt reference v2");
-    hasher.update(&scene.geometry.content_hash());
-    hasher.update(serde_json::to_string(camera)?.as_bytes());
-    hasher.update(&(map.width() as u64).to_le_bytes());
-    hasher.update(&(map.height() as u64).to_le_bytes());
-    hasher.update(bytemuck::cast_slice(map.texels()));
-    hasher.update(&rotation_deg.to_le_bytes());
-    hasher.update(serde_json::to_string(settings)?.as_bytes());
-    Ok(hasher.finalize().to_hex()[..24].to_owned())
-}
-
-/// The reference with its coverage and visibility, from the cache or rendered (then cached).
-pub(crate) struct ReferenceImages {
-    pub(crate) radiance: RgbImageF32,
-    pub(crate) coverage: Vec<f32>,
-    pub(crate) visibility: Vec<f32>,
-    pub(crate) cached: bool,
-    pub(crate) seconds: f64,
-}
-
-pub(crate) fn reference_images(
-    scene: &Scene,
-    camera: &Camera,
-    map: &EnvMap,
-    rotation_deg: f32,
-    settings: &ReferenceSettings,
-) -> anyhow::Result<ReferenceImages> {
-    let key = reference_key(scene, camera, map, rotation_deg, settings)?;
-    let dir = cache_dir().join("references");
-    let paths =
-        ["radiance", "coverage", "visibility"].map(|kind| dir.join(format!("{key}.{kind}.exr")));
-    if paths.iter().all(|p| p.exists()) {
-        let loaded = (|| -> anyhow::Result<ReferenceImages> {
-            Ok(ReferenceImages {
-                radiance: read_exr(&paths[0])?,
-                coverage: read_exr(&paths[1])?.pixels.iter().map(|p| p.x).collect(),
-                visibility: read_exr(&paths[2])?.pixels.iter().map(|p| p.x).collect(),
-                cached: true,
-                seconds: 0.0,
-            })
-        })();
-        if let Ok(images) = loaded {
-            return Ok(images);
-        }
-        log::warn!("the cached reference {key} is unreadable; rendering it again");
-    }
-    let start = Instant::now();
-    let bvh = SceneBvh::build(&scene.geometry.mesh);
-    let light = EnvironmentLight::new(map, rotation_deg);
-    let progress = TerminalProgress::new("reference rows");
-    let image = reference::render(&scene.geometry, &bvh, &light, camera, settings, &progress);
-    bake_cache::create_cache_folder(&dir)?;
-    let (w, h) = (camera.width as usize, camera.height as usize);
-    write_exr(&paths[0], &image.radiance)?;
-    write_exr(&paths[1], &RgbImageF32::from_grey(w, h, &image.coverage))?;
-    write_exr(&paths[2], &RgbImageF32::from_grey(w, h, &image.visibility))?;
-    Ok(ReferenceImages {
-        radiance: image.radiance,
-        coverage: image.coverage,
-        visibility: image.visibility,
-        cached: false,
-        seconds: start.elapsed().as_secs_f64(),
-    })
 }
 
 /// Renders with `lighting` and times `frames` frames (static lighting, median).
@@ -339,6 +293,10 @@ fn write_reference(dir: &Path, reference: &ReferenceImages, exposure: f32) -> an
     let (w, h) = (reference.radiance.width, reference.radiance.height);
     write_exr(&dir.join("reference.exr"), &reference.radiance)?;
     write_png(&dir.join("reference.png"), &reference.radiance, exposure)?;
+    // The two independent halves it averages: their difference is its noise floor.
+    for (k, half) in reference.halves.iter().enumerate() {
+        write_exr(&dir.join(format!("reference-half{k}.exr")), half)?;
+    }
     write_exr(
         &dir.join("reference-coverage.exr"),
         &RgbImageF32::from_grey(w, h, &reference.coverage),
@@ -381,29 +339,14 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
     let dir = job.out.join(&name);
     crate::support::create_folder(&dir)?;
 
-    let reference_settings = ReferenceSettings {
-        spp: job.settings.spp,
-        bounces: job.settings.bounces,
-        seed: job.settings.seed,
-    };
-    let reference = reference_images(job.scene, &job.camera, &map, rotation, &reference_settings)?;
-    if reference.cached {
-        println!("{name}: reference from the cache");
-    } else {
-        println!(
-            "{name}: reference ({}x{}, {} spp) rendered in {:.1} s",
-            job.camera.width, job.camera.height, job.settings.spp, reference.seconds
-        );
-    }
-    write_reference(&dir, &reference, exposure)?;
-    let masks = Masks::new(&reference.coverage, &reference.visibility);
-
+    // The methods first: a reference rendered to a share of the best method's error needs
+    // their images.
     job.renderer.set_environment(&map, rotation);
     let order = job.renderer.order();
     let mut lighting = EnvironmentLighting::new(&map, DecomposeSettings::default())?;
     lighting.set_rotation(rotation);
     let default_threshold = DecomposeSettings::default().threshold;
-    let mut methods = Vec::new();
+    let mut rendered = Vec::new();
     let mut images = Vec::new();
     for method in Method::ALL {
         let (frame, lights, decomposition_ms) =
@@ -415,15 +358,60 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
             &image,
             exposure,
         )?;
-        methods.push(MethodResult {
-            method: method.name().to_owned(),
-            stats: error_stats(&image, &reference.radiance, &masks, exposure),
-            lights,
-            decomposition_ms,
-            frame_ms,
-        });
+        rendered.push((method, lights, decomposition_ms, frame_ms));
         images.push(image);
     }
+
+    let request = job.settings.reference_request(exposure);
+    let best_error = |reference: &ReferenceImages| {
+        let masks = Masks::new(&reference.coverage, &reference.visibility);
+        images
+            .iter()
+            .map(|image| error_stats(image, &reference.radiance, &masks, exposure).mean)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let reference = reference_images(
+        job.scene,
+        &job.camera,
+        &map,
+        rotation,
+        &request,
+        &best_error,
+    )?;
+    let reference_spp = 2 * reference.samples_per_half;
+    let noise = reference.noise(exposure);
+    if reference.cached {
+        println!("{name}: reference from the cache ({reference_spp} spp)");
+    } else {
+        println!(
+            "{name}: reference ({}x{}, {reference_spp} spp) rendered in {:.1} s",
+            job.camera.width, job.camera.height, reference.seconds
+        );
+    }
+    println!(
+        "{name}: reference noise floor {:.5} (mean), {:.5} (shadow region)",
+        noise.mean, noise.shadow_mean
+    );
+    write_reference(&dir, &reference, exposure)?;
+    let masks = Masks::new(&reference.coverage, &reference.visibility);
+    let methods: Vec<MethodResult> = rendered
+        .iter()
+        .zip(&images)
+        .map(|(&(method, lights, decomposition_ms, frame_ms), image)| {
+            let stats = error_stats(image, &reference.radiance, &masks, exposure);
+            MethodResult {
+                method: method.name().to_owned(),
+                relative_rmse_corrected: stats::corrected_relative_rmse(
+                    stats.relative_rmse,
+                    &noise,
+                ),
+                stats,
+                lights,
+                decomposition_ms,
+                frame_ms,
+            }
+        })
+        .collect();
     write_heat_maps(&dir, &images, &reference.radiance, &masks, exposure)?;
 
     // Error against the Weber threshold, for both hybrid modes.
@@ -454,6 +442,21 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
         });
         sweep.push((method.name().to_owned(), points));
     }
+    let best = methods
+        .iter()
+        .map(|m| m.stats.mean)
+        .fold(f64::INFINITY, f64::min);
+    let noise_warning = stats::noise_dominates(&noise, best);
+    if noise_warning {
+        println!(
+            "warning: {name}: the reference's noise floor {:.5} is {:.0}% of the best method's \
+             mean error {best:.5}; the statistics measure the reference as much as the methods \
+             (raise --spp or pass --target-noise {:.5})",
+            noise.mean,
+            100.0 * noise.mean / best,
+            stats::NOISE_WARNING * best
+        );
+    }
     let svg = figures::threshold_plot(&name, &curves, methods[0].stats.mean)?;
     write_atomic(&dir.join("threshold.svg"), svg.as_bytes())?;
     Ok(MapReport {
@@ -464,6 +467,9 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
         exposure,
         reference_cached: reference.cached,
         reference_seconds: reference.seconds,
+        reference_spp,
+        noise,
+        noise_warning,
         methods,
         sweep,
     })
@@ -509,6 +515,9 @@ pub fn run_report(
                 exposure: 0.0,
                 reference_cached: false,
                 reference_seconds: 0.0,
+                reference_spp: 0,
+                noise: NoiseFloor::default(),
+                noise_warning: false,
                 methods: Vec::new(),
                 sweep: Vec::new(),
             }
@@ -555,12 +564,24 @@ fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
         "covered_pixels",
         "shadow_pixels",
         "penumbra_pixels",
+        "relative_rmse_corrected",
+        "reference_spp",
+        "noise_floor_mean",
+        "noise_floor_shadow_mean",
+        "noise_floor_relative_rmse",
+        "noise_warning",
     ])?;
     for map in &report.maps {
         if map.methods.is_empty() {
             writer.write_record([
                 map.name.as_str(),
                 map.status.name(),
+                "",
+                "",
+                "",
+                "",
+                "",
+                "",
                 "",
                 "",
                 "",
@@ -596,6 +617,12 @@ fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
                 s.covered_pixels.to_string(),
                 s.shadow_pixels.to_string(),
                 s.penumbra_pixels.to_string(),
+                format!("{:.6}", m.relative_rmse_corrected),
+                map.reference_spp.to_string(),
+                format!("{:.6}", map.noise.mean),
+                format!("{:.6}", map.noise.shadow_mean),
+                format!("{:.6}", map.noise.relative_rmse),
+                map.noise_warning.to_string(),
             ])?;
         }
     }

@@ -7,7 +7,7 @@
 
 use super::figures;
 use super::stats::{Masks, error_stats};
-use super::{ReportSettings, reference_images};
+use super::{ReferenceRequest, ReportSettings, reference_images};
 use crate::bake_cache;
 use crate::cli::ReportOptions;
 use crate::environment::{default_exposure, scene_rotation};
@@ -16,7 +16,6 @@ use base64::Engine;
 use precompute::atomic_file::write_atomic;
 use precompute::image_io::{RgbImageF32, to_display_rgb8, tonemap};
 use precompute::luminance;
-use precompute::reference::ReferenceSettings;
 use precompute::scene::Scene;
 use runtime::render::{GpuContext, RenderMode, Renderer, ShadowSettings};
 use runtime::{DecomposeSettings, EnvironmentLighting, TrackingSettings};
@@ -221,10 +220,9 @@ pub fn write_sequence_report(
         }
         None => None,
     };
-    let reference_settings = ReferenceSettings {
-        spp: settings.spp,
-        bounces: settings.bounces,
-        seed: settings.seed,
+    let request = ReferenceRequest {
+        target_noise: None,
+        ..settings.reference_request(exposure)
     };
     let mut frames = Vec::new();
     let mut previous: Option<(Vec<f32>, Vec<Vec<f32>>)> = None;
@@ -237,7 +235,8 @@ pub fn write_sequence_report(
         } else {
             sequence.frame(k)?
         };
-        let reference = reference_images(scene, &camera, &map, rotation, &reference_settings)?;
+        let reference =
+            reference_images(scene, &camera, &map, rotation, &request, &|_| f64::INFINITY)?;
         let masks = Masks::new(&reference.coverage, &reference.visibility);
         let reference_y = tonemapped_luminance(&reference.radiance, exposure);
         renderer.set_environment(&map, rotation);

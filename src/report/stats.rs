@@ -141,10 +141,105 @@ pub fn error_stats(
     }
 }
 
+/// The reference's own noise in the statistics' units (CONVENTIONS.md, "The reference's
+/// noise"), from its two independent halves `a` and `b` (the reference is their mean).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct NoiseFloor {
+    /// Mean over covered pixels of `|Y(T(a)) − Y(T(b))| / 2`: the expected distance of the
+    /// reference from the truth (for Gaussian noise `E|r − t| = E|a − b| / 2`), which every
+    /// method's `mean` includes.
+    pub mean: f64,
+    /// The same over the shadow region and the penumbra region (NaN when empty).
+    pub shadow_mean: f64,
+    pub penumbra_mean: f64,
+    /// `√(mean Var(r)) / mean r` with `Var(r) = (Y(a) − Y(b))² / 4` per pixel: the part of
+    /// every `relative_rmse²` that is the reference's variance.
+    pub relative_rmse: f64,
+}
+
+/// The noise floor of a reference made of the halves `a` and `b`.
+pub fn noise_floor(a: &RgbImageF32, b: &RgbImageF32, masks: &Masks, exposure: f32) -> NoiseFloor {
+    let differences: Vec<f64> = error_image(a, b, exposure)
+        .iter()
+        .map(|d| 0.5 * *d as f64)
+        .collect();
+    let masked_mean = |mask: &[bool]| {
+        mean_std(
+            mask.iter()
+                .zip(&differences)
+                .filter(|(m, _)| **m)
+                .map(|(_, d)| *d),
+        )
+        .0
+    };
+    let (mut variance, mut reference_sum, mut n) = (0.0f64, 0.0f64, 0usize);
+    for ((x, y), _) in a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .zip(&masks.covered)
+        .filter(|(_, c)| **c)
+    {
+        let (lx, ly) = (luminance(*x) as f64, luminance(*y) as f64);
+        variance += (lx - ly).powi(2) / 4.0;
+        reference_sum += 0.5 * (lx + ly);
+        n += 1;
+    }
+    let n = n.max(1) as f64;
+    NoiseFloor {
+        mean: masked_mean(&masks.covered),
+        shadow_mean: masked_mean(&masks.shadow),
+        penumbra_mean: masked_mean(&masks.penumbra),
+        relative_rmse: (variance / n).sqrt() / (reference_sum / n).max(1e-12),
+    }
+}
+
+/// A method's relative RMSE with the reference's variance taken out, exactly for squared
+/// errors: `E[(m − r)²] − Var(r)` (clamped at 0).
+pub fn corrected_relative_rmse(relative_rmse: f64, floor: &NoiseFloor) -> f64 {
+    (relative_rmse.powi(2) - floor.relative_rmse.powi(2))
+        .max(0.0)
+        .sqrt()
+}
+
+/// Whether the floor is a large part of what the report measures: above `NOISE_WARNING` of the
+/// best method's mean error.
+pub fn noise_dominates(floor: &NoiseFloor, best_mean: f64) -> bool {
+    floor.mean > NOISE_WARNING * best_mean
+}
+
+/// The share of the best method's mean error above which a report warns about the floor.
+pub const NOISE_WARNING: f64 = 0.2;
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use precompute::Rgb;
+
+    /// Halves that differ by known amounts: the floor is half their tone-mapped difference,
+    /// and the corrected RMSE removes exactly the variance `(a − b)² / 4`.
+    #[test]
+    fn noise_floor_of_known_halves() {
+        let a = RgbImageF32::new(2, 1, vec![Rgb::splat(1.0), Rgb::splat(2.0)]);
+        let b = RgbImageF32::new(2, 1, vec![Rgb::splat(3.0), Rgb::splat(2.0)]);
+        let masks = Masks::new(&[1.0, 1.0], &[0.2, 1.0]);
+        let floor = noise_floor(&a, &b, &masks, 1.0);
+        let tonemapped = |l: f64| 1.0 - (-l).exp();
+        let d = (tonemapped(3.0) - tonemapped(1.0)) / 2.0;
+        assert!((floor.mean - d / 2.0).abs() < 1e-6, "{floor:?}");
+        assert!((floor.shadow_mean - d).abs() < 1e-6);
+        // Visibility 0.2 is in the penumbra too.
+        assert!((floor.penumbra_mean - d).abs() < 1e-6);
+        // Var = (1 − 3)² / 4 = 1 and 0: √(1/2) over a mean of 2.
+        let expected = 0.5f64.sqrt() / 2.0;
+        assert!((floor.relative_rmse - expected).abs() < 1e-6);
+        let corrected = corrected_relative_rmse(1.0, &floor);
+        assert!((corrected - (1.0 - expected * expected).sqrt()).abs() < 1e-9);
+        assert_eq!(corrected_relative_rmse(0.1, &floor), 0.0);
+        // The floor at 21% of the best error warns, at 19% it does not.
+        assert!(noise_dominates(&floor, floor.mean / 0.21));
+        assert!(!noise_dominates(&floor, floor.mean / 0.19));
+    }
 
     #[test]
     fn percentile_ignores_uncovered_pixels() {

@@ -13,13 +13,18 @@ pub struct EnvSampler {
     height: usize,
     /// `height + 1` entries, from 0 to 1.
     marginal_cdf: Vec<f32>,
+    marginal_guide: Vec<u32>,
     /// `height` rows of `width + 1` entries, each from 0 to 1.
     conditional_cdf: Vec<f32>,
+    /// `height` rows of `width` entries.
+    conditional_guide: Vec<u32>,
     /// Probability of each texel (sums to 1).
     texel_probability: Vec<f32>,
 }
 
-/// Index `k` with `cdf[k] <= x < cdf[k + 1]`, and where `x` falls inside that interval.
+/// Index `k` with `cdf[k] <= x < cdf[k + 1]`, and where `x` falls inside that interval, by
+/// bisection: what [`invert_guided`] must agree with.
+#[cfg(test)]
 fn invert_cdf(cdf: &[f32], x: f32) -> (usize, f32) {
     let n = cdf.len() - 1;
     let k = cdf
@@ -27,6 +32,44 @@ fn invert_cdf(cdf: &[f32], x: f32) -> (usize, f32) {
         .saturating_sub(1)
         .min(n - 1);
     // Skip empty intervals (possible when x lands exactly on a plateau edge).
+    let width = cdf[k + 1] - cdf[k];
+    let t = if width > 0.0 {
+        ((x - cdf[k]) / width).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    (k, t)
+}
+
+/// A guide table for inverting `cdf` (Chen and Asau's cutpoint method): entry b is the
+/// interval holding `b / m`, so inversion starts next to its answer instead of bisecting.
+fn guide_table(cdf: &[f32]) -> Vec<u32> {
+    let n = cdf.len() - 1;
+    let mut k = 0usize;
+    (0..n)
+        .map(|b| {
+            let lower = b as f32 / n as f32;
+            while k + 1 < n && cdf[k + 1] <= lower {
+                k += 1;
+            }
+            k as u32
+        })
+        .collect()
+}
+
+/// [`invert_cdf`] through `guide` (from [`guide_table`]): the same answer, in a step or two.
+#[inline]
+fn invert_guided(cdf: &[f32], guide: &[u32], x: f32) -> (usize, f32) {
+    let n = cdf.len() - 1;
+    let bucket = ((x * n as f32) as usize).min(n - 1);
+    let mut k = guide[bucket] as usize;
+    // Rounding can put x in a neighbouring bucket: walk to the last k with cdf[k] <= x.
+    while k > 0 && cdf[k] > x {
+        k -= 1;
+    }
+    while k + 1 < n && cdf[k + 1] <= x {
+        k += 1;
+    }
     let width = cdf[k + 1] - cdf[k];
     let t = if width > 0.0 {
         ((x - cdf[k]) / width).clamp(0.0, 1.0)
@@ -60,6 +103,7 @@ impl EnvSampler {
     pub fn new(map: &EnvMap) -> Option<Self> {
         let (w, h) = (map.width(), map.height());
         let mut conditional_cdf = Vec::with_capacity(h * (w + 1));
+        let mut conditional_guide = Vec::with_capacity(h * w);
         let mut row_weights = Vec::with_capacity(h);
         let mut texel_weights = Vec::with_capacity(w * h);
         for j in 0..h {
@@ -68,6 +112,7 @@ impl EnvSampler {
                 .map(|i| luminance(map.texel(i, j)).max(0.0) as f64 * sin_theta)
                 .collect();
             let (cdf, total) = normalised_cdf(&weights);
+            conditional_guide.extend(guide_table(&cdf));
             conditional_cdf.extend(cdf);
             row_weights.push(total);
             texel_weights.extend(weights);
@@ -79,8 +124,10 @@ impl EnvSampler {
         Some(Self {
             width: w,
             height: h,
+            marginal_guide: guide_table(&marginal_cdf),
             marginal_cdf,
             conditional_cdf,
+            conditional_guide,
             texel_probability: texel_weights.iter().map(|x| (x / total) as f32).collect(),
         })
     }
@@ -98,26 +145,52 @@ impl EnvSampler {
 
     /// A direction (in the map's own frame) drawn with density [`Self::pdf`], and that density.
     pub fn sample(&self, u: Vec2) -> (Vec3, f32) {
-        let (j, tv) = invert_cdf(&self.marginal_cdf, u.y);
+        let (w, pdf, _) = self.sample_texel(u);
+        (w, pdf)
+    }
+
+    /// [`Self::sample`], with the index `j · width + i` of the texel drawn (its radiance is
+    /// the map's there, so the caller need not look the direction up again).
+    pub fn sample_texel(&self, u: Vec2) -> (Vec3, f32, usize) {
+        let (j, tv) = invert_guided(&self.marginal_cdf, &self.marginal_guide, u.y);
         let row = &self.conditional_cdf[j * (self.width + 1)..(j + 1) * (self.width + 1)];
-        let (i, tu) = invert_cdf(row, u.x);
+        let guide = &self.conditional_guide[j * self.width..(j + 1) * self.width];
+        let (i, tu) = invert_guided(row, guide, u.x);
         let uu = (i as f32 + tu) / self.width as f32;
         // Keep off the poles, where the density is zero (a measure-zero event, but
         // Hammersley point 0 hits it exactly).
         let vv = (j as f32 + tv.clamp(1e-4, 1.0 - 1e-4)) / self.height as f32;
         let w = direction_of_uv(uu, vv);
-        let p = self.texel_probability[j * self.width + i];
-        (w, self.density(p, (PI * vv).sin()))
+        let texel = j * self.width + i;
+        let p = self.texel_probability[texel];
+        (w, self.density(p, (PI * vv).sin()), texel)
     }
 
     /// Solid-angle density of sampling direction `w` (map frame).
     pub fn pdf(&self, w: Vec3) -> f32 {
+        self.pdf_of_texel(w, self.texel_index(w))
+    }
+
+    /// The index of the texel `w` falls in (as `EnvMap::texel_of`).
+    #[inline]
+    pub fn texel_index(&self, w: Vec3) -> usize {
         let (u, v) = uv_of_direction(w);
         let i = ((u * self.width as f32) as usize).min(self.width - 1);
         let j = ((v * self.height as f32) as usize).min(self.height - 1);
+        j * self.width + i
+    }
+
+    /// The density of every direction in `texel` times its `sin θ`: `pdf = factor / sin θ`.
+    pub fn texel_density_factor(&self, texel: usize) -> f32 {
+        self.density(self.texel_probability[texel], 1.0)
+    }
+
+    /// The density of `w`, already located in `texel`.
+    #[inline]
+    pub fn pdf_of_texel(&self, w: Vec3, texel: usize) -> f32 {
         // From x and z, which keep their precision near the poles (unlike 1 - y²).
         let sin_theta = (w.x * w.x + w.z * w.z).sqrt();
-        self.density(self.texel_probability[j * self.width + i], sin_theta)
+        self.density(self.texel_probability[texel], sin_theta)
     }
 }
 
@@ -161,6 +234,36 @@ mod tests {
             (estimate - exact).abs() < 5e-3 * exact,
             "{estimate} vs {exact}"
         );
+    }
+
+    /// The guide table changes the speed of inversion, not its answer: on a CDF with steep
+    /// steps and plateaus, every x maps as bisection maps it.
+    #[test]
+    fn guided_inversion_equals_bisection() {
+        let weights: Vec<f64> = (0..200)
+            .map(|i| match i % 17 {
+                0 => 50.0,
+                3..=6 => 0.0,
+                k => k as f64 * 0.1,
+            })
+            .collect();
+        let (cdf, _) = normalised_cdf(&weights);
+        let guide = guide_table(&cdf);
+        for k in 0..100_000 {
+            let x = (k as f32 + 0.5) / 100_000.0;
+            assert_eq!(
+                invert_guided(&cdf, &guide, x),
+                invert_cdf(&cdf, x),
+                "x = {x}"
+            );
+        }
+        for x in cdf.iter().copied().filter(|x| *x < 1.0) {
+            assert_eq!(
+                invert_guided(&cdf, &guide, x),
+                invert_cdf(&cdf, x),
+                "x = {x}"
+            );
+        }
     }
 
     #[test]

@@ -4,21 +4,35 @@
 use crate::color::Rgb;
 use crate::envmap::sampling::EnvSampler;
 use crate::envmap::{EnvMap, rotate_y};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// Distant lighting `L(ω) = map(R_y(−rotation) ω)` (CONVENTIONS.md, "Rotating an environment").
 pub struct EnvironmentLight<'a> {
     map: &'a EnvMap,
     sampler: Option<EnvSampler>,
+    /// Per texel: its radiance and its sampling density times `sin θ`, side by side, so a
+    /// path escaping the scene reads one cache line for both.
+    texels: Vec<Vec4>,
     rotation: f32,
 }
 
 impl<'a> EnvironmentLight<'a> {
     /// `rotation_deg` turns the map about +Y, counter-clockwise seen from above.
     pub fn new(map: &'a EnvMap, rotation_deg: f32) -> Self {
+        let sampler = EnvSampler::new(map);
+        let texels = map
+            .texels()
+            .iter()
+            .enumerate()
+            .map(|(k, l)| {
+                let factor = sampler.as_ref().map_or(0.0, |s| s.texel_density_factor(k));
+                Vec4::new(l.x, l.y, l.z, factor)
+            })
+            .collect();
         Self {
             map,
-            sampler: EnvSampler::new(map),
+            sampler,
+            texels,
             rotation: rotation_deg.to_radians(),
         }
     }
@@ -37,8 +51,37 @@ impl<'a> EnvironmentLight<'a> {
     /// `None` for a black environment.
     #[inline]
     pub fn sample(&self, u: Vec2) -> Option<(Vec3, f32)> {
-        let (w, pdf) = self.sampler.as_ref()?.sample(u);
-        (pdf > 0.0).then(|| (rotate_y(w, self.rotation), pdf))
+        self.sample_with_radiance(u).map(|(w, pdf, _)| (w, pdf))
+    }
+
+    /// [`Self::sample`] with the radiance arriving from the direction drawn (one lookup).
+    #[inline]
+    pub fn sample_with_radiance(&self, u: Vec2) -> Option<(Vec3, f32, Rgb)> {
+        let (w, pdf, texel) = self.sampler.as_ref()?.sample_texel(u);
+        (pdf > 0.0).then(|| {
+            (
+                rotate_y(w, self.rotation),
+                pdf,
+                self.texels[texel].truncate(),
+            )
+        })
+    }
+
+    /// The radiance arriving from world direction `w` and the density of sampling it (one
+    /// lookup for both: what a path escaping along `w` needs).
+    #[inline]
+    pub fn radiance_and_pdf(&self, w: Vec3) -> (Rgb, f32) {
+        let local = rotate_y(w, -self.rotation);
+        let (i, j) = self.map.texel_of(local);
+        let texel = self.texels[j * self.map.width() + i];
+        // From x and z, which keep their precision near the poles (unlike 1 − y²).
+        let sin_theta = (local.x * local.x + local.z * local.z).sqrt();
+        let pdf = if sin_theta > 0.0 {
+            texel.w / sin_theta
+        } else {
+            0.0
+        };
+        (texel.truncate(), pdf)
     }
 
     /// Density of [`Self::sample`] producing world direction `w`.
@@ -69,5 +112,18 @@ mod tests {
         assert_eq!(light.radiance(Vec3::NEG_Z), Rgb::splat(0.1));
         let (w, pdf) = light.sample(Vec2::new(0.5, 0.5)).unwrap();
         assert!((pdf - light.pdf(w)).abs() < 1e-3 * pdf);
+        // The one-lookup forms agree with the separate ones.
+        for u in [
+            Vec2::new(0.1, 0.2),
+            Vec2::new(0.7, 0.55),
+            Vec2::new(0.93, 0.9),
+        ] {
+            let (w, pdf, radiance) = light.sample_with_radiance(u).unwrap();
+            assert_eq!(radiance, light.radiance(w));
+            let (escaped, escaped_pdf) = light.radiance_and_pdf(w);
+            assert_eq!(escaped, radiance);
+            assert!((escaped_pdf - light.pdf(w)).abs() < 1e-6 * escaped_pdf);
+            assert!((pdf - light.pdf(w)).abs() < 1e-3 * pdf);
+        }
     }
 }

@@ -2,13 +2,13 @@
 //! multiple importance sampling (power heuristic) with cosine-weighted sampling of the surface.
 
 use super::environment::EnvironmentLight;
+use super::sampler::PathSampler;
 use crate::bake::RAY_OFFSET_FRACTION;
 use crate::bvh::{Hit, SceneBvh, Skip};
 use crate::color::{Rgb, luminance};
 use crate::sampling::{Frame, cosine_hemisphere};
 use crate::scene::SceneMesh;
-use glam::{Vec2, Vec3};
-use rand_core::Rng;
+use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
 
 /// A shading point.
@@ -42,16 +42,6 @@ pub struct Integrator<'a> {
     pub bounces: u32,
     offset: f32,
     front_normals: Vec<Vec3>,
-}
-
-/// Uniform numbers in `[0, 1)` from a PCG stream.
-#[inline]
-fn next_2d(rng: &mut impl Rng) -> Vec2 {
-    let scale = 1.0 / (1u32 << 24) as f32;
-    Vec2::new(
-        (rng.next_u32() >> 8) as f32 * scale,
-        (rng.next_u32() >> 8) as f32 * scale,
-    )
 }
 
 #[inline]
@@ -140,7 +130,7 @@ impl<'a> Integrator<'a> {
     pub fn radiance(
         &self,
         start: &SurfacePoint,
-        rng: &mut impl Rng,
+        sampler: &mut impl PathSampler,
         rays: &mut u64,
     ) -> (Rgb, DirectVisibility) {
         let mut radiance = Rgb::ZERO;
@@ -151,10 +141,9 @@ impl<'a> Integrator<'a> {
         for depth in 0..=self.bounces {
             let n = point.shading_normal;
             // Next-event estimation toward the environment.
-            if let Some((w, pdf_light)) = self.light.sample(next_2d(rng)) {
+            if let Some((w, pdf_light, le)) = self.light.sample_with_radiance(sampler.next_2d()) {
                 let cos = n.dot(w);
                 if cos > 0.0 {
-                    let le = self.light.radiance(w);
                     *rays += 1;
                     let visible = !self.occluded(&point, w);
                     if depth == 0 {
@@ -173,20 +162,24 @@ impl<'a> Integrator<'a> {
             }
             // Cosine-weighted continuation; on escape it is the other MIS strategy for the
             // environment.
-            let w = Frame::from_normal(n).to_world(cosine_hemisphere(next_2d(rng)));
+            let w = Frame::from_normal(n).to_world(cosine_hemisphere(sampler.next_2d()));
             let pdf_surface = n.dot(w).max(0.0) * FRAC_1_PI;
-            let escape_weight = |w: Vec3| power_heuristic(pdf_surface, self.light.pdf(w));
+            // The environment seen along an escaping continuation, MIS-weighted.
+            let escaped = |w: Vec3| {
+                let (le, pdf_light) = self.light.radiance_and_pdf(w);
+                le * power_heuristic(pdf_surface, pdf_light)
+            };
             *rays += 1;
             if depth == self.bounces {
                 // Only whether it escapes matters: an occlusion ray suffices.
                 if !self.occluded(&point, w) {
-                    radiance += throughput * self.light.radiance(w) * escape_weight(w);
+                    radiance += throughput * escaped(w);
                 }
                 break;
             }
             match self.trace(&point, w) {
                 None => {
-                    radiance += throughput * self.light.radiance(w) * escape_weight(w);
+                    radiance += throughput * escaped(w);
                     break;
                 }
                 Some(hit) => {

@@ -9,9 +9,11 @@
 
 mod environment;
 mod integrator;
+mod sampler;
 
 pub use environment::EnvironmentLight;
 pub use integrator::{DirectVisibility, Integrator, SurfacePoint};
+pub use sampler::{MAX_SOBOL_SAMPLES, PathSampler, PixelSampler, SamplerKind, SobolSampler};
 
 use crate::bvh::SceneBvh;
 use crate::camera::Camera;
@@ -32,6 +34,36 @@ pub struct ReferenceSettings {
     /// Indirect bounces, as in the bake (0: shadowed direct lighting).
     pub bounces: u32,
     pub seed: u64,
+    pub sampler: SamplerKind,
+    /// Index of the first sample: a pass with `first_sample = n` continues one of `n` samples
+    /// (same seed and sampler), so the two can be averaged weighted by their counts.
+    pub first_sample: u32,
+}
+
+impl ReferenceSettings {
+    /// `spp` samples from the start of the sequence with the default sampler.
+    pub fn new(spp: u32, bounces: u32, seed: u64) -> Self {
+        Self {
+            spp,
+            bounces,
+            seed,
+            sampler: SamplerKind::default(),
+            first_sample: 0,
+        }
+    }
+
+    /// Sobol sequences are 2^16 points long.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.sampler == SamplerKind::Sobol
+            && u64::from(self.first_sample) + u64::from(self.spp) > u64::from(MAX_SOBOL_SAMPLES)
+        {
+            return Err(format!(
+                "the sobol sampler takes at most {MAX_SOBOL_SAMPLES} samples per pixel, {} asked",
+                u64::from(self.first_sample) + u64::from(self.spp)
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// The rendered images.
@@ -100,11 +132,17 @@ pub fn render(
                     continue;
                 };
                 let point = integrator.surface(&hit);
-                let mut rng = stream(settings.seed, (j * width + i) as u64);
+                let mut sampler = PixelSampler::for_pass(
+                    settings.sampler,
+                    settings.seed,
+                    (j * width + i) as u64,
+                    settings.first_sample,
+                );
                 let mut sum = Rgb::ZERO;
                 let mut direct = DirectVisibility::default();
                 for _ in 0..settings.spp {
-                    let (l, d) = integrator.radiance(&point, &mut rng, &mut row.3);
+                    let (l, d) = integrator.radiance(&point, &mut sampler, &mut row.3);
+                    sampler.next_sample();
                     sum += l;
                     direct.visible += d.visible;
                     direct.unoccluded += d.unoccluded;

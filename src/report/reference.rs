@@ -1,0 +1,412 @@
+//! The reports' reference: two independent halves, whose difference measures its own noise
+//! (CONVENTIONS.md, "The reference's noise"), cached with their sample counts so that a later,
+//! stricter request continues them instead of starting over.
+
+use super::stats::{Masks, NoiseFloor, noise_floor};
+use crate::bake_cache::{self, cache_dir};
+use crate::support::TerminalProgress;
+use precompute::bvh::SceneBvh;
+use precompute::camera::Camera;
+use precompute::envmap::EnvMap;
+use precompute::image_io::{RgbImageF32, read_exr, write_exr};
+use precompute::progress::Progress;
+use precompute::reference::{
+    self, EnvironmentLight, MAX_SOBOL_SAMPLES, ReferenceImage, ReferenceSettings, SamplerKind,
+};
+use precompute::scene::Scene;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// How quiet the reference must get: a noise floor (in the mean error's units), or a share of
+/// the best method's mean error against the reference itself (written `20%`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub enum NoiseTarget {
+    Absolute(f64),
+    ShareOfBest(f64),
+}
+
+impl std::str::FromStr for NoiseTarget {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let text = text.trim();
+        let (number, share) = match text.strip_suffix('%') {
+            Some(percent) => (percent, true),
+            None => (text, false),
+        };
+        match number.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() && v > 0.0 && share => Ok(Self::ShareOfBest(v / 100.0)),
+            Ok(v) if v.is_finite() && v > 0.0 => Ok(Self::Absolute(v)),
+            _ => Err(format!(
+                "expected a noise floor above 0 (0.001) or a share of the best method's error \
+                 (20%), got {text:?}"
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for NoiseTarget {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Absolute(v) => write!(f, "{v}"),
+            Self::ShareOfBest(s) => write!(f, "{}% of the best method's error", s * 100.0),
+        }
+    }
+}
+
+/// What the reference must reach.
+#[derive(Debug, Clone, Copy)]
+pub struct ReferenceRequest {
+    /// Samples per pixel at least, both halves together.
+    pub spp: u32,
+    pub bounces: u32,
+    pub seed: u64,
+    pub sampler: SamplerKind,
+    /// Keep doubling the samples until the noise floor (mean statistic) reaches this.
+    pub target_noise: Option<NoiseTarget>,
+    /// Stop doubling when the next pass would end later than this many seconds.
+    pub max_seconds: Option<f64>,
+    /// Tone-mapping exposure of the statistics (the floor is in their units).
+    pub exposure: f32,
+}
+
+/// The reference with its coverage, visibility and halves.
+pub(crate) struct ReferenceImages {
+    /// The mean of the two halves.
+    pub(crate) radiance: RgbImageF32,
+    pub(crate) halves: [RgbImageF32; 2],
+    pub(crate) coverage: Vec<f32>,
+    pub(crate) visibility: Vec<f32>,
+    pub(crate) samples_per_half: u32,
+    /// Nothing had to be rendered.
+    pub(crate) cached: bool,
+    /// Seconds spent rendering now.
+    pub(crate) seconds: f64,
+}
+
+impl ReferenceImages {
+    /// The noise floor of the statistics on this reference.
+    pub(crate) fn noise(&self, exposure: f32) -> NoiseFloor {
+        let masks = Masks::new(&self.coverage, &self.visibility);
+        noise_floor(&self.halves[0], &self.halves[1], &masks, exposure)
+    }
+}
+
+/// The seed of half `k` (0 or 1): independent streams and scrambles.
+fn half_seed(seed: u64, k: usize) -> u64 {
+    if k == 0 {
+        seed
+    } else {
+        seed ^ 0x9e37_79b9_7f4a_7c15
+    }
+}
+
+/// Everything that determines the reference's samples, hashed: the cache key (the map by its
+/// content, so generated maps are cached too). The sample count is not in it: more samples
+/// continue the same sequence.
+fn reference_key(
+    scene: &Scene,
+    camera: &Camera,
+    map: &EnvMap,
+    rotation_deg: f32,
+    request: &ReferenceRequest,
+) -> anyhow::Result<String> {
+    let mut hasher = blake3::Hasher::new();
+    hasher.update(b"hprt reference v3 (halves)");
+    hasher.update(&scene.geometry.content_hash());
+    hasher.update(serde_json::to_string(camera)?.as_bytes());
+    hasher.update(&(map.width() as u64).to_le_bytes());
+    hasher.update(&(map.height() as u64).to_le_bytes());
+    hasher.update(bytemuck::cast_slice(map.texels()));
+    hasher.update(&rotation_deg.to_le_bytes());
+    hasher.update(&request.bounces.to_le_bytes());
+    hasher.update(&request.seed.to_le_bytes());
+    hasher.update(request.sampler.name().as_bytes());
+    Ok(hasher.finalize().to_hex()[..24].to_owned())
+}
+
+#[derive(serde::Serialize, serde::Deserialize)]
+struct CacheMeta {
+    samples_per_half: u32,
+}
+
+struct CachePaths {
+    halves: [PathBuf; 2],
+    coverage: PathBuf,
+    visibility: PathBuf,
+    meta: PathBuf,
+}
+
+impl CachePaths {
+    fn new(key: &str) -> Self {
+        let dir = cache_dir().join("references");
+        let file = |kind: &str| dir.join(format!("{key}.{kind}"));
+        Self {
+            halves: [file("half0.exr"), file("half1.exr")],
+            coverage: file("coverage.exr"),
+            visibility: file("visibility.exr"),
+            meta: file("json"),
+        }
+    }
+
+    fn load(&self) -> anyhow::Result<ReferenceImages> {
+        let meta: CacheMeta = serde_json::from_slice(&std::fs::read(&self.meta)?)?;
+        let halves = [read_exr(&self.halves[0])?, read_exr(&self.halves[1])?];
+        Ok(ReferenceImages {
+            radiance: mean_image(&halves[0], &halves[1]),
+            halves,
+            coverage: read_exr(&self.coverage)?
+                .pixels
+                .iter()
+                .map(|p| p.x)
+                .collect(),
+            visibility: read_exr(&self.visibility)?
+                .pixels
+                .iter()
+                .map(|p| p.x)
+                .collect(),
+            samples_per_half: meta.samples_per_half,
+            cached: true,
+            seconds: 0.0,
+        })
+    }
+
+    /// Writes the images, then the sample count that makes them a cache entry.
+    fn store(&self, images: &ReferenceImages) -> anyhow::Result<()> {
+        bake_cache::create_cache_folder(self.meta.parent().expect("a cache folder"))?;
+        let (w, h) = (images.radiance.width, images.radiance.height);
+        let _ = std::fs::remove_file(&self.meta);
+        write_exr(&self.halves[0], &images.halves[0])?;
+        write_exr(&self.halves[1], &images.halves[1])?;
+        write_exr(
+            &self.coverage,
+            &RgbImageF32::from_grey(w, h, &images.coverage),
+        )?;
+        write_exr(
+            &self.visibility,
+            &RgbImageF32::from_grey(w, h, &images.visibility),
+        )?;
+        let meta = CacheMeta {
+            samples_per_half: images.samples_per_half,
+        };
+        precompute::atomic_file::write_atomic(&self.meta, &serde_json::to_vec(&meta)?)?;
+        Ok(())
+    }
+}
+
+fn mean_image(a: &RgbImageF32, b: &RgbImageF32) -> RgbImageF32 {
+    let pixels = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(x, y)| (*x + *y) * 0.5)
+        .collect();
+    RgbImageF32::new(a.width, a.height, pixels)
+}
+
+/// `(a n + b k) / (n + k)` per pixel.
+fn weighted(a: &[f32], n: u32, b: &[f32], k: u32) -> Vec<f32> {
+    let (n, k) = (n as f32, k as f32);
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| (a * n + b * k) / (n + k))
+        .collect()
+}
+
+fn weighted_image(a: &RgbImageF32, n: u32, b: &RgbImageF32, k: u32) -> RgbImageF32 {
+    let (nf, kf) = (n as f32, k as f32);
+    let pixels = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(x, y)| (*x * nf + *y * kf) / (nf + kf))
+        .collect();
+    RgbImageF32::new(a.width, a.height, pixels)
+}
+
+/// What a reference shows: the scene through the camera under the turned map.
+struct View<'a> {
+    scene: &'a Scene,
+    camera: &'a Camera,
+    map: &'a EnvMap,
+    rotation_deg: f32,
+}
+
+/// Renders samples `[first, first + count)` of both halves and merges them into `current`.
+fn render_pass(
+    view: &View,
+    request: &ReferenceRequest,
+    current: Option<ReferenceImages>,
+    count: u32,
+    progress: &dyn Progress,
+) -> ReferenceImages {
+    let (scene, camera) = (view.scene, view.camera);
+    let bvh = SceneBvh::build(&scene.geometry.mesh);
+    let light = EnvironmentLight::new(view.map, view.rotation_deg);
+    let first = current.as_ref().map_or(0, |c| c.samples_per_half);
+    let passes: Vec<ReferenceImage> = (0..2)
+        .map(|k| {
+            let settings = ReferenceSettings {
+                sampler: request.sampler,
+                first_sample: first,
+                ..ReferenceSettings::new(count, request.bounces, half_seed(request.seed, k))
+            };
+            reference::render(&scene.geometry, &bvh, &light, camera, &settings, progress)
+        })
+        .collect();
+    let [a, b]: [ReferenceImage; 2] = passes.try_into().ok().expect("two halves");
+    let visibility: Vec<f32> = a
+        .visibility
+        .iter()
+        .zip(&b.visibility)
+        .map(|(x, y)| 0.5 * (x + y))
+        .collect();
+    let (halves, visibility) = match current {
+        None => ([a.radiance, b.radiance], visibility),
+        Some(c) => (
+            [
+                weighted_image(&c.halves[0], first, &a.radiance, count),
+                weighted_image(&c.halves[1], first, &b.radiance, count),
+            ],
+            weighted(&c.visibility, first, &visibility, count),
+        ),
+    };
+    ReferenceImages {
+        radiance: mean_image(&halves[0], &halves[1]),
+        halves,
+        coverage: a.coverage,
+        visibility,
+        samples_per_half: first + count,
+        cached: false,
+        seconds: 0.0,
+    }
+}
+
+/// The reference `request` asks for: from the cache, continued from it, or rendered (then
+/// cached). `best_error` gives the best method's mean error against a reference, for a
+/// target relative to it.
+pub(crate) fn reference_images(
+    scene: &Scene,
+    camera: &Camera,
+    map: &EnvMap,
+    rotation_deg: f32,
+    request: &ReferenceRequest,
+    best_error: &dyn Fn(&ReferenceImages) -> f64,
+) -> anyhow::Result<ReferenceImages> {
+    let key = reference_key(scene, camera, map, rotation_deg, request)?;
+    let paths = CachePaths::new(&key);
+    let mut current = if paths.meta.exists() {
+        match paths.load() {
+            Ok(images) => Some(images),
+            Err(e) => {
+                log::warn!("the cached reference {key} is unreadable ({e:#}); rendering it again");
+                None
+            }
+        }
+    } else {
+        None
+    };
+    let limit = match request.sampler {
+        SamplerKind::Sobol => MAX_SOBOL_SAMPLES,
+        SamplerKind::Independent => u32::MAX / 2,
+    };
+    let start = Instant::now();
+    let mut rendered = false;
+    let mut seconds_per_sample = None;
+    // One pass of `count` more samples per half, and the seconds each took.
+    let pass = |current: Option<ReferenceImages>, count: u32, label: String| {
+        println!("reference: {label}");
+        let progress = TerminalProgress::new("reference rows");
+        progress.status(&label);
+        let pass_start = Instant::now();
+        let view = View {
+            scene,
+            camera,
+            map,
+            rotation_deg,
+        };
+        let images = render_pass(&view, request, current, count, &progress);
+        (
+            images,
+            pass_start.elapsed().as_secs_f64() / f64::from(count),
+        )
+    };
+    let wanted = request.spp.div_ceil(2).max(1);
+    let have = current.as_ref().map_or(0, |c| c.samples_per_half);
+    if have < wanted {
+        let label = format!("2 × {have} → 2 × {wanted} spp");
+        let (images, per_sample) = pass(current, wanted - have, label);
+        current = Some(images);
+        seconds_per_sample = Some(per_sample);
+        rendered = true;
+    }
+    let mut images = current.expect("rendered or cached");
+    if let Some(wanted) = request.target_noise {
+        loop {
+            let target = match wanted {
+                NoiseTarget::Absolute(t) => t,
+                NoiseTarget::ShareOfBest(share) => share * best_error(&images),
+            };
+            let floor = images.noise(request.exposure).mean;
+            let n = images.samples_per_half;
+            if floor <= target || n >= limit {
+                break;
+            }
+            // Noise falls at least as 1/√n: the samples that should reach the target.
+            let needed = (f64::from(n) * (floor / target).powi(2)).ceil();
+            let next = (2 * n).min(limit);
+            if let (Some(max), Some(per_sample)) = (request.max_seconds, seconds_per_sample) {
+                let elapsed = start.elapsed().as_secs_f64();
+                if elapsed + per_sample * f64::from(next - n) > max {
+                    println!(
+                        "reference: noise floor {floor:.5} above the target {target:.5} at 2 × {n} \
+                         spp; the next pass would end after the {max} s limit"
+                    );
+                    break;
+                }
+            }
+            let left = seconds_per_sample
+                .map(|s| format!(", about {:.0} s left", s * (needed - f64::from(n)).max(0.0)))
+                .unwrap_or_default();
+            let label = format!(
+                "2 × {n} → 2 × {next} spp (noise floor {floor:.5}, target {target:.5}{left})"
+            );
+            let (more, per_sample) = pass(Some(images), next - n, label);
+            images = more;
+            seconds_per_sample = Some(per_sample);
+            rendered = true;
+        }
+    }
+    if rendered {
+        paths.store(&images)?;
+    }
+    images.cached = !rendered;
+    images.seconds = start.elapsed().as_secs_f64();
+    Ok(images)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn halves_have_different_seeds_and_half_zero_keeps_the_seed() {
+        assert_eq!(half_seed(7, 0), 7);
+        assert_ne!(half_seed(7, 1), 7);
+        assert_ne!(half_seed(0, 1), half_seed(1, 1));
+    }
+
+    #[test]
+    fn noise_targets_parse() {
+        assert_eq!("0.001".parse(), Ok(NoiseTarget::Absolute(0.001)));
+        assert_eq!("20%".parse(), Ok(NoiseTarget::ShareOfBest(0.2)));
+        for bad in ["0", "-1%", "abc", "nan", "%"] {
+            assert!(bad.parse::<NoiseTarget>().is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn weighted_merge_is_the_mean_of_all_samples() {
+        assert_eq!(weighted(&[1.0, 4.0], 1, &[4.0, 1.0], 2), vec![3.0, 2.0]);
+    }
+}
