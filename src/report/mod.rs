@@ -545,58 +545,41 @@ pub fn run_report(
     Ok(report)
 }
 
+/// The columns of `stats.csv`.
+const CSV_COLUMNS: [&str; 22] = [
+    "map",
+    "status",
+    "method",
+    "mean",
+    "std",
+    "shadow_mean",
+    "shadow_std",
+    "penumbra_mean",
+    "penumbra_std",
+    "relative_rmse",
+    "lights",
+    "decomposition_ms",
+    "frame_ms",
+    "covered_pixels",
+    "shadow_pixels",
+    "penumbra_pixels",
+    "relative_rmse_corrected",
+    "reference_spp",
+    "noise_floor_mean",
+    "noise_floor_shadow_mean",
+    "noise_floor_relative_rmse",
+    "noise_warning",
+];
+
 fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
     let mut writer = csv::Writer::from_writer(Vec::new());
-    writer.write_record([
-        "map",
-        "status",
-        "method",
-        "mean",
-        "std",
-        "shadow_mean",
-        "shadow_std",
-        "penumbra_mean",
-        "penumbra_std",
-        "relative_rmse",
-        "lights",
-        "decomposition_ms",
-        "frame_ms",
-        "covered_pixels",
-        "shadow_pixels",
-        "penumbra_pixels",
-        "relative_rmse_corrected",
-        "reference_spp",
-        "noise_floor_mean",
-        "noise_floor_shadow_mean",
-        "noise_floor_relative_rmse",
-        "noise_warning",
-    ])?;
+    writer.write_record(CSV_COLUMNS)?;
     for map in &report.maps {
         if map.methods.is_empty() {
-            writer.write_record([
-                map.name.as_str(),
-                map.status.name(),
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-                "",
-            ])?;
+            // A failed map: its name and status, the other columns empty.
+            let mut record = vec![map.name.as_str(), map.status.name()];
+            record.resize(CSV_COLUMNS.len(), "");
+            writer.write_record(record)?;
         }
         for m in &map.methods {
             let s = &m.stats;

@@ -32,13 +32,18 @@ fn invert_cdf(cdf: &[f32], x: f32) -> (usize, f32) {
         .saturating_sub(1)
         .min(n - 1);
     // Skip empty intervals (possible when x lands exactly on a plateau edge).
+    (k, position_in(cdf, k, x))
+}
+
+/// Where `x` falls inside interval `k` of `cdf`, in `[0, 1]` (the middle of an empty one).
+#[inline]
+fn position_in(cdf: &[f32], k: usize, x: f32) -> f32 {
     let width = cdf[k + 1] - cdf[k];
-    let t = if width > 0.0 {
+    if width > 0.0 {
         ((x - cdf[k]) / width).clamp(0.0, 1.0)
     } else {
         0.5
-    };
-    (k, t)
+    }
 }
 
 /// A guide table for inverting `cdf` (Chen and Asau's cutpoint method): entry b is the
@@ -70,13 +75,7 @@ fn invert_guided(cdf: &[f32], guide: &[u32], x: f32) -> (usize, f32) {
     while k + 1 < n && cdf[k + 1] <= x {
         k += 1;
     }
-    let width = cdf[k + 1] - cdf[k];
-    let t = if width > 0.0 {
-        ((x - cdf[k]) / width).clamp(0.0, 1.0)
-    } else {
-        0.5
-    };
-    (k, t)
+    (k, position_in(cdf, k, x))
 }
 
 fn normalised_cdf(weights: &[f64]) -> (Vec<f32>, f64) {
