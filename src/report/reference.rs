@@ -45,15 +45,6 @@ impl std::str::FromStr for NoiseTarget {
     }
 }
 
-impl std::fmt::Display for NoiseTarget {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Self::Absolute(v) => write!(f, "{v}"),
-            Self::ShareOfBest(s) => write!(f, "{}% of the best method's error", s * 100.0),
-        }
-    }
-}
-
 /// What the reference must reach.
 #[derive(Debug, Clone, Copy)]
 pub struct ReferenceRequest {
@@ -153,7 +144,7 @@ impl CachePaths {
         let meta: CacheMeta = serde_json::from_slice(&std::fs::read(&self.meta)?)?;
         let halves = [read_exr(&self.halves[0])?, read_exr(&self.halves[1])?];
         Ok(ReferenceImages {
-            radiance: mean_image(&halves[0], &halves[1]),
+            radiance: weighted_image(&halves[0], 1, &halves[1], 1),
             halves,
             coverage: read_exr(&self.coverage)?
                 .pixels
@@ -194,42 +185,33 @@ impl CachePaths {
     }
 }
 
-fn mean_image(a: &RgbImageF32, b: &RgbImageF32) -> RgbImageF32 {
-    let pixels = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .map(|(x, y)| (*x + *y) * 0.5)
-        .collect();
-    RgbImageF32::new(a.width, a.height, pixels)
-}
-
-/// `(a n + b k) / (n + k)` per pixel.
-fn weighted(a: &[f32], n: u32, b: &[f32], k: u32) -> Vec<f32> {
+/// `(a n + b k) / (n + k)` element by element: the mean of `n` samples' estimate `a` and
+/// `k` samples' estimate `b`.
+fn weighted<T>(a: &[T], n: u32, b: &[T], k: u32) -> Vec<T>
+where
+    T: Copy
+        + std::ops::Mul<f32, Output = T>
+        + std::ops::Add<Output = T>
+        + std::ops::Div<f32, Output = T>,
+{
     let (n, k) = (n as f32, k as f32);
     a.iter()
         .zip(b)
-        .map(|(a, b)| (a * n + b * k) / (n + k))
+        .map(|(a, b)| (*a * n + *b * k) / (n + k))
         .collect()
 }
 
 fn weighted_image(a: &RgbImageF32, n: u32, b: &RgbImageF32, k: u32) -> RgbImageF32 {
-    let (nf, kf) = (n as f32, k as f32);
-    let pixels = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .map(|(x, y)| (*x * nf + *y * kf) / (nf + kf))
-        .collect();
-    RgbImageF32::new(a.width, a.height, pixels)
+    RgbImageF32::new(a.width, a.height, weighted(&a.pixels, n, &b.pixels, k))
 }
 
-/// What a reference shows: the scene through the camera under the turned map.
+/// What a reference traces: the scene's BVH, seen through the camera, lit by the turned map.
+/// Built once per reference, on its first pass.
 struct View<'a> {
     scene: &'a Scene,
     camera: &'a Camera,
-    map: &'a EnvMap,
-    rotation_deg: f32,
+    bvh: SceneBvh,
+    light: EnvironmentLight<'a>,
 }
 
 /// Renders samples `[first, first + count)` of both halves and merges them into `current`.
@@ -240,9 +222,6 @@ fn render_pass(
     count: u32,
     progress: &dyn Progress,
 ) -> ReferenceImages {
-    let (scene, camera) = (view.scene, view.camera);
-    let bvh = SceneBvh::build(&scene.geometry.mesh);
-    let light = EnvironmentLight::new(view.map, view.rotation_deg);
     let first = current.as_ref().map_or(0, |c| c.samples_per_half);
     let passes: Vec<ReferenceImage> = (0..2)
         .map(|k| {
@@ -251,16 +230,18 @@ fn render_pass(
                 first_sample: first,
                 ..ReferenceSettings::new(count, request.bounces, half_seed(request.seed, k))
             };
-            reference::render(&scene.geometry, &bvh, &light, camera, &settings, progress)
+            reference::render(
+                &view.scene.geometry,
+                &view.bvh,
+                &view.light,
+                view.camera,
+                &settings,
+                progress,
+            )
         })
         .collect();
     let [a, b]: [ReferenceImage; 2] = passes.try_into().ok().expect("two halves");
-    let visibility: Vec<f32> = a
-        .visibility
-        .iter()
-        .zip(&b.visibility)
-        .map(|(x, y)| 0.5 * (x + y))
-        .collect();
+    let visibility = weighted(&a.visibility, 1, &b.visibility, 1);
     let (halves, visibility) = match current {
         None => ([a.radiance, b.radiance], visibility),
         Some(c) => (
@@ -272,7 +253,7 @@ fn render_pass(
         ),
     };
     ReferenceImages {
-        radiance: mean_image(&halves[0], &halves[1]),
+        radiance: weighted_image(&halves[0], 1, &halves[1], 1),
         halves,
         coverage: a.coverage,
         visibility,
@@ -311,21 +292,21 @@ pub(crate) fn reference_images(
         SamplerKind::Independent => u32::MAX / 2,
     };
     let start = Instant::now();
-    let mut rendered = false;
     let mut seconds_per_sample = None;
+    let view = std::cell::OnceCell::new();
     // One pass of `count` more samples per half, and the seconds each took.
     let pass = |current: Option<ReferenceImages>, count: u32, label: String| {
         println!("reference: {label}");
         let progress = TerminalProgress::new("reference rows");
         progress.status(&label);
         let pass_start = Instant::now();
-        let view = View {
+        let view = view.get_or_init(|| View {
             scene,
             camera,
-            map,
-            rotation_deg,
-        };
-        let images = render_pass(&view, request, current, count, &progress);
+            bvh: SceneBvh::build(&scene.geometry.mesh),
+            light: EnvironmentLight::new(map, rotation_deg),
+        });
+        let images = render_pass(view, request, current, count, &progress);
         (
             images,
             pass_start.elapsed().as_secs_f64() / f64::from(count),
@@ -338,7 +319,6 @@ pub(crate) fn reference_images(
         let (images, per_sample) = pass(current, wanted - have, label);
         current = Some(images);
         seconds_per_sample = Some(per_sample);
-        rendered = true;
     }
     let mut images = current.expect("rendered or cached");
     if let Some(wanted) = request.target_noise {
@@ -374,9 +354,9 @@ pub(crate) fn reference_images(
             let (more, per_sample) = pass(Some(images), next - n, label);
             images = more;
             seconds_per_sample = Some(per_sample);
-            rendered = true;
         }
     }
+    let rendered = images.samples_per_half > have;
     if rendered {
         paths.store(&images)?;
     }

@@ -167,29 +167,17 @@ impl EnvSampler {
 
     /// Solid-angle density of sampling direction `w` (map frame).
     pub fn pdf(&self, w: Vec3) -> f32 {
-        self.pdf_of_texel(w, self.texel_index(w))
-    }
-
-    /// The index of the texel `w` falls in (as `EnvMap::texel_of`).
-    #[inline]
-    pub fn texel_index(&self, w: Vec3) -> usize {
         let (u, v) = uv_of_direction(w);
         let i = ((u * self.width as f32) as usize).min(self.width - 1);
         let j = ((v * self.height as f32) as usize).min(self.height - 1);
-        j * self.width + i
+        // From x and z, which keep their precision near the poles (unlike 1 - y²).
+        let sin_theta = (w.x * w.x + w.z * w.z).sqrt();
+        self.density(self.texel_probability[j * self.width + i], sin_theta)
     }
 
     /// The density of every direction in `texel` times its `sin θ`: `pdf = factor / sin θ`.
     pub fn texel_density_factor(&self, texel: usize) -> f32 {
         self.density(self.texel_probability[texel], 1.0)
-    }
-
-    /// The density of `w`, already located in `texel`.
-    #[inline]
-    pub fn pdf_of_texel(&self, w: Vec3, texel: usize) -> f32 {
-        // From x and z, which keep their precision near the poles (unlike 1 - y²).
-        let sin_theta = (w.x * w.x + w.z * w.z).sqrt();
-        self.density(self.texel_probability[texel], sin_theta)
     }
 }
 
