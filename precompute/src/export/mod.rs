@@ -127,6 +127,11 @@ pub fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
         r#"<?xml version="1.0" encoding="utf-8"?>
 <!-- Exported by hprt; see its README, "Cross-checking with Mitsuba 3". -->
 <scene version="3.0.0">
+    <!-- How the backs of triangles look. twosided: as surfaces of their own, facing the
+         other way. hprt shows the front's radiance on both sides (CONVENTIONS.md,
+         "Surfaces"); for exactly that, import thinsheet.py from this folder and load with
+         surface="thinsheet". -->
+    <default name="surface" value="twosided"/>
     <integrator type="path">
         <!-- hprt bounces = {bounces} -->
         <integer name="max_depth" value="{max_depth}"/>
@@ -174,7 +179,7 @@ pub fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
             r#"    <shape type="ply" id="{id}">
         <string name="filename" value="meshes/{file}"/>
         <boolean name="face_normals" value="false"/>
-        <bsdf type="twosided">
+        <bsdf type="$surface">
             <bsdf type="diffuse">
                 <rgb name="reflectance" value="{r}, {g}, {b}"/>
             </bsdf>
@@ -199,7 +204,11 @@ fn xml_escape(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// Writes `dir/scene.xml`, `dir/envmap.exr` and `dir/meshes/*.ply`.
+/// The Mitsuba 3 plugin that reproduces hprt's surfaces (both sides show the front), registered
+/// as `thinsheet` when imported.
+pub const THIN_SHEET_PLUGIN: &str = include_str!("thinsheet.py");
+
+/// Writes `dir/scene.xml`, `dir/thinsheet.py`, `dir/envmap.exr` and `dir/meshes/*.ply`.
 pub fn export_mitsuba(
     dir: &Path,
     geometry: &SceneMesh,
@@ -220,6 +229,9 @@ pub fn export_mitsuba(
     let env_path = dir.join("envmap.exr");
     let image = RgbImageF32::new(map.width(), map.height(), map.texels().to_vec());
     write_exr(&env_path, &image).map_err(|e| error(&env_path, e.to_string()))?;
+    let plugin_path = dir.join("thinsheet.py");
+    write_atomic(&plugin_path, THIN_SHEET_PLUGIN.as_bytes())
+        .map_err(|e| error(&plugin_path, e.to_string()))?;
     let xml_path = dir.join("scene.xml");
     write_atomic(&xml_path, scene_xml(geometry, settings).as_bytes())
         .map_err(|e| error(&xml_path, e.to_string()))?;
@@ -268,6 +280,10 @@ mod tests {
         };
         let xml = scene_xml(&geometry, &settings);
         assert!(xml.contains("<integer name=\"max_depth\" value=\"5\"/>"));
+        // Mitsuba's own two-sided BSDF by default; the plugin written beside it on request.
+        assert!(xml.contains("<default name=\"surface\" value=\"twosided\"/>"));
+        assert!(xml.contains("<bsdf type=\"$surface\">"));
+        assert!(THIN_SHEET_PLUGIN.contains("mi.register_bsdf(\"thinsheet\""));
         assert!(xml.contains("meshes/00_table_top.ply"));
         assert!(xml.contains("<rotate y=\"1\" angle=\"30\"/>"));
         assert!(xml.contains("<rfilter type=\"box\"/>"));
