@@ -1,13 +1,20 @@
 // First pass: the scene with its per-vertex PRT radiance (depth written), plus the normal and
 // albedo the light pass needs. Both sides of a triangle show its front (no culling).
+//
+// Textured objects: their transfer is baked per unit texel value, so the interpolated radiance
+// and the vertex albedo (the texture's factor) are both multiplied by the texel here. Untextured
+// objects are drawn with a white texel: unchanged.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(0) var albedo_texture: texture_2d<f32>;
+@group(1) @binding(1) var albedo_sampler: sampler;
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) albedo: vec3<f32>,
     @location(3) radiance: vec4<f32>,
+    @location(4) uv: vec2<f32>,
 };
 
 struct VertexOut {
@@ -15,6 +22,7 @@ struct VertexOut {
     @location(0) normal: vec3<f32>,
     @location(1) albedo: vec3<f32>,
     @location(2) radiance: vec3<f32>,
+    @location(3) uv: vec2<f32>,
 };
 
 @vertex
@@ -24,6 +32,7 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.normal = in.normal;
     out.albedo = in.albedo;
     out.radiance = in.radiance.xyz;
+    out.uv = in.uv;
     return out;
 }
 
@@ -54,12 +63,13 @@ fn sh_irradiance_over_pi(n: vec3<f32>) -> vec3<f32> {
 fn fs_main(in: VertexOut) -> FragmentOut {
     var out: FragmentOut;
     let normal = normalize(in.normal);
-    out.color = vec4<f32>(in.radiance, 1.0);
+    let texel = textureSample(albedo_texture, albedo_sampler, in.uv).rgb;
+    out.color = vec4<f32>(in.radiance * texel, 1.0);
     if (frame.flags & 4u) != 0u {
-        out.color = vec4<f32>(in.albedo * max(sh_irradiance_over_pi(normal), vec3<f32>(0.0)), 1.0);
+        out.color = vec4<f32>(in.albedo * texel * max(sh_irradiance_over_pi(normal), vec3<f32>(0.0)), 1.0);
     }
     out.normal = vec4<f32>(normal, 1.0);
-    out.albedo = vec4<f32>(in.albedo, 1.0);
+    out.albedo = vec4<f32>(in.albedo * texel, 1.0);
     out.depth = encode_depth(in.clip.z);
     return out;
 }

@@ -35,6 +35,9 @@ enum Command {
     Export(commands::export::ExportArgs),
     /// Error statistics of plain PRT and the hybrid against the path-traced reference.
     Report(commands::report::ReportArgs),
+    /// Scene files: `hprt scene init MODEL -o scene.toml` writes the scene a model gets.
+    #[command(subcommand)]
+    Scene(commands::scene::SceneCommand),
     /// Open the real-time viewer (needs a display; see `hprt render` otherwise).
     View(view::ViewArgs),
     /// Benchmarks anyone can rerun (bake throughput, ...).
@@ -67,6 +70,7 @@ fn main() {
         Command::Report(args) => commands::report::run(args),
         Command::Bake(args) => commands::bake::run(args),
         Command::Bench(cmd) => commands::bench::run(cmd),
+        Command::Scene(cmd) => commands::scene::run(cmd),
         Command::Decompose(args) => commands::decompose::run(args),
         Command::Reference(args) => commands::reference::run(args),
         Command::Render(args) => commands::render::run(args),

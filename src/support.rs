@@ -7,9 +7,9 @@ use precompute::progress::Progress;
 use precompute::scene::Scene;
 use std::path::Path;
 
-/// Loads a scene file, with the path in any error.
+/// Loads a scene file, or a bare model placed in a default scene, with the path in any error.
 pub fn load_scene(path: &Path) -> anyhow::Result<Scene> {
-    Scene::load(path).context("cannot load the scene")
+    Scene::open(path).context("cannot load the scene")
 }
 
 /// Runs `f` on a rayon pool of `threads` threads (all cores when `None`).

@@ -67,9 +67,7 @@ fn reference_agrees_with_the_bake_at_vertices() {
             };
             let traced = bake::trace(&scene.geometry, &bvh, &settings, &NoProgress).unwrap();
             inside = traced.inside.clone();
-            let indirect: Vec<TransferVectors> = traced
-                .cumulative_indirect(&scene.geometry.albedo, 3)
-                .collect();
+            let indirect: Vec<TransferVectors> = traced.cumulative_indirect(3).collect();
             bounce_counts
                 .iter()
                 .map(|&b| match b {

@@ -188,6 +188,74 @@ fn plays_an_environment_sequence_under_xvfb() {
     assert!(!state["light_shares"].as_array().unwrap().is_empty());
 }
 
+/// A model in one command, as a new user opens one: `hprt view model.glb --env map.exr`.
+/// The first opening bakes into the cache (its progress in the panel); the textured crate is
+/// drawn with its checkerboard; the second opening finds the bake in the cache.
+#[test]
+fn opens_a_gltf_model_in_one_command_under_xvfb() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let model = repo().join("scenes/models/crate.glb");
+    let env = repo().join("scenes/env/city.exr");
+    let cache = d.join("cache");
+    std::fs::write(
+        d.join("open.script"),
+        "wait-bake\nwait 2\nscreenshot crate.png\nstate state.json\nquit\n",
+    )
+    .unwrap();
+    let open = || {
+        Command::new("xvfb-run")
+            .args([
+                "-a",
+                "-s",
+                "-screen 0 1024x768x24",
+                env!("CARGO_BIN_EXE_hprt"),
+                "view",
+            ])
+            .arg(&model)
+            .arg("--env")
+            .arg(&env)
+            .args([
+                "--width",
+                "800",
+                "--height",
+                "500",
+                "--script",
+                "open.script",
+            ])
+            .current_dir(d)
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .env("HPRT_CACHE", &cache)
+            .output()
+            .expect("xvfb-run (package xvfb; tests/run.sh installs it)")
+    };
+    let out = open();
+    assert!(out.status.success(), "viewer failed: {}", stderr(&out));
+    let baked: Vec<_> = std::fs::read_dir(&cache).unwrap().flatten().collect();
+    assert_eq!(baked.len(), 1, "one bake in the cache");
+    assert!(baked[0].file_name().to_string_lossy().starts_with("crate-"));
+
+    // The crate's two checker colours (orange and cream) both show: the texture is drawn.
+    let (_, _, rgb) = image_rgb(&d.join("crate.png"));
+    let orange = rgb
+        .chunks_exact(3)
+        .filter(|p| {
+            p[0] > 120 && 2 * p[0] as u32 > 5 * p[2] as u32 && 4 * (p[1] as u32) < 3 * p[0] as u32
+        })
+        .count();
+    assert!(orange > 500, "only {orange} orange pixels");
+
+    // Opened again, it reads the cached bake instead of baking.
+    let modified = baked[0].metadata().unwrap().modified().unwrap();
+    let again = open();
+    assert!(again.status.success(), "viewer failed: {}", stderr(&again));
+    assert_eq!(
+        baked[0].metadata().unwrap().modified().unwrap(),
+        modified,
+        "the cached bake was reused"
+    );
+}
+
 /// Runs `hprt view SCENE ARGS` in `dir` under a virtual X server.
 fn view_under_xvfb(dir: &std::path::Path, scene: &std::path::Path, args: &[&str]) -> Output {
     Command::new("xvfb-run")

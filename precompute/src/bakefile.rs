@@ -4,7 +4,7 @@
 //! ```text
 //! offset size  field
 //!      0    8  magic "HPRTBAKE"
-//!      8    4  u32 format version (1)
+//!      8    4  u32 format version (2)
 //!     12    4  u32 header size in bytes (128)
 //!     16    4  u32 SH order n
 //!     20    4  u32 bounces
@@ -15,7 +15,8 @@
 //!     72    8  u64 seed
 //!     80    4  f32 ray offset (fraction of the scene's bounding-box diagonal)
 //!     84    4  u32 sampling scheme (1 = cosine-weighted Hammersley, rotated per vertex)
-//!     88   40  reserved (zero)
+//!     88    8  u64 vertices of textured objects (transfer per unit texel value)
+//!     96   32  reserved (zero)
 //!    128  4·V·3·n²  direct transfer, f32 [V][3][n²]
 //!      …  4·V·3·n²  indirect transfer, f32 [V][3][n²]
 //!    end    4  u32 CRC-32 (IEEE, zlib's crc32) of every preceding byte
@@ -27,7 +28,8 @@ use crate::sh::{self, num_coeffs};
 use std::path::{Path, PathBuf};
 
 pub const MAGIC: &[u8; 8] = b"HPRTBAKE";
-pub const VERSION: u32 = 1;
+/// 2: textured objects' vertices store transfer per unit texel value (count at 88).
+pub const VERSION: u32 = 2;
 pub const HEADER_SIZE: usize = 128;
 const SAMPLING_COSINE_HAMMERSLEY: u32 = 1;
 
@@ -81,6 +83,7 @@ pub fn encode(transfer: &Transfer, mesh_hash: &[u8; 32]) -> Vec<u8> {
     out.extend_from_slice(&s.seed.to_le_bytes());
     out.extend_from_slice(&RAY_OFFSET_FRACTION.to_le_bytes());
     out.extend_from_slice(&SAMPLING_COSINE_HAMMERSLEY.to_le_bytes());
+    out.extend_from_slice(&transfer.textured_vertices.to_le_bytes());
     out.resize(HEADER_SIZE, 0);
     for x in transfer
         .direct
@@ -186,6 +189,7 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<(BakeHeader, Transfer), BakeF
             .ok_or_else(|| corrupt("direct transfer size".into()))?,
         indirect: TransferVectors::from_raw(order, vertex_count, indirect.to_vec())
             .ok_or_else(|| corrupt("indirect transfer size".into()))?,
+        textured_vertices: u64_at(bytes, 88),
     };
     Ok((header, transfer))
 }
@@ -241,6 +245,7 @@ mod tests {
                 .unwrap(),
             indirect: TransferVectors::from_raw(order, v, (0..n).map(|i| -(i as f32)).collect())
                 .unwrap(),
+            textured_vertices: 2,
         }
     }
 

@@ -7,9 +7,11 @@ use crate::color::Rgb;
 use crate::mesh::{
     self, LoadOptions, MeshCleanup, MeshError, TriangleMesh, annulus_mesh, box_mesh,
 };
+use crate::texture::AlbedoTexture;
 use glam::{Mat3, Mat4, Quat, Vec3};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Why a scene could not be loaded. Every variant names the scene file.
 #[derive(Debug, thiserror::Error)]
@@ -32,11 +34,13 @@ pub enum SceneError {
 }
 
 /// The scene file as written.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     pub camera: Camera,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub environment: Option<EnvironmentSpec>,
     #[serde(default)]
     pub bake: BakeSettings,
@@ -56,30 +60,38 @@ pub struct EnvironmentSpec {
 }
 
 /// One object: a mesh file or a procedural box, placed by a transform, with an albedo.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectSpec {
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    /// Mesh file (OBJ, PLY, BPT, optionally .gz), relative to the scene file.
+    /// Mesh file (OBJ, PLY, BPT, optionally .gz, or glTF 2.0), relative to the scene file. A
+    /// glTF model becomes one object per triangle primitive, named `name/mesh/primitive`.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mesh: Option<PathBuf>,
-    #[serde(rename = "box")]
+    #[serde(rename = "box", skip_serializing_if = "Option::is_none")]
     pub box_shape: Option<BoxSpec>,
-    /// Lambertian RGB albedo, each channel in [0, 1).
-    pub albedo: [f32; 3],
+    /// Lambertian RGB albedo, each channel in [0, 1). Optional for glTF models, whose
+    /// materials give it; when set, it overrides them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub albedo: Option<[f32; 3]>,
     #[serde(default)]
     pub transform: Transform,
     /// Quads per Bézier patch side (BPT meshes).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub patch_segments: Option<u32>,
     /// Bézier patches to leave out (BPT meshes, 0-based).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub skip_patches: Vec<usize>,
     /// A flat ring (or disc, with `inner_radius = 0`) in the object's XZ plane, facing +Y.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub annulus: Option<AnnulusSpec>,
     /// Weld coincident vertices (default: when the file has no normals).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub weld: Option<bool>,
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoxSpec {
     pub min: [f32; 3],
@@ -89,7 +101,7 @@ pub struct BoxSpec {
     pub segments: [u32; 3],
     /// Faces to leave out, named "+x", "-x", "+y", "-y", "+z", "-z" (faces that touch
     /// something else and are never seen).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub skip_faces: Vec<String>,
 }
 
@@ -97,7 +109,7 @@ fn default_box_segments() -> [u32; 3] {
     [1, 1, 1]
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct AnnulusSpec {
     #[serde(default)]
@@ -115,7 +127,7 @@ fn default_annulus_segments() -> [u32; 2] {
 }
 
 /// Object-to-world placement: scale, then rotations about X, Y and Z (degrees), then translate.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Transform {
     #[serde(default = "one")]
@@ -140,7 +152,7 @@ fn one() -> Scale {
     Scale::Uniform(1.0)
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(untagged)]
 pub enum Scale {
     Uniform(f32),
@@ -164,17 +176,29 @@ impl Transform {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneObject {
     pub name: String,
+    /// The albedo, or for a textured object the factor its texture is multiplied by.
     pub albedo: Rgb,
     pub vertices: std::ops::Range<u32>,
     pub triangles: std::ops::Range<u32>,
+    /// Index into [`SceneMesh::textures`] of its base colour texture.
+    pub texture: Option<usize>,
 }
+
+/// Marks a triangle without a texture in [`SceneMesh::triangle_textures`].
+pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// All objects merged into one world-space mesh, with a per-vertex albedo.
 #[derive(Debug, Clone, Default)]
 pub struct SceneMesh {
+    /// World-space geometry; its texture coordinates are empty unless an object is textured.
     pub mesh: TriangleMesh,
+    /// Per vertex: its object's albedo, or for a textured object the factor its texture is
+    /// multiplied by (the bake's transfer is then per unit texel value: CONVENTIONS.md,
+    /// "Textured albedo").
     pub albedo: Vec<Rgb>,
     pub objects: Vec<SceneObject>,
+    /// Base colour textures of the textured objects.
+    pub textures: Vec<Arc<AlbedoTexture>>,
 }
 
 impl SceneMesh {
@@ -200,6 +224,27 @@ impl SceneMesh {
                 hasher.update(&i.to_le_bytes());
             }
         }
+        // Textures count only where there are some, so untextured scenes keep their hashes
+        // (and their cached bakes).
+        if !self.textures.is_empty() {
+            hasher.update(b"textured");
+            for uv in &self.mesh.uvs {
+                hasher.update(&uv.x.to_le_bytes());
+                hasher.update(&uv.y.to_le_bytes());
+            }
+            for o in &self.objects {
+                hasher.update(&o.texture.map_or(u64::MAX, |t| t as u64).to_le_bytes());
+            }
+            for t in &self.textures {
+                hasher.update(&(t.width as u64).to_le_bytes());
+                hasher.update(&(t.height as u64).to_le_bytes());
+                for texel in &t.texels {
+                    for c in texel.to_array() {
+                        hasher.update(&c.to_le_bytes());
+                    }
+                }
+            }
+        }
         *hasher.finalize().as_bytes()
     }
 
@@ -223,7 +268,69 @@ impl SceneMesh {
             albedo,
             vertices: v0..self.mesh.vertex_count() as u32,
             triangles: t0..self.mesh.triangle_count() as u32,
+            texture: None,
         });
+    }
+
+    /// Adds `mesh` (world space, with texture coordinates) whose albedo is `factor` times
+    /// `texture` looked up at each point.
+    pub fn push_textured_object(
+        &mut self,
+        name: String,
+        mesh: &TriangleMesh,
+        factor: Rgb,
+        texture: Arc<AlbedoTexture>,
+    ) {
+        debug_assert_eq!(mesh.uvs.len(), mesh.vertex_count());
+        let index = match self.textures.iter().position(|t| Arc::ptr_eq(t, &texture)) {
+            Some(i) => i,
+            None => {
+                self.textures.push(texture);
+                self.textures.len() - 1
+            }
+        };
+        self.push_object(name, mesh, factor);
+        if let Some(object) = self.objects.last_mut() {
+            object.texture = Some(index);
+        }
+    }
+
+    /// Whether any object is textured.
+    pub fn is_textured(&self) -> bool {
+        !self.textures.is_empty()
+    }
+
+    /// Per triangle, the index of its texture, or [`NO_TEXTURE`].
+    pub fn triangle_textures(&self) -> Vec<u32> {
+        let mut out = vec![NO_TEXTURE; self.mesh.triangle_count()];
+        for o in &self.objects {
+            if let Some(t) = o.texture {
+                out[o.triangles.start as usize..o.triangles.end as usize].fill(t as u32);
+            }
+        }
+        out
+    }
+
+    /// Per vertex, the albedo it reflects toward other surfaces in the bake's interreflection:
+    /// its object's albedo, or for a textured object the factor times the texture averaged
+    /// around the vertex ([`crate::texture::vertex_average`]).
+    pub fn reflected_albedo(&self) -> Vec<Rgb> {
+        let mut albedo = self.albedo.clone();
+        for o in &self.objects {
+            let Some(t) = o.texture else { continue };
+            let (v0, v1) = (o.vertices.start as usize, o.vertices.end as usize);
+            let local: Vec<[u32; 3]> = self.mesh.triangles
+                [o.triangles.start as usize..o.triangles.end as usize]
+                .iter()
+                .map(|tri| tri.map(|i| i - v0 as u32))
+                .collect();
+            let averages =
+                crate::texture::vertex_average(&self.textures[t], &self.mesh.uvs[v0..v1], &local);
+            for (a, avg) in albedo[v0..v1].iter_mut().zip(averages) {
+                *a *= avg;
+            }
+        }
+        albedo
     }
 }
 
@@ -276,14 +383,14 @@ impl Scene {
                 .name
                 .clone()
                 .unwrap_or_else(|| format!("#{}", index + 1));
-            let albedo = Rgb::from(object.albedo);
-            if !object.albedo.iter().all(|a| (0.0..1.0).contains(a)) {
+            if let Some(albedo) = object.albedo
+                && !albedo.iter().all(|a| (0.0..1.0).contains(a))
+            {
                 return Err(invalid(format!(
-                    "{name}: albedo {:?} must be in [0, 1) per channel",
-                    object.albedo
+                    "{name}: albedo {albedo:?} must be in [0, 1) per channel"
                 )));
             }
-            let local = load_object_mesh(dir, object).map_err(|e| match e {
+            let parts = load_object_parts(dir, object).map_err(|e| match e {
                 ObjectError::Mesh(cause) => SceneError::Mesh {
                     scene: path.to_owned(),
                     object: name.clone(),
@@ -291,9 +398,32 @@ impl Scene {
                 },
                 ObjectError::Spec(m) => invalid(format!("{name}: {m}")),
             })?;
-            let world = transform_mesh(&local, &object.transform.matrix())
-                .ok_or_else(|| invalid(format!("{name}: the transform is singular")))?;
-            geometry.push_object(name, &world, albedo);
+            let single = parts.len() == 1;
+            for part in parts {
+                let albedo = object
+                    .albedo
+                    .map(Rgb::from)
+                    .or(part.albedo)
+                    .ok_or_else(|| {
+                        invalid(format!(
+                            "{name}: give it an albedo = [r, g, b] (only glTF models carry \
+                             their own)"
+                        ))
+                    })?;
+                let part_name = match single {
+                    true => name.clone(),
+                    false => format!("{name}/{}", part.name),
+                };
+                let world = transform_mesh(&part.mesh, &object.transform.matrix())
+                    .ok_or_else(|| invalid(format!("{name}: the transform is singular")))?;
+                // An albedo in the scene file replaces the model's material, texture included.
+                match (object.albedo, part.texture) {
+                    (None, Some(texture)) => {
+                        geometry.push_textured_object(part_name, &world, albedo, texture)
+                    }
+                    _ => geometry.push_object(part_name, &world, albedo),
+                }
+            }
         }
         if let Some(env) = &file.environment
             && !env.rotation_deg.is_finite()
@@ -330,7 +460,24 @@ enum ObjectError {
     Spec(String),
 }
 
-fn load_object_mesh(dir: &Path, object: &ObjectSpec) -> Result<TriangleMesh, ObjectError> {
+/// One part of an object: a glTF primitive, or the whole of any other object.
+struct ObjectPart {
+    name: String,
+    mesh: TriangleMesh,
+    /// The albedo the model file gives (glTF materials); the texture's factor if textured.
+    albedo: Option<Rgb>,
+    texture: Option<Arc<AlbedoTexture>>,
+}
+
+fn load_object_parts(dir: &Path, object: &ObjectSpec) -> Result<Vec<ObjectPart>, ObjectError> {
+    let whole = |mesh| {
+        vec![ObjectPart {
+            name: String::new(),
+            mesh,
+            albedo: None,
+            texture: None,
+        }]
+    };
     match (&object.mesh, &object.box_shape, &object.annulus) {
         (Some(file), None, None) => {
             let options = LoadOptions {
@@ -338,21 +485,56 @@ fn load_object_mesh(dir: &Path, object: &ObjectSpec) -> Result<TriangleMesh, Obj
                 skip_patches: object.skip_patches.clone(),
             };
             let path = dir.join(file);
-            let raw = mesh::read_mesh(&path, &options).map_err(ObjectError::Mesh)?;
             let cleanup = MeshCleanup {
                 weld: object.weld,
                 ..Default::default()
             };
-            let (mesh, _report) = cleanup.run(&path, raw).map_err(ObjectError::Mesh)?;
-            Ok(mesh)
+            mesh::read_model(&path, &options)
+                .map_err(ObjectError::Mesh)?
+                .into_iter()
+                .map(|part| {
+                    let (mesh, _report) = cleanup
+                        .run(&path, part.mesh)
+                        .map_err(ObjectError::Mesh)?;
+                    Ok(ObjectPart {
+                        albedo: part.material.as_ref().map(|m| material_albedo(&path, m)),
+                        texture: part.material.and_then(|m| m.texture),
+                        name: part.name,
+                        mesh,
+                    })
+                })
+                .collect()
         }
-        (None, Some(b), None) => box_object(b),
-        (None, None, Some(a)) => annulus_object(a),
+        (None, Some(b), None) => box_object(b).map(whole),
+        (None, None, Some(a)) => annulus_object(a).map(whole),
         _ => Err(ObjectError::Spec(
             "give exactly one of `mesh = \"file\"`, `box = { min, max }` or `annulus = { outer_radius }`"
                 .into(),
         )),
     }
+}
+
+/// Largest albedo a model's material may give: albedos must stay below 1 (a white furnace
+/// would never converge); a glTF base colour of 1 (its default) becomes this.
+pub const MAX_MATERIAL_ALBEDO: f32 = 0.99;
+
+/// The albedo of a glTF material: its base colour factor (which multiplies its texture, if it
+/// has one), kept below 1.
+fn material_albedo(path: &Path, material: &mesh::PartMaterial) -> Rgb {
+    let albedo = material.base_color;
+    // A texture's factor is usually 1 (glTF's default): the texels are the albedo.
+    if material.texture.is_some() {
+        return albedo.clamp(Rgb::ZERO, Rgb::ONE);
+    }
+    if albedo.max_element() > MAX_MATERIAL_ALBEDO {
+        log::warn!(
+            "{}: {}: base colour {:.3?} clamped to {MAX_MATERIAL_ALBEDO} (albedos stay below 1)",
+            path.display(),
+            material.name,
+            albedo.to_array()
+        );
+    }
+    albedo.clamp(Rgb::ZERO, Rgb::splat(MAX_MATERIAL_ALBEDO))
 }
 
 fn box_object(b: &BoxSpec) -> Result<TriangleMesh, ObjectError> {
@@ -437,6 +619,7 @@ pub fn transform_mesh(mesh: &TriangleMesh, m: &Mat4) -> Option<TriangleMesh> {
             .map(|n| (normal_matrix * *n).normalize_or(Vec3::Y))
             .collect(),
         triangles,
+        uvs: mesh.uvs.clone(),
     })
 }
 

@@ -14,7 +14,8 @@ use std::time::Instant;
 
 #[derive(Args)]
 pub struct BakeArgs {
-    /// Scene file (TOML); its [bake] table gives the defaults of the options below.
+    /// Scene file (TOML), whose [bake] table gives the defaults of the options below; or a
+    /// model (glTF, OBJ, PLY, BPT) placed in a default scene.
     pub scene: PathBuf,
     /// Output bake file (written atomically: an interrupted bake leaves no file).
     #[arg(short, long)]

@@ -38,18 +38,25 @@ pub struct DemoArgs {
     pub backend: runtime::render::Backend,
 }
 
-/// The bundled teapot scene: `scenes/teapot.toml` under the working directory, else in the
-/// source tree the program was built from.
-fn bundled_teapot() -> PathBuf {
-    let local = Path::new("scenes/teapot.toml");
+/// A bundled file: `path` under the working directory, else in the source tree the program was
+/// built from.
+fn bundled(path: &str) -> PathBuf {
+    let local = Path::new(path);
     if local.exists() {
         return local.to_owned();
     }
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/teapot.toml")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
 }
 
+/// The glTF sample (a textured crate) and the map it is shown under.
+const MODEL_SAMPLE: &str = "scenes/models/crate.glb";
+const MODEL_SAMPLE_MAP: &str = "scenes/env/city.exr";
+/// Reference samples of the sample's report: a small scene, a quick reference (its noise
+/// floor is stated in the report).
+const MODEL_SAMPLE_SPP: u32 = 512;
+
 pub fn run(args: DemoArgs) -> anyhow::Result<()> {
-    let scene = load_scene(&args.scene.unwrap_or_else(bundled_teapot))?;
+    let scene = load_scene(&args.scene.unwrap_or_else(|| bundled("scenes/teapot.toml")))?;
     let Some(environment) = &scene.environment else {
         anyhow::bail!("{} names no [environment]", scene.path.display());
     };
@@ -70,5 +77,23 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         frames: 5,
         backend: args.backend,
     };
-    write_report(&scene, &envs, &options, &args.output)
+    write_report(&scene, &envs, &options, &args.output)?;
+
+    // A model as users bring theirs: the textured glTF sample, placed on its own, through
+    // bake, hybrid, PRT and the path-traced reference.
+    println!("\nthe glTF sample {MODEL_SAMPLE}:");
+    let sample = load_scene(&bundled(MODEL_SAMPLE))?;
+    let sample_options = ReportOptions {
+        spp: MODEL_SAMPLE_SPP,
+        target_noise: None,
+        thresholds: vec![0.0, 0.05],
+        frames: 1,
+        ..options
+    };
+    write_report(
+        &sample,
+        &[bundled(MODEL_SAMPLE_MAP)],
+        &sample_options,
+        &args.output.join("crate"),
+    )
 }

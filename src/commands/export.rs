@@ -9,7 +9,8 @@ use std::path::PathBuf;
 
 #[derive(Args)]
 pub struct ExportArgs {
-    /// Scene file (TOML).
+    /// Scene file (TOML), or a model (glTF, OBJ, PLY, BPT) placed in a default scene (`hprt
+    /// scene init` writes that scene out for editing).
     pub scene: PathBuf,
     #[command(flatten)]
     pub environment: EnvironmentArgs,

@@ -11,3 +11,4 @@ mod mitsuba;
 pub mod reference;
 pub mod render;
 pub mod report;
+pub mod scene;

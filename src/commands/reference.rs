@@ -15,7 +15,8 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub struct ReferenceArgs {
-    /// Scene file (TOML).
+    /// Scene file (TOML), or a model (glTF, OBJ, PLY, BPT) placed in a default scene (`hprt
+    /// scene init` writes that scene out for editing).
     pub scene: PathBuf,
     #[command(flatten)]
     pub environment: EnvironmentArgs,

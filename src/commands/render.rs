@@ -17,7 +17,8 @@ use std::path::PathBuf;
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene file (TOML).
+    /// Scene file (TOML), or a model (glTF, OBJ, PLY, BPT) placed in a default scene (`hprt
+    /// scene init` writes that scene out for editing).
     pub scene: PathBuf,
     /// Bake of the scene (from `hprt bake`).
     #[arg(long)]

@@ -10,7 +10,8 @@ use std::path::PathBuf;
 
 #[derive(Args)]
 pub struct ReportArgs {
-    /// Scene file (TOML).
+    /// Scene file (TOML), or a model (glTF, OBJ, PLY, BPT) placed in a default scene (`hprt
+    /// scene init` writes that scene out for editing).
     pub scene: PathBuf,
     /// Environment maps (default: the scene's map and every .exr / .hdr map beside it).
     #[arg(long, num_args = 1..)]

@@ -39,7 +39,8 @@ use winit::window::{Window, WindowId};
 
 #[derive(Args)]
 pub struct ViewArgs {
-    /// Scene file (TOML).
+    /// Scene file (TOML), or a model (glTF, OBJ, PLY, BPT) placed in a default scene (`hprt
+    /// scene init` writes that scene out for editing).
     pub scene: PathBuf,
     /// Bake of the scene (default: the cached bake of the scene's [bake] settings, or offer
     /// to make one).
@@ -258,6 +259,11 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         error: None,
     };
     app.load_environment();
+    // A scene opened for the first time bakes at once, with its progress in the panel, into
+    // the cache the next opening reads.
+    if app.bake.transfer.is_none() {
+        app.start_bake();
+    }
     event_loop
         .run_app(&mut app)
         .context("the window's event loop failed")?;
@@ -452,6 +458,17 @@ impl App {
                 C::Wait(n) => {
                     self.script.wait = n;
                     return Ok(());
+                }
+                C::WaitBake => {
+                    if self.bake.job.is_some() {
+                        self.script.commands.push_front(C::WaitBake);
+                        return Ok(());
+                    }
+                    anyhow::ensure!(
+                        self.bake.transfer.is_some(),
+                        "wait-bake: there is no bake ({})",
+                        self.stats.message
+                    );
                 }
                 C::Orbit(dx, dy) => self.input.orbit.rotate(dx, dy),
                 C::Pan(dx, dy) => self.input.orbit.pan(dx, dy, self.window.size.1),

@@ -3,6 +3,7 @@
 //!
 //! ```text
 //! wait 5                    # let 5 frames pass
+//! wait-bake                 # until the bake the viewer started has finished
 //! orbit 40 -10              # drag with the left button by (dx, dy) pixels
 //! pan 20 0                  # drag with the right button
 //! zoom 2                    # wheel notches (positive: closer)
@@ -20,6 +21,7 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
     Wait(u32),
+    WaitBake,
     Orbit(f32, f32),
     Pan(f32, f32),
     Zoom(f32),
@@ -62,6 +64,7 @@ pub fn parse(path: &Path, text: &str) -> anyhow::Result<Vec<Command>> {
         };
         let command = match words[0] {
             "wait" => Command::Wait(number_at(1)? as u32),
+            "wait-bake" => Command::WaitBake,
             "orbit" => Command::Orbit(number_at(1)?, number_at(2)?),
             "pan" => Command::Pan(number_at(1)?, number_at(2)?),
             "zoom" => Command::Zoom(number_at(1)?),

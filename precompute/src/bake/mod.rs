@@ -30,6 +30,9 @@ pub struct Transfer {
     pub settings: BakeSettings,
     pub direct: TransferVectors,
     pub indirect: TransferVectors,
+    /// Vertices of textured objects: their transfer is per unit texel value, to be multiplied
+    /// by the texture where drawn (CONVENTIONS.md, "Textured albedo").
+    pub textured_vertices: u64,
 }
 
 impl Transfer {
@@ -65,8 +68,15 @@ pub const RAY_OFFSET_FRACTION: f32 = 1e-5;
 /// The result of the tracing pass: the direct transfer and the interreflection operator, from
 /// which any number of bounces follows without tracing again.
 pub struct TracedScene {
+    /// The direct transfer as stored: with each vertex's albedo (on a textured object, its
+    /// texture's factor: the transfer is per unit texel value).
     pub direct: TransferVectors,
     pub operator: InterreflectionOperator,
+    /// The albedo each vertex reflects toward the others ([`SceneMesh::reflected_albedo`]).
+    reflected_albedo: Vec<crate::color::Rgb>,
+    /// For a textured scene: the direct transfer with the reflected albedo (what the next
+    /// bounce sees) and the stored vertices' albedo; `None` where the two albedos agree.
+    textured: Option<(TransferVectors, Vec<crate::color::Rgb>)>,
     /// Vertices inside solids (see [`fill_inside`]); their transfer is their neighbours'.
     pub inside: Vec<bool>,
     neighbours: VertexNeighbours,
@@ -76,19 +86,33 @@ pub struct TracedScene {
 
 impl TracedScene {
     /// The indirect transfer after each of `bounces` Neumann-series steps: item `b` is
-    /// `Σ_{k=1..b+1} (diag(ρ) W)^k T_direct`.
-    pub fn cumulative_indirect<'a>(
-        &'a self,
-        albedo: &'a [crate::color::Rgb],
-        bounces: u32,
-    ) -> impl Iterator<Item = TransferVectors> + 'a {
+    /// `Σ_{k=1..b+1} diag(a) W (diag(ρ) W)^(k-1) T_direct(ρ)`, with `ρ` the reflected and `a`
+    /// the vertex albedo (the same unless the scene is textured).
+    pub fn cumulative_indirect(&self, bounces: u32) -> impl Iterator<Item = TransferVectors> + '_ {
         let order = self.direct.order();
-        let mut previous = self.direct.clone();
+        let mut previous = match &self.textured {
+            Some((reflected_direct, _)) => reflected_direct.clone(),
+            None => self.direct.clone(),
+        };
         let mut sum = TransferVectors::zeros(order, self.direct.vertex_count());
+        let ones = vec![crate::color::Rgb::ONE; self.direct.vertex_count()];
         (0..bounces).map(move |_| {
-            previous = self.operator.apply(&previous, albedo);
-            fill_inside(&mut previous, &self.inside, &self.neighbours);
-            for (acc, x) in sum.as_mut_slice().iter_mut().zip(previous.as_slice()) {
+            let stored = match &self.textured {
+                None => {
+                    previous = self.operator.apply(&previous, &self.reflected_albedo);
+                    fill_inside(&mut previous, &self.inside, &self.neighbours);
+                    previous.clone()
+                }
+                Some((_, baked)) => {
+                    let gathered = self.operator.apply(&previous, &ones);
+                    previous = gathered.scaled_per_vertex(&self.reflected_albedo);
+                    fill_inside(&mut previous, &self.inside, &self.neighbours);
+                    let mut stored = gathered.scaled_per_vertex(baked);
+                    fill_inside(&mut stored, &self.inside, &self.neighbours);
+                    stored
+                }
+            };
+            for (acc, x) in sum.as_mut_slice().iter_mut().zip(stored.as_slice()) {
                 *acc += x;
             }
             sum.clone()
@@ -108,12 +132,23 @@ pub fn trace(
     let start = Instant::now();
     progress.start(geometry.mesh.vertex_count() as u64);
     let traced = visibility::trace_vertices(geometry, bvh, settings, progress);
-    let mut direct = traced.direct_transfer(&geometry.albedo, settings.order);
     let neighbours = VertexNeighbours::new(&geometry.mesh);
-    fill_inside(&mut direct, &traced.inside, &neighbours);
+    let reflected_albedo = geometry.reflected_albedo();
+    let mut reflected_direct = traced.direct_transfer(&reflected_albedo, settings.order);
+    fill_inside(&mut reflected_direct, &traced.inside, &neighbours);
+    let (direct, textured) = if geometry.is_textured() {
+        let albedo = geometry.albedo.clone();
+        let mut direct = traced.direct_transfer(&albedo, settings.order);
+        fill_inside(&mut direct, &traced.inside, &neighbours);
+        (direct, Some((reflected_direct, albedo)))
+    } else {
+        (reflected_direct, None)
+    };
     Ok(TracedScene {
         direct,
         operator: traced.operator,
+        reflected_albedo,
+        textured,
         inside: traced.inside,
         neighbours,
         seconds: start.elapsed().as_secs_f64(),
@@ -140,10 +175,7 @@ pub fn bake(
     };
     let mut indirect = TransferVectors::zeros(settings.order, vertex_count);
     let mut bounce_start = Instant::now();
-    for (bounce, sum) in traced
-        .cumulative_indirect(&geometry.albedo, settings.bounces)
-        .enumerate()
-    {
+    for (bounce, sum) in traced.cumulative_indirect(settings.bounces).enumerate() {
         stats
             .bounce_seconds
             .push(bounce_start.elapsed().as_secs_f64());
@@ -158,6 +190,12 @@ pub fn bake(
             settings: *settings,
             direct: traced.direct,
             indirect,
+            textured_vertices: geometry
+                .objects
+                .iter()
+                .filter(|o| o.texture.is_some())
+                .map(|o| u64::from(o.vertices.end - o.vertices.start))
+                .sum(),
         },
         stats,
     ))

@@ -204,6 +204,7 @@ fn plane_facing(normal: Vec3) -> TriangleMesh {
         positions: corners.to_vec(),
         normals: vec![normal; 4],
         triangles: vec![[0, 1, 2], [0, 2, 3]],
+        uvs: Vec::new(),
     }
 }
 
@@ -231,7 +232,7 @@ fn each_sh_basis_function_lights_open_surfaces_by_funk_hecke() {
         let (transfer, _) = run(&geometry, settings);
         let full = transfer.full();
         let mut worst = 0.0f32;
-        for l in 0..5usize {
+        for (l, clamped_cosine) in CLAMPED_COSINE.iter().enumerate() {
             for m in -(l as isize)..=l as isize {
                 let k = crate::sh::index(l, m);
                 let mut light = ShCoeffs::zeros(5);
@@ -239,7 +240,7 @@ fn each_sh_basis_function_lights_open_surfaces_by_funk_hecke() {
                 for v in 0..geometry.mesh.vertex_count() {
                     let n = geometry.mesh.normals[v];
                     let y = basis.eval_vec(n)[k];
-                    let want = albedo * (CLAMPED_COSINE[l] / std::f32::consts::PI * y);
+                    let want = albedo * (clamped_cosine / std::f32::consts::PI * y);
                     let got = full.radiance(v, &light);
                     let error = (got - want).abs().max_element();
                     worst = worst.max(error);

@@ -73,6 +73,20 @@ impl TransferVectors {
     }
 
     /// Element-wise sum (direct + indirect = full transfer).
+    /// Each vertex's vectors times its albedo, channel by channel.
+    pub fn scaled_per_vertex(&self, albedo: &[Rgb]) -> TransferVectors {
+        let mut out = self.clone();
+        let per_channel = self.stride() / 3;
+        for (vector, rho) in out.data.chunks_exact_mut(self.stride()).zip(albedo) {
+            for (c, channel) in vector.chunks_exact_mut(per_channel).enumerate() {
+                for x in channel {
+                    *x *= rho[c];
+                }
+            }
+        }
+        out
+    }
+
     pub fn sum(&self, other: &TransferVectors) -> TransferVectors {
         assert_eq!(
             (self.order, self.vertex_count),

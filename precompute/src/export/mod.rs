@@ -102,6 +102,7 @@ fn object_mesh(geometry: &SceneMesh, object: usize) -> TriangleMesh {
             .iter()
             .map(|t| t.map(|i| i - v0 as u32))
             .collect(),
+        uvs: mesh.uvs.get(v0..v1).map(<[_]>::to_vec).unwrap_or_default(),
     }
 }
 
@@ -173,7 +174,11 @@ pub fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
         rotation = settings.rotation_deg,
     );
     for (i, o) in geometry.objects.iter().enumerate() {
-        let a = o.albedo;
+        // Textures are not exported yet: a textured object gets its texture's mean.
+        let a = match o.texture {
+            Some(t) => o.albedo * geometry.textures[t].mean(),
+            None => o.albedo,
+        };
         let _ = write!(
             xml,
             r#"    <shape type="ply" id="{id}">
@@ -219,6 +224,12 @@ pub fn export_mitsuba(
         path: path.to_owned(),
         message,
     };
+    if geometry.is_textured() {
+        log::warn!(
+            "textured objects are exported with their texture's mean albedo: Mitsuba's image \
+             differs from hprt's on them"
+        );
+    }
     let meshes = dir.join("meshes");
     std::fs::create_dir_all(&meshes).map_err(|e| error(&meshes, e.to_string()))?;
     for i in 0..geometry.objects.len() {

@@ -54,18 +54,22 @@ impl MeshCleanup {
             mut positions,
             normals,
             triangles,
+            uvs,
         } = raw;
         let diagonal = bounds_diagonal(&positions);
         let mut report = CleanupReport::default();
         let input_triangles = triangles.len();
 
-        let weld = self.weld.unwrap_or(normals.is_none());
-        let (mut triangles, mut normals) = (triangles, normals);
+        // Texture seams are split vertices on purpose: a textured mesh is not welded unless
+        // asked (and then each welded vertex keeps the first one's coordinates).
+        let weld = self.weld.unwrap_or(normals.is_none() && uvs.is_none());
+        let (mut triangles, mut normals, mut uvs) = (triangles, normals, uvs);
         if weld {
             let (remap, kept) = weld_positions(&positions, self.weld_tolerance * diagonal);
             report.welded_vertices = positions.len() - kept.len();
             positions = kept.iter().map(|&i| positions[i as usize]).collect();
             normals = normals.map(|n| kept.iter().map(|&i| n[i as usize]).collect());
+            uvs = uvs.map(|t| kept.iter().map(|&i| t[i as usize]).collect());
             for t in &mut triangles {
                 *t = t.map(|i| remap[i as usize]);
             }
@@ -105,6 +109,7 @@ impl MeshCleanup {
             positions,
             normals,
             triangles,
+            uvs: uvs.unwrap_or_default(),
         });
         Ok((mesh, report))
     }
@@ -143,6 +148,18 @@ fn validate(raw: &RawMesh) -> Result<(), String> {
         }
         if let Some(i) = normals.iter().position(|n| !n.is_finite()) {
             return Err(format!("vertex {i} has a non-finite normal"));
+        }
+    }
+    if let Some(uvs) = &raw.uvs {
+        if uvs.len() != raw.positions.len() {
+            return Err(format!(
+                "{} texture coordinates for {} vertices",
+                uvs.len(),
+                raw.positions.len()
+            ));
+        }
+        if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
+            return Err(format!("vertex {i} has non-finite texture coordinates"));
         }
     }
     let n = raw.positions.len() as u32;
@@ -244,6 +261,9 @@ fn remove_unreferenced(mesh: TriangleMesh) -> TriangleMesh {
                 *slot = out.positions.len() as u32;
                 out.positions.push(mesh.positions[i as usize]);
                 out.normals.push(mesh.normals[i as usize]);
+                if let Some(uv) = mesh.uvs.get(i as usize) {
+                    out.uvs.push(*uv);
+                }
             }
             *slot
         });
@@ -272,6 +292,7 @@ mod tests {
             ],
             normals: None,
             triangles: vec![[0, 1, 2], [3, 4, 5], [0, 1, 0], [0, 2, 6]],
+            uvs: None,
         }
     }
 
@@ -315,6 +336,7 @@ mod tests {
             positions: vec![Vec3::ZERO; 3],
             normals: None,
             triangles: vec![[0, 1, 2]],
+            uvs: None,
         };
         let err = MeshCleanup::default()
             .run(&PathBuf::from("flat.obj"), raw)

@@ -4,23 +4,28 @@
 
 mod bpt;
 mod cleanup;
+mod gltf;
 mod obj;
 mod ply;
 mod shapes;
 
 pub use bpt::{BezierPatch, read_bpt, tessellate_patches};
 pub use cleanup::{CleanupReport, MeshCleanup};
+pub use gltf::{ModelPart, PartMaterial, srgb_to_linear};
 pub use shapes::{annulus_mesh, box_mesh, icosahedron, sphere_mesh, subdivide};
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::path::{Path, PathBuf};
 
-/// An indexed triangle mesh with one unit normal per vertex.
+/// An indexed triangle mesh with one unit normal per vertex and, for a textured mesh, one
+/// texture coordinate per vertex (glTF's convention: origin at the image's top left).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriangleMesh {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
     pub triangles: Vec<[u32; 3]>,
+    /// Empty, or one per vertex.
+    pub uvs: Vec<Vec2>,
 }
 
 impl TriangleMesh {
@@ -66,9 +71,19 @@ impl TriangleMesh {
         )
     }
 
-    /// Appends `other`, offsetting its indices.
+    /// Appends `other`, offsetting its indices. Texture coordinates stay one per vertex where
+    /// either mesh has them (zero for the other's vertices).
     pub fn append(&mut self, other: &TriangleMesh) {
         let base = self.positions.len() as u32;
+        if !self.uvs.is_empty() || !other.uvs.is_empty() {
+            self.uvs.resize(self.positions.len(), Vec2::ZERO);
+            match other.uvs.is_empty() {
+                true => self
+                    .uvs
+                    .extend(std::iter::repeat_n(Vec2::ZERO, other.positions.len())),
+                false => self.uvs.extend_from_slice(&other.uvs),
+            }
+        }
         self.positions.extend_from_slice(&other.positions);
         self.normals.extend_from_slice(&other.normals);
         self.triangles
@@ -76,12 +91,14 @@ impl TriangleMesh {
     }
 }
 
-/// A mesh as read from a file: positions, triangles and, if the file has them, normals.
+/// A mesh as read from a file: positions, triangles and, if the file has them, normals and
+/// texture coordinates.
 #[derive(Debug, Clone, Default)]
 pub struct RawMesh {
     pub positions: Vec<Vec3>,
     pub normals: Option<Vec<Vec3>>,
     pub triangles: Vec<[u32; 3]>,
+    pub uvs: Option<Vec<Vec2>>,
 }
 
 /// Why a mesh could not be loaded. Every variant names the file.
@@ -103,7 +120,8 @@ pub enum MeshError {
     #[error("{}: the mesh has no triangles{detail}", path.display())]
     Empty { path: PathBuf, detail: String },
     #[error(
-        "{}: unsupported mesh format (expected .obj, .ply, .bpt, optionally gzipped as .gz)",
+        "{}: unsupported mesh format (expected .obj, .ply, .bpt, optionally gzipped as .gz, or \
+         glTF 2.0: .gltf, .glb)",
         path.display()
     )]
     UnsupportedFormat { path: PathBuf },
@@ -151,7 +169,7 @@ fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
 fn format_of(path: &Path) -> Option<&'static str> {
     let name = path.file_name()?.to_str()?.to_ascii_lowercase();
     let name = name.strip_suffix(".gz").unwrap_or(&name);
-    ["obj", "ply", "bpt"]
+    ["obj", "ply", "bpt", "gltf", "glb"]
         .into_iter()
         .find(|ext| name.ends_with(&format!(".{ext}")))
 }
@@ -170,7 +188,42 @@ pub struct LoadOptions {
 /// use (the teapot needs 16), and bounded before anything is allocated.
 pub const MAX_PATCH_SEGMENTS: u32 = 256;
 
-/// Reads a mesh file (OBJ, PLY ASCII or binary, BPT; any of them gzipped) without clean-up.
+/// Whether `path` names a mesh or model file hprt reads (by its extension).
+pub fn is_mesh_file(path: &Path) -> bool {
+    format_of(path).is_some()
+}
+
+/// Whether `path` names a glTF 2.0 model (`.gltf` or `.glb`).
+pub fn is_gltf(path: &Path) -> bool {
+    matches!(format_of(path), Some("gltf" | "glb"))
+}
+
+/// Reads any model file as parts without clean-up: a glTF model's triangle primitives with
+/// their materials, or another mesh file as one part named after the file.
+pub fn read_model(path: &Path, options: &LoadOptions) -> Result<Vec<ModelPart>, MeshError> {
+    if is_gltf(path) {
+        let bytes = read_bytes(path)?;
+        return gltf::parse_gltf(path, &bytes);
+    }
+    if format_of(path) == Some("obj") {
+        let bytes = read_bytes(path)?;
+        if let Some(parts) = obj::parse_obj_parts(path, &bytes)? {
+            return Ok(parts);
+        }
+    }
+    let mesh = read_mesh(path, options)?;
+    Ok(vec![ModelPart {
+        name: path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        mesh,
+        material: None,
+    }])
+}
+
+/// Reads a mesh file (OBJ, PLY ASCII or binary, BPT; any of them gzipped; or a glTF model's
+/// primitives merged) without clean-up.
 pub fn read_mesh(path: &Path, options: &LoadOptions) -> Result<RawMesh, MeshError> {
     let format = format_of(path).ok_or_else(|| MeshError::UnsupportedFormat {
         path: path.to_owned(),
@@ -179,6 +232,7 @@ pub fn read_mesh(path: &Path, options: &LoadOptions) -> Result<RawMesh, MeshErro
     match format {
         "obj" => obj::parse_obj(path, &bytes),
         "ply" => ply::parse_ply(path, &bytes),
+        "gltf" | "glb" => Ok(merge_parts(gltf::parse_gltf(path, &bytes)?)),
         _ => {
             let mut patches = bpt::read_bpt(path, &bytes)?;
             if let Some(&bad) = options.skip_patches.iter().find(|&&p| p >= patches.len()) {
@@ -222,6 +276,26 @@ pub fn load_mesh(
     MeshCleanup::default().run(path, raw)
 }
 
+/// One mesh of all `parts`; normals only if every part has them.
+fn merge_parts(parts: Vec<ModelPart>) -> RawMesh {
+    let all_normals = parts.iter().all(|p| p.mesh.normals.is_some());
+    let mut merged = RawMesh {
+        normals: all_normals.then(Vec::new),
+        ..Default::default()
+    };
+    for part in parts {
+        let base = merged.positions.len() as u32;
+        merged.positions.extend(&part.mesh.positions);
+        if let (Some(all), Some(n)) = (&mut merged.normals, &part.mesh.normals) {
+            all.extend(n);
+        }
+        merged
+            .triangles
+            .extend(part.mesh.triangles.iter().map(|t| t.map(|i| i + base)));
+    }
+    merged
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -240,6 +314,7 @@ mod tests {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
             normals: vec![Vec3::Z; 3],
             triangles: vec![[0, 1, 2]],
+            uvs: Vec::new(),
         };
         let mut m = tri.clone();
         m.append(&tri);

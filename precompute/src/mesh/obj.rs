@@ -1,34 +1,45 @@
 //! Wavefront OBJ through `tobj`, with the offending line located for error messages.
 
-use super::{MeshError, RawMesh};
-use glam::Vec3;
-use std::path::Path;
+use super::{MeshError, ModelPart, PartMaterial, RawMesh};
+use crate::color::Rgb;
+use crate::texture::AlbedoTexture;
+use glam::{Vec2, Vec3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
-    let options = tobj::LoadOptions {
+/// Triangles, and one index per vertex for positions, normals and texture coordinates.
+fn load_options() -> tobj::LoadOptions {
+    tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ..Default::default()
-    };
+    }
+}
+
+/// What tobj's error means, with the offending line where it can be found.
+fn syntax_error(path: &Path, bytes: &[u8], e: tobj::LoadError) -> MeshError {
+    let text = String::from_utf8_lossy(bytes);
+    match first_bad_line(&text) {
+        Some((line, message)) => MeshError::Syntax {
+            path: path.to_owned(),
+            line,
+            message,
+        },
+        None => MeshError::Invalid {
+            path: path.to_owned(),
+            message: format!("malformed OBJ: {e}"),
+        },
+    }
+}
+
+/// The whole file as one mesh, materials ignored.
+pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let mut reader = std::io::BufReader::new(bytes);
-    // Materials are irrelevant: albedo comes from the scene file.
-    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| {
+    let (models, _) = tobj::load_obj_buf(&mut reader, &load_options(), |_| {
         Ok((Vec::new(), Default::default()))
     })
-    .map_err(|e| {
-        let text = String::from_utf8_lossy(bytes);
-        match first_bad_line(&text) {
-            Some((line, message)) => MeshError::Syntax {
-                path: path.to_owned(),
-                line,
-                message,
-            },
-            None => MeshError::Invalid {
-                path: path.to_owned(),
-                message: format!("malformed OBJ: {e}"),
-            },
-        }
-    })?;
+    .map_err(|e| syntax_error(path, bytes, e))?;
 
     let mut mesh = RawMesh::default();
     let all_have_normals = models
@@ -60,6 +71,117 @@ pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
         mesh.normals = Some(normals);
     }
     Ok(mesh)
+}
+
+/// The file's objects as parts with their `.mtl` materials: `Kd` as the base colour, `map_Kd`
+/// (sRGB) as its texture, texture coordinates flipped to glTF's top-left origin. `None` when
+/// the file names no material library, or one that defines no material, or one that cannot be
+/// read (with a warning): the scene's albedo applies to the whole file.
+pub fn parse_obj_parts(path: &Path, bytes: &[u8]) -> Result<Option<Vec<ModelPart>>, MeshError> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut reader = std::io::BufReader::new(bytes);
+    let (models, materials) = tobj::load_obj_buf(&mut reader, &load_options(), |p| {
+        tobj::load_mtl(dir.join(p))
+    })
+    .map_err(|e| syntax_error(path, bytes, e))?;
+    let materials = match materials {
+        Ok(m) if !m.is_empty() => m,
+        Ok(_) => return Ok(None),
+        Err(e) => {
+            log::warn!(
+                "{}: cannot read its material library ({e}): its materials are ignored",
+                path.display()
+            );
+            return Ok(None);
+        }
+    };
+    let mut textures: HashMap<PathBuf, Arc<AlbedoTexture>> = HashMap::new();
+    let mut parts = Vec::new();
+    for model in &models {
+        let m = &model.mesh;
+        let positions: Vec<Vec3> = m
+            .positions
+            .chunks_exact(3)
+            .map(|p| Vec3::new(p[0], p[1], p[2]))
+            .collect();
+        let normals = (m.normals.len() == m.positions.len()).then(|| {
+            m.normals
+                .chunks_exact(3)
+                .map(|n| Vec3::new(n[0], n[1], n[2]))
+                .collect()
+        });
+        let uvs = (m.texcoords.len() / 2 == positions.len() && !positions.is_empty()).then(|| {
+            m.texcoords
+                .chunks_exact(2)
+                .map(|t| Vec2::new(t[0], 1.0 - t[1]))
+                .collect::<Vec<_>>()
+        });
+        let material = match m.material_id.and_then(|i| materials.get(i)) {
+            None => None,
+            Some(mat) => {
+                let texture = match (&mat.diffuse_texture, &uvs) {
+                    (Some(file), Some(_)) => {
+                        let file = dir.join(file);
+                        Some(match textures.get(&file) {
+                            Some(t) => t.clone(),
+                            None => {
+                                let t = Arc::new(read_srgb_texture(&file)?);
+                                textures.insert(file, t.clone());
+                                t
+                            }
+                        })
+                    }
+                    (Some(_), None) => {
+                        log::warn!(
+                            "{}: {}: map_Kd ignored (the object has no texture coordinates)",
+                            path.display(),
+                            model.name
+                        );
+                        None
+                    }
+                    _ => None,
+                };
+                Some(PartMaterial {
+                    name: mat.name.clone(),
+                    base_color: Rgb::from_array(mat.diffuse.unwrap_or([1.0; 3])),
+                    texture,
+                })
+            }
+        };
+        parts.push(ModelPart {
+            name: model.name.clone(),
+            mesh: RawMesh {
+                triangles: m
+                    .indices
+                    .chunks_exact(3)
+                    .map(|t| [t[0], t[1], t[2]])
+                    .collect(),
+                positions,
+                normals,
+                uvs,
+            },
+            material,
+        });
+    }
+    Ok(Some(parts))
+}
+
+/// An 8- or 16-bit image file as an sRGB-encoded albedo texture, decoded to linear RGB.
+pub fn read_srgb_texture(path: &Path) -> Result<AlbedoTexture, MeshError> {
+    let image = image::open(path).map_err(|e| MeshError::Invalid {
+        path: path.to_owned(),
+        message: format!("cannot read the texture: {e}"),
+    })?;
+    let rgb = image.to_rgb32f();
+    // to_rgb32f only rescales the stored values: they are still sRGB-encoded.
+    Ok(AlbedoTexture {
+        width: rgb.width() as usize,
+        height: rgb.height() as usize,
+        texels: rgb
+            .pixels()
+            .map(|p| Vec3::from_array(p.0).map(super::gltf::srgb_to_linear))
+            .collect(),
+    })
 }
 
 /// The first line that does not parse as OBJ geometry, with a description (tobj reports the

@@ -197,6 +197,7 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
         positions,
         normals,
         triangles,
+        uvs: None,
     })
 }
 

@@ -139,6 +139,7 @@ pub fn sphere_mesh(center: Vec3, radius: f32, subdivisions: u32) -> TriangleMesh
         positions: directions.iter().map(|d| center + *d * radius).collect(),
         normals: directions,
         triangles,
+        uvs: Vec::new(),
     }
 }
 

@@ -7,7 +7,7 @@ use crate::bake::RAY_OFFSET_FRACTION;
 use crate::bvh::{Hit, SceneBvh, Skip};
 use crate::color::{Rgb, luminance};
 use crate::sampling::{Frame, cosine_hemisphere};
-use crate::scene::SceneMesh;
+use crate::scene::{NO_TEXTURE, SceneMesh};
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
 
@@ -42,6 +42,8 @@ pub struct Integrator<'a> {
     pub bounces: u32,
     offset: f32,
     front_normals: Vec<Vec3>,
+    /// Per triangle, its texture in `geometry.textures` or [`NO_TEXTURE`].
+    triangle_textures: Vec<u32>,
 }
 
 #[inline]
@@ -67,6 +69,7 @@ impl<'a> Integrator<'a> {
             front_normals: (0..mesh.triangle_count())
                 .map(|t| mesh.front_normal(t))
                 .collect(),
+            triangle_textures: geometry.triangle_textures(),
         }
     }
 
@@ -83,6 +86,16 @@ impl<'a> Integrator<'a> {
             position += mesh.positions[*i as usize] * w;
             normal += mesh.normals[*i as usize] * w;
             albedo += self.geometry.albedo[*i as usize] * w;
+        }
+        let texture = self.triangle_textures[hit.triangle as usize];
+        if texture != NO_TEXTURE {
+            // The texel's albedo (times the object's factor, interpolated above).
+            let uv: glam::Vec2 = corners
+                .iter()
+                .zip(weights)
+                .map(|(i, w)| mesh.uvs[*i as usize] * w)
+                .sum();
+            albedo *= self.geometry.textures[texture as usize].bilinear(uv);
         }
         let front = self.front_normals[hit.triangle as usize];
         SurfacePoint {
@@ -102,6 +115,7 @@ impl<'a> Integrator<'a> {
             position: mesh.positions[v as usize],
             shading_normal: normal,
             front_normal: normal,
+            // On a textured object, the texture's factor: as the bake, per unit texel value.
             albedo: self.geometry.albedo[v as usize],
             leaving: Skip::VertexTriangles(v),
         }

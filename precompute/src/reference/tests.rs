@@ -79,7 +79,7 @@ fn furnace_sphere_reflects_its_albedo() {
     );
     // Uncovered pixels show the environment; a convex sphere sees its whole sky, except for
     // the few directions below a facet that its smooth normal still counts as above.
-    assert!(image.coverage.iter().any(|c| *c == 0.0));
+    assert!(image.coverage.contains(&0.0));
     let covered: Vec<f32> = image
         .visibility
         .iter()
@@ -104,6 +104,7 @@ fn open_box() -> TriangleMesh {
         positions: outer.positions.clone(),
         normals: outer.normals.iter().map(|n| -*n).collect(),
         triangles: outer.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect(),
+        uvs: Vec::new(),
     }
 }
 

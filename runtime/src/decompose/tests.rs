@@ -310,10 +310,10 @@ fn every_sh_window_scales_the_sh_part_band_by_band_in_both_modes() {
                     a.power
                 );
             }
-            for l in 0..5usize {
+            for (l, factor) in factors.iter().enumerate().take(5) {
                 for m in -(l as isize)..=l as isize {
                     let k = precompute::sh::index(l, m);
-                    let want = plain.sh.as_slice()[k] * factors[l];
+                    let want = plain.sh.as_slice()[k] * *factor;
                     let got = windowed.sh.as_slice()[k];
                     assert!(
                         (got - want).abs().max_element()

@@ -38,7 +38,12 @@ pub fn next_level(texels: &[Rgb], width: usize, height: usize) -> (Vec<Rgb>, usi
 
 /// Every mip level of `map`, full resolution first.
 pub fn mip_chain(map: &EnvMap) -> Vec<(Vec<Rgb>, usize, usize)> {
-    let mut levels = vec![(map.texels().to_vec(), map.width(), map.height())];
+    mip_chain_of(map.texels(), map.width(), map.height())
+}
+
+/// Every mip level of a `width × height` image, full resolution first.
+pub fn mip_chain_of(texels: &[Rgb], width: usize, height: usize) -> Vec<(Vec<Rgb>, usize, usize)> {
+    let mut levels = vec![(texels.to_vec(), width, height)];
     while let Some((texels, w, h)) = levels.last().filter(|l| l.1 > 1 || l.2 > 1) {
         let next = next_level(texels, *w, *h);
         levels.push(next);
@@ -48,49 +53,7 @@ pub fn mip_chain(map: &EnvMap) -> Vec<(Vec<Rgb>, usize, usize)> {
 
 impl EnvironmentTexture {
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, map: &EnvMap, rotation: f32) -> Self {
-        let levels = mip_chain(map);
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("environment"),
-            size: wgpu::Extent3d {
-                width: map.width() as u32,
-                height: map.height() as u32,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: levels.len() as u32,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        for (level, (texels, w, h)) in levels.iter().enumerate() {
-            let data: Vec<half::f16> = texels
-                .iter()
-                .flat_map(|c| {
-                    let c = c.clamp(Rgb::ZERO, Rgb::splat(HALF_MAX));
-                    [c.x, c.y, c.z, 1.0].map(half::f16::from_f32)
-                })
-                .collect();
-            queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: level as u32,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                bytemuck::cast_slice(&data),
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(*w as u32 * 8),
-                    rows_per_image: Some(*h as u32),
-                },
-                wgpu::Extent3d {
-                    width: *w as u32,
-                    height: *h as u32,
-                    depth_or_array_layers: 1,
-                },
-            );
-        }
+        let texture = upload_mip_chain(device, queue, "environment", &mip_chain(map));
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("environment"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -106,6 +69,60 @@ impl EnvironmentTexture {
             rotation,
         }
     }
+}
+
+/// A mipmapped Rgba16Float texture (filterable on every backend) holding `levels`, full
+/// resolution first; values beyond the largest half float are clamped to it.
+pub fn upload_mip_chain(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    levels: &[(Vec<Rgb>, usize, usize)],
+) -> wgpu::Texture {
+    let (_, width, height) = levels[0];
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: width as u32,
+            height: height as u32,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: levels.len() as u32,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba16Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for (level, (texels, w, h)) in levels.iter().enumerate() {
+        let data: Vec<half::f16> = texels
+            .iter()
+            .flat_map(|c| {
+                let c = c.clamp(Rgb::ZERO, Rgb::splat(HALF_MAX));
+                [c.x, c.y, c.z, 1.0].map(half::f16::from_f32)
+            })
+            .collect();
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: level as u32,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(&data),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(*w as u32 * 8),
+                rows_per_image: Some(*h as u32),
+            },
+            wgpu::Extent3d {
+                width: *w as u32,
+                height: *h as u32,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+    texture
 }
 
 #[cfg(test)]

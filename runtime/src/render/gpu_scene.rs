@@ -2,13 +2,17 @@
 //! radiance computed from them every time the lighting changes (`shaders/transfer.wgsl`).
 
 use super::RenderError;
+use super::environment::{mip_chain_of, upload_mip_chain};
 use super::shaders::{MAX_GPU_COEFFS, MAX_GPU_ORDER, Shader, TRANSFER_WORKGROUP};
 use crate::lighting::{FrameLighting, ShTransfer};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use precompute::bake::Transfer;
+use precompute::color::Rgb;
 use precompute::scene::SceneMesh;
 use precompute::sh::num_coeffs;
+use precompute::texture::AlbedoTexture;
+use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 #[repr(C)]
@@ -16,7 +20,9 @@ use wgpu::util::DeviceExt;
 struct Vertex {
     position: [f32; 3],
     normal: [f32; 3],
+    /// The albedo, or a textured object's factor (the texel multiplies it per pixel).
     albedo: [f32; 3],
+    uv: [f32; 2],
 }
 
 /// Matches `Lighting` in `shaders/transfer.wgsl`.
@@ -43,12 +49,20 @@ pub struct GpuScene {
     lighting_buffer: wgpu::Buffer,
     transfer_pipeline: wgpu::ComputePipeline,
     transfer_bind_group: wgpu::BindGroup,
+    /// Layout of group 1 of the PRT pass: an albedo texture and its sampler.
+    pub texture_layout: wgpu::BindGroupLayout,
+    /// One per texture; the first is a white texel for untextured objects.
+    texture_groups: Vec<wgpu::BindGroup>,
+    /// Index ranges drawn with one texture group each, in scene order.
+    draws: Vec<(std::ops::Range<u32>, usize)>,
 }
 
 pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: std::mem::size_of::<Vertex>() as u64,
     step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3],
+    attributes: &wgpu::vertex_attr_array![
+        0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 4 => Float32x2
+    ],
 };
 
 pub const RADIANCE_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
@@ -60,6 +74,7 @@ pub const RADIANCE_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBuffe
 impl GpuScene {
     pub fn new(
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
         geometry: &SceneMesh,
         transfer: &Transfer,
     ) -> Result<Self, RenderError> {
@@ -91,6 +106,7 @@ impl GpuScene {
                 position: mesh.positions[v].to_array(),
                 normal: mesh.normals[v].to_array(),
                 albedo: geometry.albedo[v].to_array(),
+                uv: mesh.uvs.get(v).map_or([0.0; 2], |uv| uv.to_array()),
             })
             .collect();
         let init = |label, contents: &[u8], usage| {
@@ -165,7 +181,20 @@ impl GpuScene {
                 },
             ],
         });
+        let texture_layout = texture_layout(device);
+        let white = Arc::new(AlbedoTexture {
+            width: 1,
+            height: 1,
+            texels: vec![Rgb::ONE],
+        });
+        let texture_groups = std::iter::once(&white)
+            .chain(&geometry.textures)
+            .map(|t| texture_group(device, queue, &texture_layout, t))
+            .collect();
         Ok(Self {
+            texture_layout,
+            texture_groups,
+            draws: draws(geometry),
             vertex_buffer,
             radiance_buffer,
             index_buffer,
@@ -216,15 +245,97 @@ impl GpuScene {
         self.draw_triangles(pass);
     }
 
-    /// Draws every triangle with its vertices' PRT radiance (the PRT pass).
+    /// Draws every triangle with its vertices' PRT radiance and its albedo texture (group 1)
+    /// (the PRT pass).
     pub fn draw_with_radiance(&self, pass: &mut wgpu::RenderPass) {
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, self.radiance_buffer.slice(..));
-        self.draw_triangles(pass);
+        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+        for (range, group) in &self.draws {
+            pass.set_bind_group(1, &self.texture_groups[*group], &[]);
+            pass.draw_indexed(range.clone(), 0, 0..1);
+        }
     }
 
     fn draw_triangles(&self, pass: &mut wgpu::RenderPass) {
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..self.index_count, 0, 0..1);
     }
+}
+
+/// Index ranges of consecutive objects sharing a texture group (0: untextured, `i + 1`:
+/// `geometry.textures[i]`): an untextured scene is one draw.
+fn draws(geometry: &SceneMesh) -> Vec<(std::ops::Range<u32>, usize)> {
+    let mut draws: Vec<(std::ops::Range<u32>, usize)> = Vec::new();
+    for o in &geometry.objects {
+        let group = o.texture.map_or(0, |t| t + 1);
+        let range = 3 * o.triangles.start..3 * o.triangles.end;
+        match draws.last_mut() {
+            Some((last, g)) if *g == group && last.end == range.start => last.end = range.end,
+            _ => draws.push((range, group)),
+        }
+    }
+    draws
+}
+
+/// Group 1 of the PRT pass: a filterable 2D texture and a filtering sampler.
+fn texture_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("albedo texture"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+        ],
+    })
+}
+
+/// An albedo texture with its mipmaps, sampled trilinearly with repeat wrapping (the reference
+/// looks the base level up bilinearly: `AlbedoTexture::bilinear`).
+fn texture_group(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    layout: &wgpu::BindGroupLayout,
+    texture: &AlbedoTexture,
+) -> wgpu::BindGroup {
+    let levels = mip_chain_of(&texture.texels, texture.width, texture.height);
+    let gpu_texture = upload_mip_chain(device, queue, "albedo texture", &levels);
+    let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("albedo texture"),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    });
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("albedo texture"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(
+                    &gpu_texture.create_view(&Default::default()),
+                ),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::Sampler(&sampler),
+            },
+        ],
+    })
 }

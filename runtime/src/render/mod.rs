@@ -141,11 +141,11 @@ impl Renderer {
         camera.validate()?;
         check_image_size(&gpu.device, camera)?;
         let device = gpu.device.clone();
-        let scene = GpuScene::new(&device, geometry, transfer)?;
+        let scene = GpuScene::new(&device, &gpu.queue, geometry, transfer)?;
         let buffers = FrameBuffers::new(&device);
         Ok(Self {
             bounds: BoundingSphere::of_box(scene.bounds.0, scene.bounds.1),
-            prt_pass: PrtPass::new(&device, &buffers.frame),
+            prt_pass: PrtPass::new(&device, &buffers.frame, &scene.texture_layout),
             light_pass: LightPass::new(&device),
             shadow_maps: ShadowMaps::new(&device, shadow)?,
             targets: Targets::new(&device, camera.width, camera.height),

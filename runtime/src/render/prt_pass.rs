@@ -16,11 +16,34 @@ pub struct PrtPass {
 }
 
 impl PrtPass {
-    pub fn new(device: &wgpu::Device, frame_buffer: &wgpu::Buffer) -> Self {
+    /// `texture_layout`: the scene's albedo textures (group 1, [`GpuScene::texture_layout`]).
+    pub fn new(
+        device: &wgpu::Device,
+        frame_buffer: &wgpu::Buffer,
+        texture_layout: &wgpu::BindGroupLayout,
+    ) -> Self {
         let module = Shader::Geometry.module(device);
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("prt pass frame"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("prt pass"),
+            bind_group_layouts: &[Some(&frame_layout), Some(texture_layout)],
+            immediate_size: 0,
+        });
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("prt pass"),
-            layout: None,
+            layout: Some(&layout),
             vertex: wgpu::VertexState {
                 module: &module,
                 entry_point: Some("vs_main"),
@@ -49,7 +72,7 @@ impl PrtPass {
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("prt pass"),
-            layout: &pipeline.get_bind_group_layout(0),
+            layout: &frame_layout,
             entries: &[wgpu::BindGroupEntry {
                 binding: 0,
                 resource: frame_buffer.as_entire_binding(),

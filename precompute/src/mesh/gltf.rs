@@ -1,0 +1,407 @@
+//! glTF 2.0 models (`.gltf` with its buffers, or `.glb`) through the `gltf` crate: every
+//! triangle primitive of the default scene, placed by its node transforms, with its texture
+//! coordinates and the material's base colour (factor and texture). Everything else a material
+//! says is ignored, with one note per material.
+
+use super::{MeshError, RawMesh};
+use crate::color::Rgb;
+use crate::texture::AlbedoTexture;
+use glam::{Mat3, Mat4, Vec2, Vec3};
+use gltf::mesh::Mode;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// One primitive of a model, in model space (the node transforms applied).
+#[derive(Debug, Clone)]
+pub struct ModelPart {
+    /// `mesh name/primitive index`, or the node's name where the mesh has none.
+    pub name: String,
+    /// The mesh, with texture coordinates where the primitive has them.
+    pub mesh: RawMesh,
+    /// The glTF material; `None` for formats without materials.
+    pub material: Option<PartMaterial>,
+}
+
+/// The part of a glTF material hprt uses: the base colour, linear.
+#[derive(Debug, Clone)]
+pub struct PartMaterial {
+    pub name: String,
+    /// `baseColorFactor` (linear RGB; alpha ignored).
+    pub base_color: Rgb,
+    /// `baseColorTexture`, decoded to linear RGB, if the material has one.
+    pub texture: Option<std::sync::Arc<AlbedoTexture>>,
+}
+
+/// Extensions that change how geometry is stored: a file that requires one cannot be read.
+const COMPRESSION_EXTENSIONS: [&str; 3] = [
+    "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression",
+    "KHR_mesh_quantization",
+];
+
+pub fn parse_gltf(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, MeshError> {
+    let invalid = |message: String| MeshError::Invalid {
+        path: path.to_owned(),
+        message,
+    };
+    let parsed = gltf::Gltf::from_slice_without_validation(bytes)
+        .map_err(|e| invalid(format!("malformed glTF: {e}")))?;
+    if let Some(ext) = parsed.document.extensions_required().next() {
+        let why = if COMPRESSION_EXTENSIONS.contains(&ext) {
+            "compressed or quantised geometry is not supported; export the model without \
+             compression"
+        } else {
+            "hprt does not support it"
+        };
+        return Err(invalid(format!(
+            "the file requires the extension {ext}: {why}"
+        )));
+    }
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice(bytes).map_err(|e| invalid(format!("invalid glTF: {e}")))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let buffers = gltf::import_buffers(&document, Some(base), blob)
+        .map_err(|e| invalid(format!("cannot load its buffers: {e}")))?;
+    let scene = document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+        .ok_or_else(|| invalid("the file has no scene".into()))?;
+
+    let mut loader = Loader {
+        path,
+        base,
+        buffers: &buffers,
+        textures: HashMap::new(),
+        noted: Vec::new(),
+        parts: Vec::new(),
+    };
+    let mut stack: Vec<(gltf::Node, Mat4, usize)> =
+        scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    while let Some((node, parent, depth)) = stack.pop() {
+        // A node may not be its own ancestor (the spec forbids cycles; a malformed file
+        // could have one).
+        if depth > 256 {
+            return Err(invalid(
+                "the node hierarchy is deeper than 256 (a cycle?)".into(),
+            ));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if let Some(mesh) = node.mesh() {
+            loader.mesh(&node, &mesh, &world)?;
+        }
+        stack.extend(node.children().map(|c| (c, world, depth + 1)));
+    }
+    if loader.parts.is_empty() {
+        return Err(MeshError::Empty {
+            path: path.to_owned(),
+            detail: " (no triangle primitive in the default scene)".into(),
+        });
+    }
+    Ok(loader.parts)
+}
+
+struct Loader<'a> {
+    path: &'a Path,
+    base: &'a Path,
+    buffers: &'a [gltf::buffer::Data],
+    /// Decoded base colour textures by image index.
+    textures: HashMap<usize, std::sync::Arc<AlbedoTexture>>,
+    /// Materials already noted for the properties hprt ignores.
+    noted: Vec<Option<usize>>,
+    parts: Vec<ModelPart>,
+}
+
+impl Loader<'_> {
+    fn invalid(&self, message: String) -> MeshError {
+        MeshError::Invalid {
+            path: self.path.to_owned(),
+            message,
+        }
+    }
+
+    fn mesh(
+        &mut self,
+        node: &gltf::Node,
+        mesh: &gltf::Mesh,
+        world: &Mat4,
+    ) -> Result<(), MeshError> {
+        let mesh_name = mesh
+            .name()
+            .or(node.name())
+            .map(str::to_owned)
+            .unwrap_or_else(|| format!("mesh{}", mesh.index()));
+        for primitive in mesh.primitives() {
+            let name = format!("{mesh_name}/{}", primitive.index());
+            let triangles_mode = matches!(
+                primitive.mode(),
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            );
+            if !triangles_mode {
+                log::warn!(
+                    "{}: {name}: {:?} primitive skipped (only triangles are surfaces)",
+                    self.path.display(),
+                    primitive.mode()
+                );
+                continue;
+            }
+            for (semantic, accessor) in primitive.attributes() {
+                self.check_accessor(&name, &format!("{semantic:?}"), &accessor)?;
+            }
+            if let Some(indices) = primitive.indices() {
+                self.check_accessor(&name, "indices", &indices)?;
+            }
+            let reader = primitive.reader(|b| self.buffers.get(b.index()).map(|d| &d[..]));
+            let positions: Vec<Vec3> = reader
+                .read_positions()
+                .ok_or_else(|| self.invalid(format!("{name}: no POSITION attribute")))?
+                .map(Vec3::from)
+                .collect();
+            let normals: Option<Vec<Vec3>> =
+                reader.read_normals().map(|n| n.map(Vec3::from).collect());
+            let uvs: Option<Vec<Vec2>> = reader
+                .read_tex_coords(0)
+                .map(|t| t.into_f32().map(Vec2::from).collect());
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..positions.len() as u32).collect(),
+            };
+            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+                return Err(self.invalid(format!(
+                    "{name}: index {bad} is past its {} vertices",
+                    positions.len()
+                )));
+            }
+            let mut triangles = assemble_triangles(primitive.mode(), &indices);
+            // A mirroring transform turns the winding around (glTF 2.0, 3.7.4).
+            let linear = Mat3::from_mat4(*world);
+            if linear.determinant() < 0.0 {
+                for t in &mut triangles {
+                    t.swap(1, 2);
+                }
+            }
+            if !linear.determinant().is_normal() {
+                return Err(self.invalid(format!("{name}: its node transform is singular")));
+            }
+            let normal_matrix = linear.inverse().transpose();
+            let raw = RawMesh {
+                positions: positions
+                    .iter()
+                    .map(|p| world.transform_point3(*p))
+                    .collect(),
+                normals: normals.map(|ns| {
+                    ns.iter()
+                        .map(|n| (normal_matrix * *n).normalize_or_zero())
+                        .collect()
+                }),
+                triangles,
+                uvs,
+            };
+            let material = self.material(&primitive.material())?;
+            if material.texture.is_some() && raw.uvs.is_none() {
+                return Err(self.invalid(format!(
+                    "{name}: its material has a base colour texture but the primitive has no \
+                     TEXCOORD_0"
+                )));
+            }
+            self.parts.push(ModelPart {
+                name,
+                mesh: raw,
+                material: Some(material),
+            });
+        }
+        Ok(())
+    }
+
+    /// Refuses what the `gltf` crate's reader would read wrongly or panic on: sparse
+    /// accessors, and accessors reaching past their buffer view or buffer.
+    fn check_accessor(
+        &self,
+        part: &str,
+        what: &str,
+        accessor: &gltf::Accessor,
+    ) -> Result<(), MeshError> {
+        if accessor.sparse().is_some() {
+            return Err(self.invalid(format!(
+                "{part}: {what} uses a sparse accessor, which hprt does not support"
+            )));
+        }
+        let Some(view) = accessor.view() else {
+            return Err(self.invalid(format!("{part}: {what} has no buffer view")));
+        };
+        let buffer_len = self
+            .buffers
+            .get(view.buffer().index())
+            .map_or(0, |b| b.len());
+        let element = accessor.size();
+        let stride = view.stride().unwrap_or(element);
+        let needed = match accessor.count() {
+            0 => 0,
+            n => accessor.offset() + stride * (n - 1) + element,
+        };
+        if needed > view.length() || view.offset() + view.length() > buffer_len {
+            return Err(self.invalid(format!(
+                "{part}: {what} reaches past the end of its buffer (accessor {})",
+                accessor.index()
+            )));
+        }
+        Ok(())
+    }
+
+    fn material(&mut self, material: &gltf::Material) -> Result<PartMaterial, MeshError> {
+        let name = material
+            .name()
+            .map(str::to_owned)
+            .unwrap_or_else(|| match material.index() {
+                Some(i) => format!("material {i}"),
+                None => "the default material".into(),
+            });
+        let pbr = material.pbr_metallic_roughness();
+        let [r, g, b, _] = pbr.base_color_factor();
+        if !self.noted.contains(&material.index()) {
+            self.noted.push(material.index());
+            let ignored = ignored_properties(material);
+            if !ignored.is_empty() {
+                log::warn!(
+                    "{}: {name}: hprt renders the base colour only; ignored: {}",
+                    self.path.display(),
+                    ignored.join(", ")
+                );
+            }
+        }
+        let texture = match pbr.base_color_texture() {
+            None => None,
+            Some(info) => {
+                if info.tex_coord() != 0 {
+                    return Err(self.invalid(format!(
+                        "{name}: the base colour texture uses TEXCOORD_{}; hprt reads \
+                         TEXCOORD_0 only",
+                        info.tex_coord()
+                    )));
+                }
+                Some(self.texture(&info.texture().source())?)
+            }
+        };
+        Ok(PartMaterial {
+            name,
+            base_color: Rgb::new(r, g, b),
+            texture,
+        })
+    }
+
+    fn texture(&mut self, image: &gltf::Image) -> Result<std::sync::Arc<AlbedoTexture>, MeshError> {
+        if let Some(t) = self.textures.get(&image.index()) {
+            return Ok(t.clone());
+        }
+        let data = gltf::image::Data::from_source(image.source(), Some(self.base), self.buffers)
+            .map_err(|e| self.invalid(format!("image {}: cannot decode it: {e}", image.index())))?;
+        let texture = std::sync::Arc::new(decode_srgb(&data).ok_or_else(|| {
+            self.invalid(format!(
+                "image {}: unsupported pixel format {:?} for a base colour",
+                image.index(),
+                data.format
+            ))
+        })?);
+        self.textures.insert(image.index(), texture.clone());
+        Ok(texture)
+    }
+}
+
+/// Triangles of a triangle list, strip or fan.
+fn assemble_triangles(mode: Mode, indices: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::TriangleStrip => (2..indices.len())
+            .map(|i| {
+                let (a, b, c) = (indices[i - 2], indices[i - 1], indices[i]);
+                // Every other triangle of a strip is wound the other way.
+                if i % 2 == 0 { [a, b, c] } else { [b, a, c] }
+            })
+            .collect(),
+        Mode::TriangleFan => (2..indices.len())
+            .map(|i| [indices[0], indices[i - 1], indices[i]])
+            .collect(),
+        _ => indices
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect(),
+    }
+}
+
+/// Material properties that would change a render but that hprt ignores.
+fn ignored_properties(material: &gltf::Material) -> Vec<&'static str> {
+    let pbr = material.pbr_metallic_roughness();
+    let mut ignored = Vec::new();
+    if pbr.metallic_factor() != 0.0 || pbr.metallic_roughness_texture().is_some() {
+        ignored.push("metallic");
+    }
+    if pbr.roughness_factor() != 1.0 {
+        ignored.push("roughness");
+    }
+    if material.normal_texture().is_some() {
+        ignored.push("normal texture");
+    }
+    if material.occlusion_texture().is_some() {
+        ignored.push("occlusion texture");
+    }
+    if material.emissive_texture().is_some() || material.emissive_factor() != [0.0; 3] {
+        ignored.push("emission");
+    }
+    if material.alpha_mode() != gltf::material::AlphaMode::Opaque {
+        ignored.push("transparency");
+    }
+    ignored
+}
+
+/// The sRGB electro-optical transfer function.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// 8- or 16-bit RGB(A) or grey pixels, sRGB-encoded, to linear RGB; `None` for other formats.
+fn decode_srgb(data: &gltf::image::Data) -> Option<AlbedoTexture> {
+    use gltf::image::Format;
+    let (channels, bytes_per_channel) = match data.format {
+        Format::R8 => (1, 1),
+        Format::R8G8 => (2, 1),
+        Format::R8G8B8 => (3, 1),
+        Format::R8G8B8A8 => (4, 1),
+        Format::R16 => (1, 2),
+        Format::R16G16 => (2, 2),
+        Format::R16G16B16 => (3, 2),
+        Format::R16G16B16A16 => (4, 2),
+        _ => return None,
+    };
+    let texel_bytes = channels * bytes_per_channel;
+    let (width, height) = (data.width as usize, data.height as usize);
+    if width == 0 || height == 0 || data.pixels.len() < width * height * texel_bytes {
+        return None;
+    }
+    let channel = |texel: &[u8], c: usize| -> f32 {
+        match bytes_per_channel {
+            1 => f32::from(texel[c]) / 255.0,
+            _ => f32::from(u16::from_ne_bytes([texel[2 * c], texel[2 * c + 1]])) / 65535.0,
+        }
+    };
+    let texels = data
+        .pixels
+        .chunks_exact(texel_bytes)
+        .take(width * height)
+        .map(|texel| {
+            // Grey (and grey + alpha) images repeat their one channel.
+            let rgb = if channels < 3 {
+                Vec3::splat(channel(texel, 0))
+            } else {
+                Vec3::new(channel(texel, 0), channel(texel, 1), channel(texel, 2))
+            };
+            rgb.map(srgb_to_linear)
+        })
+        .collect();
+    Some(AlbedoTexture {
+        width,
+        height,
+        texels,
+    })
+}
