@@ -125,9 +125,11 @@ fn one_node() -> Value {
 fn node_transforms_apply_through_two_levels() {
     let dir = tempfile::tempdir().unwrap();
     // Parent: TRS (translation, rotation by 90° about +Y, uniform scale 2). Child: a matrix
-    // (column-major) translating by (0, 1, 0) and scaling x by 3, then the mesh.
+    // (column-major): scale x by 3, turn 90° about +X, translate by (0, 1, 0); then the mesh.
     let rotation = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
-    let child = Mat4::from_translation(Vec3::Y) * Mat4::from_scale(Vec3::new(3.0, 1.0, 1.0));
+    let child = Mat4::from_translation(Vec3::Y)
+        * Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2)
+        * Mat4::from_scale(Vec3::new(3.0, 1.0, 1.0));
     let nodes = json!([
         {
             "children": [1],
@@ -139,12 +141,13 @@ fn node_transforms_apply_through_two_levels() {
     ]);
     let parts = load(&write_gltf(dir.path(), "tree", nodes));
     assert_eq!(parts.len(), 1);
-    // Worked by hand: child takes (x, y, z) to (3x, y + 1, z); the rotation about +Y takes
-    // (x, y, z) to (z, y, -x); then scale 2 and translate (1, 2, 3).
+    // Worked by hand: the child takes (x, y, z) to (3x, 1 - z, y) (the turn about +X takes
+    // (x, y, z) to (x, -z, y)); the parent's turn about +Y takes (x, y, z) to (z, y, -x), then
+    // scale 2 and translate (1, 2, 3).
     let expected = [
         Vec3::new(1.0, 4.0, 3.0),
         Vec3::new(1.0, 4.0, -3.0),
-        Vec3::new(1.0, 6.0, 3.0),
+        Vec3::new(3.0, 4.0, 3.0),
     ];
     for (got, want) in parts[0].mesh.positions.iter().zip(expected) {
         assert!(got.distance(want) < 1e-5, "{got} != {want}");

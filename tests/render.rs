@@ -1063,10 +1063,10 @@ fn background_shows_the_map_filtered() {
 }
 
 /// A textured quad under a uniform sky of radiance 1 reflects exactly its texel's albedo
-/// (`E/π = 1`, nothing to shadow or interreflect): a checkerboard's two colours, on the GPU
-/// pixel by pixel and in the path-traced reference on average, within 1% in the linear
-/// readback. Pixels within a texel of a cell edge (where bilinear filtering blends) are left
-/// out.
+/// (`E/π = 1`, nothing to shadow or interreflect): a checkerboard's two colours, pixel by
+/// pixel on the GPU and in the path-traced reference (256 samples: its noise is below 0.7%
+/// here), within 1% in the linear readback. Pixels within a texel of a cell edge (where
+/// bilinear filtering blends) are left out.
 #[test]
 fn a_textured_quad_shows_its_texture_per_pixel_on_the_gpu_and_in_the_reference() {
     use precompute::mesh::srgb_to_linear;
@@ -1107,15 +1107,14 @@ fn a_textured_quad_shows_its_texture_per_pixel_on_the_gpu_and_in_the_reference()
         &SceneBvh::build(&geometry.mesh),
         &EnvironmentLight::new(&EnvMap::uniform(64, 32, Rgb::ONE), 0.0),
         &cam,
-        &ReferenceSettings::new(64, 1, 0),
+        &ReferenceSettings::new(256, 1, 0),
         &NoProgress,
     );
 
     // Which colour each pixel's centre sees, where it sees one cell clearly.
     let bvh = SceneBvh::build(&geometry.mesh);
     let basis = cam.basis();
-    let mut sums = [(Rgb::ZERO, 0usize); 2];
-    let mut checked = 0;
+    let mut checked = [0usize; 2];
     for j in 0..96 {
         for i in 0..96 {
             let d = cam.pixel_direction(&basis, i, j);
@@ -1138,18 +1137,16 @@ fn a_textured_quad_shows_its_texture_per_pixel_on_the_gpu_and_in_the_reference()
                 ((gpu_pixel - want) / want).abs().max_element() < 0.01,
                 "GPU pixel ({i}, {j}): {gpu_pixel} vs {want}"
             );
-            sums[colour].0 += reference.radiance.pixels[(j * 96 + i) as usize];
-            sums[colour].1 += 1;
-            checked += 1;
+            let traced = reference.radiance.pixels[(j * 96 + i) as usize];
+            assert!(
+                ((traced - want) / want).abs().max_element() < 0.01,
+                "reference pixel ({i}, {j}): {traced} vs {want}"
+            );
+            checked[colour] += 1;
         }
     }
-    assert!(checked > 1000, "only {checked} pixels inside cells");
-    for (colour, (sum, n)) in sums.iter().enumerate() {
-        let mean = *sum / *n as f32;
-        let want = colours[colour];
-        assert!(
-            ((mean - want) / want).abs().max_element() < 0.01,
-            "reference, colour {colour}: {mean} vs {want} ({n} pixels)"
-        );
-    }
+    assert!(
+        checked.iter().all(|&n| n > 500),
+        "pixels inside cells of each colour: {checked:?}"
+    );
 }

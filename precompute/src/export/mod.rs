@@ -36,17 +36,25 @@ pub fn mitsuba_max_depth(bounces: u32) -> u32 {
     bounces + 2
 }
 
-/// A binary little-endian PLY with positions and normals.
+/// A binary little-endian PLY with positions, normals and, for a textured mesh, texture
+/// coordinates (`u`, `v`: hprt's and Mitsuba's bitmap convention agree, origin at the image's
+/// top left).
 pub fn ply_bytes(mesh: &TriangleMesh) -> Vec<u8> {
+    let textured = !mesh.uvs.is_empty();
+    let names: &[&str] = if textured {
+        &["x", "y", "z", "nx", "ny", "nz", "u", "v"]
+    } else {
+        &["x", "y", "z", "nx", "ny", "nz"]
+    };
     let mut ply = Ply::<DefaultElement>::new();
     ply.header.encoding = Encoding::BinaryLittleEndian;
     ply.header
         .comments
         .push("exported by hprt (world space)".into());
     let mut vertex = ElementDef::new("vertex".into());
-    for name in ["x", "y", "z", "nx", "ny", "nz"] {
+    for name in names {
         vertex.properties.add(PropertyDef::new(
-            name.into(),
+            (*name).into(),
             PropertyType::Scalar(ScalarType::Float),
         ));
     }
@@ -57,16 +65,16 @@ pub fn ply_bytes(mesh: &TriangleMesh) -> Vec<u8> {
         PropertyType::List(ScalarType::UChar, ScalarType::UInt),
     ));
     ply.header.elements.add(face);
-    let vertices = mesh
-        .positions
-        .iter()
-        .zip(&mesh.normals)
-        .map(|(p, n)| {
+    let vertices = (0..mesh.vertex_count())
+        .map(|v| {
             let mut e = DefaultElement::new();
-            for (name, value) in ["x", "y", "z", "nx", "ny", "nz"]
-                .iter()
-                .zip(p.to_array().into_iter().chain(n.to_array()))
-            {
+            let uv = mesh.uvs.get(v).map(|t| t.to_array()).unwrap_or_default();
+            let values = mesh.positions[v]
+                .to_array()
+                .into_iter()
+                .chain(mesh.normals[v].to_array())
+                .chain(uv);
+            for (name, value) in names.iter().zip(values) {
                 e.insert((*name).into(), Property::Float(value));
             }
             e
@@ -104,6 +112,11 @@ fn object_mesh(geometry: &SceneMesh, object: usize) -> TriangleMesh {
             .collect(),
         uvs: mesh.uvs.get(v0..v1).map(<[_]>::to_vec).unwrap_or_default(),
     }
+}
+
+/// The texture file of textured object `index`.
+fn texture_file_for(name: &str, index: usize) -> String {
+    file_name_for(name, index).replace(".ply", ".exr")
 }
 
 fn file_name_for(name: &str, index: usize) -> String {
@@ -174,10 +187,21 @@ pub fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
         rotation = settings.rotation_deg,
     );
     for (i, o) in geometry.objects.iter().enumerate() {
-        // Textures are not exported yet: a textured object gets its texture's mean.
-        let a = match o.texture {
-            Some(t) => o.albedo * geometry.textures[t].mean(),
-            None => o.albedo,
+        let a = o.albedo;
+        let reflectance = match o.texture {
+            // The texture with the object's factor folded in, linear, looked up bilinearly
+            // with repeat wrapping (Mitsuba's defaults, and hprt's reference).
+            Some(_) => format!(
+                r#"<texture type="bitmap" name="reflectance">
+                    <string name="filename" value="textures/{}"/>
+                    <boolean name="raw" value="true"/>
+                </texture>"#,
+                texture_file_for(&o.name, i)
+            ),
+            None => format!(
+                r#"<rgb name="reflectance" value="{}, {}, {}"/>"#,
+                a.x, a.y, a.z
+            ),
         };
         let _ = write!(
             xml,
@@ -186,16 +210,13 @@ pub fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
         <boolean name="face_normals" value="false"/>
         <bsdf type="$surface">
             <bsdf type="diffuse">
-                <rgb name="reflectance" value="{r}, {g}, {b}"/>
+                {reflectance}
             </bsdf>
         </bsdf>
     </shape>
 "#,
             id = xml_escape(&o.name),
             file = file_name_for(&o.name, i),
-            r = a.x,
-            g = a.y,
-            b = a.z,
         );
     }
     xml.push_str("</scene>\n");
@@ -213,7 +234,8 @@ fn xml_escape(s: &str) -> String {
 /// as `thinsheet` when imported.
 pub const THIN_SHEET_PLUGIN: &str = include_str!("thinsheet.py");
 
-/// Writes `dir/scene.xml`, `dir/thinsheet.py`, `dir/envmap.exr` and `dir/meshes/*.ply`.
+/// Writes `dir/scene.xml`, `dir/thinsheet.py`, `dir/envmap.exr`, `dir/meshes/*.ply` and, for
+/// textured objects, `dir/textures/*.exr`.
 pub fn export_mitsuba(
     dir: &Path,
     geometry: &SceneMesh,
@@ -224,18 +246,22 @@ pub fn export_mitsuba(
         path: path.to_owned(),
         message,
     };
-    if geometry.is_textured() {
-        log::warn!(
-            "textured objects are exported with their texture's mean albedo: Mitsuba's image \
-             differs from hprt's on them"
-        );
-    }
     let meshes = dir.join("meshes");
     std::fs::create_dir_all(&meshes).map_err(|e| error(&meshes, e.to_string()))?;
     for i in 0..geometry.objects.len() {
         let path = meshes.join(file_name_for(&geometry.objects[i].name, i));
         write_atomic(&path, &ply_bytes(&object_mesh(geometry, i)))
             .map_err(|e| error(&path, e.to_string()))?;
+    }
+    for (i, o) in geometry.objects.iter().enumerate() {
+        let Some(t) = o.texture else { continue };
+        let texture = &geometry.textures[t];
+        let folder = dir.join("textures");
+        std::fs::create_dir_all(&folder).map_err(|e| error(&folder, e.to_string()))?;
+        let path = folder.join(texture_file_for(&o.name, i));
+        let texels = texture.texels.iter().map(|t| *t * o.albedo).collect();
+        let image = RgbImageF32::new(texture.width, texture.height, texels);
+        write_exr(&path, &image).map_err(|e| error(&path, e.to_string()))?;
     }
     let env_path = dir.join("envmap.exr");
     let image = RgbImageF32::new(map.width(), map.height(), map.texels().to_vec());

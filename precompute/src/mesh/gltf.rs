@@ -183,7 +183,7 @@ impl Loader<'_> {
                 return Err(self.invalid(format!("{name}: its node transform is singular")));
             }
             let normal_matrix = linear.inverse().transpose();
-            let raw = RawMesh {
+            let mut raw = RawMesh {
                 positions: positions
                     .iter()
                     .map(|p| world.transform_point3(*p))
@@ -196,6 +196,9 @@ impl Loader<'_> {
                 triangles,
                 uvs,
             };
+            if raw.normals.is_none() {
+                raw = with_flat_normals(raw);
+            }
             let material = self.material(&primitive.material())?;
             if material.texture.is_some() && raw.uvs.is_none() {
                 return Err(self.invalid(format!(
@@ -306,6 +309,33 @@ impl Loader<'_> {
     }
 }
 
+/// The mesh with one vertex per triangle corner, each with its triangle's normal: glTF 2.0
+/// asks for flat normals where a primitive has none (3.7.2.1). Degenerate triangles get a
+/// zero normal, which the clean-up drops with the triangle.
+fn with_flat_normals(mesh: RawMesh) -> RawMesh {
+    let mut out = RawMesh {
+        normals: Some(Vec::with_capacity(3 * mesh.triangles.len())),
+        uvs: mesh.uvs.as_ref().map(|_| Vec::new()),
+        ..Default::default()
+    };
+    for tri in &mesh.triangles {
+        let [a, b, c] = tri.map(|i| mesh.positions[i as usize]);
+        let normal = (b - a).cross(c - a).normalize_or_zero();
+        let base = out.positions.len() as u32;
+        for &i in tri {
+            out.positions.push(mesh.positions[i as usize]);
+            if let (Some(all), Some(uvs)) = (&mut out.uvs, &mesh.uvs) {
+                all.push(uvs[i as usize]);
+            }
+        }
+        if let Some(normals) = &mut out.normals {
+            normals.extend([normal; 3]);
+        }
+        out.triangles.push([base, base + 1, base + 2]);
+    }
+    out
+}
+
 /// Triangles of a triangle list, strip or fan.
 fn assemble_triangles(mode: Mode, indices: &[u32]) -> Vec<[u32; 3]> {
     match mode {
@@ -404,4 +434,43 @@ fn decode_srgb(data: &gltf::image::Data) -> Option<AlbedoTexture> {
         height,
         texels,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn missing_normals_become_flat_per_triangle() {
+        // A roof: two triangles meeting at a right angle along the shared edge 0-1, indexed.
+        let roof = RawMesh {
+            positions: vec![
+                Vec3::ZERO,
+                Vec3::X,
+                Vec3::new(0.0, 1.0, 0.0),
+                Vec3::new(0.0, 0.0, -1.0),
+            ],
+            normals: None,
+            triangles: vec![[0, 1, 2], [0, 1, 3]],
+            uvs: Some(vec![Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE]),
+        };
+        let flat = with_flat_normals(roof);
+        assert_eq!(flat.positions.len(), 6);
+        assert_eq!(flat.triangles, vec![[0, 1, 2], [3, 4, 5]]);
+        let normals = flat.normals.unwrap();
+        assert_eq!(&normals[..3], &[Vec3::Z; 3]);
+        assert_eq!(&normals[3..], &[Vec3::Y; 3]);
+        // Each corner keeps its texture coordinates.
+        let uvs = flat.uvs.unwrap();
+        assert_eq!(uvs[4], Vec2::X);
+        assert_eq!(uvs[5], Vec2::ONE);
+    }
+
+    #[test]
+    fn strips_and_fans_become_triangles_wound_alike() {
+        let strip = assemble_triangles(Mode::TriangleStrip, &[0, 1, 2, 3]);
+        assert_eq!(strip, vec![[0, 1, 2], [2, 1, 3]]);
+        let fan = assemble_triangles(Mode::TriangleFan, &[0, 1, 2, 3]);
+        assert_eq!(fan, vec![[0, 1, 2], [0, 2, 3]]);
+    }
 }
