@@ -204,30 +204,21 @@ fn opens_a_gltf_model_in_one_command_under_xvfb() {
     )
     .unwrap();
     let open = || {
-        Command::new("xvfb-run")
-            .args([
-                "-a",
-                "-s",
-                "-screen 0 1024x768x24",
-                env!("CARGO_BIN_EXE_hprt"),
-                "view",
-            ])
-            .arg(&model)
-            .arg("--env")
-            .arg(&env)
-            .args([
+        view_under_xvfb_with(
+            d,
+            &model,
+            &[
+                "--env",
+                env.to_str().unwrap(),
                 "--width",
                 "800",
                 "--height",
                 "500",
                 "--script",
                 "open.script",
-            ])
-            .current_dir(d)
-            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-            .env("HPRT_CACHE", &cache)
-            .output()
-            .expect("xvfb-run (package xvfb; tests/run.sh installs it)")
+            ],
+            &[("HPRT_CACHE", cache.as_path())],
+        )
     };
     let out = open();
     assert!(out.status.success(), "viewer failed: {}", stderr(&out));
@@ -258,6 +249,16 @@ fn opens_a_gltf_model_in_one_command_under_xvfb() {
 
 /// Runs `hprt view SCENE ARGS` in `dir` under a virtual X server.
 fn view_under_xvfb(dir: &std::path::Path, scene: &std::path::Path, args: &[&str]) -> Output {
+    view_under_xvfb_with(dir, scene, args, &[])
+}
+
+/// [`view_under_xvfb`] with the environment variables `vars`.
+fn view_under_xvfb_with(
+    dir: &std::path::Path,
+    scene: &std::path::Path,
+    args: &[&str],
+    vars: &[(&str, &std::path::Path)],
+) -> Output {
     Command::new("xvfb-run")
         .args([
             "-a",
@@ -270,6 +271,7 @@ fn view_under_xvfb(dir: &std::path::Path, scene: &std::path::Path, args: &[&str]
         .args(args)
         .current_dir(dir)
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .envs(vars.iter().copied())
         .output()
         .expect("xvfb-run (package xvfb; tests/run.sh installs it)")
 }
