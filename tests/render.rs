@@ -1069,13 +1069,13 @@ fn background_shows_the_map_filtered() {
 /// bilinear filtering blends) are left out.
 #[test]
 fn a_textured_quad_shows_its_texture_per_pixel_on_the_gpu_and_in_the_reference() {
-    use precompute::mesh::srgb_to_linear;
+    use precompute::image_io::srgb_decode;
     use precompute::texture::AlbedoTexture;
     use std::sync::Arc;
     const SIDE: usize = 16;
     const CELL: usize = 4;
     let colours = [[200u8, 60, 30], [40, 180, 220]]
-        .map(|c| Rgb::from_array(c.map(|b| srgb_to_linear(f32::from(b) / 255.0))));
+        .map(|c| Rgb::from_array(c.map(|b| srgb_decode(f32::from(b) / 255.0))));
     let cell_of = |x: usize, y: usize| (x / CELL + y / CELL) % 2;
     let texture = Arc::new(AlbedoTexture {
         width: SIDE,

@@ -75,6 +75,16 @@ pub fn srgb_encode(x: f32) -> f32 {
     }
 }
 
+/// The sRGB decoding function (IEC 61966-2-1), the inverse of [`srgb_encode`]: how 8-bit
+/// albedo textures are stored.
+pub fn srgb_decode(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 /// Tone-mapped, sRGB-encoded 8-bit pixels.
 pub fn to_display_rgb8(image: &RgbImageF32, exposure: f32) -> Vec<u8> {
     image

@@ -23,11 +23,6 @@ const GROUND_HALF_SIDE: f32 = 4.0;
 const GROUND_SEGMENTS: u32 = 96;
 const GROUND_ALBEDO: [f32; 3] = [0.5, 0.5, 0.5];
 
-/// Whether `path` is a model file rather than a scene (TOML) file.
-pub fn is_model_file(path: &Path) -> bool {
-    mesh::is_mesh_file(path)
-}
-
 /// The scene file for `model`, naming it as `mesh_reference` (the path the file will hold:
 /// relative to where the scene file is, or absolute). `ground` adds the slab.
 pub fn scene_file_for_model(
@@ -139,7 +134,7 @@ impl Placement {
 impl Scene {
     /// A scene file (`.toml`) or a bare model file (see the module documentation).
     pub fn open(path: &Path) -> Result<Self, SceneError> {
-        if is_model_file(path) {
+        if mesh::is_mesh_file(path) {
             Self::for_model(path)
         } else {
             Self::load(path)

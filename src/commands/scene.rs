@@ -4,7 +4,8 @@
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use precompute::atomic_file::write_atomic;
-use precompute::model_scene::{is_model_file, scene_file_for_model};
+use precompute::mesh::is_mesh_file;
+use precompute::model_scene::scene_file_for_model;
 use precompute::scene::{EnvironmentSpec, Scene};
 use std::path::{Path, PathBuf};
 
@@ -41,7 +42,7 @@ pub fn run(command: SceneCommand) -> anyhow::Result<()> {
 
 fn init(args: SceneInitArgs) -> anyhow::Result<()> {
     anyhow::ensure!(
-        is_model_file(&args.model),
+        is_mesh_file(&args.model),
         "{}: not a model file (expected .gltf, .glb, .obj, .ply or .bpt)",
         args.model.display()
     );

@@ -95,25 +95,31 @@ impl TracedScene {
             None => self.direct.clone(),
         };
         let mut sum = TransferVectors::zeros(order, self.direct.vertex_count());
-        let ones = vec![crate::color::Rgb::ONE; self.direct.vertex_count()];
+        // A textured scene gathers once and scales twice (reflected, stored).
+        let ones = self
+            .textured
+            .as_ref()
+            .map(|_| vec![crate::color::Rgb::ONE; self.direct.vertex_count()]);
         (0..bounces).map(move |_| {
-            let stored = match &self.textured {
-                None => {
-                    previous = self.operator.apply(&previous, &self.reflected_albedo);
-                    fill_inside(&mut previous, &self.inside, &self.neighbours);
-                    previous.clone()
-                }
-                Some((_, baked)) => {
-                    let gathered = self.operator.apply(&previous, &ones);
-                    previous = gathered.scaled_per_vertex(&self.reflected_albedo);
-                    fill_inside(&mut previous, &self.inside, &self.neighbours);
-                    let mut stored = gathered.scaled_per_vertex(baked);
-                    fill_inside(&mut stored, &self.inside, &self.neighbours);
-                    stored
+            let add = |sum: &mut TransferVectors, x: &TransferVectors| {
+                for (acc, x) in sum.as_mut_slice().iter_mut().zip(x.as_slice()) {
+                    *acc += x;
                 }
             };
-            for (acc, x) in sum.as_mut_slice().iter_mut().zip(stored.as_slice()) {
-                *acc += x;
+            match (&self.textured, &ones) {
+                (Some((_, albedo)), Some(ones)) => {
+                    let gathered = self.operator.apply(&previous, ones);
+                    previous = gathered.scaled_per_vertex(&self.reflected_albedo);
+                    fill_inside(&mut previous, &self.inside, &self.neighbours);
+                    let mut stored = gathered.scaled_per_vertex(albedo);
+                    fill_inside(&mut stored, &self.inside, &self.neighbours);
+                    add(&mut sum, &stored);
+                }
+                _ => {
+                    previous = self.operator.apply(&previous, &self.reflected_albedo);
+                    fill_inside(&mut previous, &self.inside, &self.neighbours);
+                    add(&mut sum, &previous);
+                }
             }
             sum.clone()
         })

@@ -381,15 +381,6 @@ fn ignored_properties(material: &gltf::Material) -> Vec<&'static str> {
     ignored
 }
 
-/// The sRGB electro-optical transfer function.
-pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// 8- or 16-bit RGB(A) or grey pixels, sRGB-encoded, to linear RGB; `None` for other formats.
 fn decode_srgb(data: &gltf::image::Data) -> Option<AlbedoTexture> {
     use gltf::image::Format;
@@ -426,7 +417,7 @@ fn decode_srgb(data: &gltf::image::Data) -> Option<AlbedoTexture> {
             } else {
                 Vec3::new(channel(texel, 0), channel(texel, 1), channel(texel, 2))
             };
-            rgb.map(srgb_to_linear)
+            rgb.map(crate::image_io::srgb_decode)
         })
         .collect();
     Some(AlbedoTexture {

@@ -11,7 +11,7 @@ mod shapes;
 
 pub use bpt::{BezierPatch, read_bpt, tessellate_patches};
 pub use cleanup::{CleanupReport, MeshCleanup};
-pub use gltf::{ModelPart, PartMaterial, srgb_to_linear};
+pub use gltf::{ModelPart, PartMaterial};
 pub use shapes::{annulus_mesh, box_mesh, icosahedron, sphere_mesh, subdivide};
 
 use glam::{Vec2, Vec3};
@@ -232,7 +232,9 @@ pub fn read_mesh(path: &Path, options: &LoadOptions) -> Result<RawMesh, MeshErro
     match format {
         "obj" => obj::parse_obj(path, &bytes),
         "ply" => ply::parse_ply(path, &bytes),
-        "gltf" | "glb" => Ok(merge_parts(gltf::parse_gltf(path, &bytes)?)),
+        "gltf" | "glb" => Ok(merge_meshes(
+            gltf::parse_gltf(path, &bytes)?.into_iter().map(|p| p.mesh),
+        )),
         _ => {
             let mut patches = bpt::read_bpt(path, &bytes)?;
             if let Some(&bad) = options.skip_patches.iter().find(|&&p| p >= patches.len()) {
@@ -276,22 +278,28 @@ pub fn load_mesh(
     MeshCleanup::default().run(path, raw)
 }
 
-/// One mesh of all `parts`; normals only if every part has them.
-fn merge_parts(parts: Vec<ModelPart>) -> RawMesh {
-    let all_normals = parts.iter().all(|p| p.mesh.normals.is_some());
+/// One mesh of all `meshes`; normals only if every one has them (and there are vertices).
+fn merge_meshes(meshes: impl IntoIterator<Item = RawMesh>) -> RawMesh {
     let mut merged = RawMesh {
-        normals: all_normals.then(Vec::new),
+        normals: Some(Vec::new()),
         ..Default::default()
     };
-    for part in parts {
+    for mesh in meshes {
         let base = merged.positions.len() as u32;
-        merged.positions.extend(&part.mesh.positions);
-        if let (Some(all), Some(n)) = (&mut merged.normals, &part.mesh.normals) {
-            all.extend(n);
-        }
+        merged.positions.extend(&mesh.positions);
+        merged.normals = match (merged.normals, &mesh.normals) {
+            (Some(mut all), Some(n)) => {
+                all.extend(n);
+                Some(all)
+            }
+            _ => None,
+        };
         merged
             .triangles
-            .extend(part.mesh.triangles.iter().map(|t| t.map(|i| i + base)));
+            .extend(mesh.triangles.iter().map(|t| t.map(|i| i + base)));
+    }
+    if merged.positions.is_empty() {
+        merged.normals = None;
     }
     merged
 }

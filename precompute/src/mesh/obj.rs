@@ -41,36 +41,41 @@ pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     })
     .map_err(|e| syntax_error(path, bytes, e))?;
 
-    let mut mesh = RawMesh::default();
-    let all_have_normals = models
-        .iter()
-        .all(|m| m.mesh.normals.len() == m.mesh.positions.len());
-    let mut normals = Vec::new();
-    for model in &models {
-        let m = &model.mesh;
-        let base = mesh.positions.len() as u32;
-        mesh.positions.extend(
-            m.positions
-                .chunks_exact(3)
-                .map(|p| Vec3::new(p[0], p[1], p[2])),
-        );
-        if all_have_normals {
-            normals.extend(
-                m.normals
-                    .chunks_exact(3)
-                    .map(|n| Vec3::new(n[0], n[1], n[2])),
-            );
-        }
-        mesh.triangles.extend(
-            m.indices
-                .chunks_exact(3)
-                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
-        );
+    Ok(super::merge_meshes(
+        models.iter().map(|m| model_mesh(&m.mesh)),
+    ))
+}
+
+/// One tobj model's geometry: normals where every vertex has one, texture coordinates (`vt`
+/// flipped to glTF's top-left origin) where every vertex has them.
+fn model_mesh(m: &tobj::Mesh) -> RawMesh {
+    let positions: Vec<Vec3> = m
+        .positions
+        .chunks_exact(3)
+        .map(|p| Vec3::new(p[0], p[1], p[2]))
+        .collect();
+    let normals = (m.normals.len() == m.positions.len()).then(|| {
+        m.normals
+            .chunks_exact(3)
+            .map(|n| Vec3::new(n[0], n[1], n[2]))
+            .collect()
+    });
+    let uvs = (m.texcoords.len() / 2 == positions.len() && !positions.is_empty()).then(|| {
+        m.texcoords
+            .chunks_exact(2)
+            .map(|t| Vec2::new(t[0], 1.0 - t[1]))
+            .collect()
+    });
+    RawMesh {
+        triangles: m
+            .indices
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect(),
+        positions,
+        normals,
+        uvs,
     }
-    if all_have_normals && !mesh.positions.is_empty() {
-        mesh.normals = Some(normals);
-    }
-    Ok(mesh)
 }
 
 /// The file's objects as parts with their `.mtl` materials: `Kd` as the base colour, `map_Kd`
@@ -99,27 +104,11 @@ pub fn parse_obj_parts(path: &Path, bytes: &[u8]) -> Result<Option<Vec<ModelPart
     let mut parts = Vec::new();
     for model in &models {
         let m = &model.mesh;
-        let positions: Vec<Vec3> = m
-            .positions
-            .chunks_exact(3)
-            .map(|p| Vec3::new(p[0], p[1], p[2]))
-            .collect();
-        let normals = (m.normals.len() == m.positions.len()).then(|| {
-            m.normals
-                .chunks_exact(3)
-                .map(|n| Vec3::new(n[0], n[1], n[2]))
-                .collect()
-        });
-        let uvs = (m.texcoords.len() / 2 == positions.len() && !positions.is_empty()).then(|| {
-            m.texcoords
-                .chunks_exact(2)
-                .map(|t| Vec2::new(t[0], 1.0 - t[1]))
-                .collect::<Vec<_>>()
-        });
+        let mesh = model_mesh(m);
         let material = match m.material_id.and_then(|i| materials.get(i)) {
             None => None,
             Some(mat) => {
-                let texture = match (&mat.diffuse_texture, &uvs) {
+                let texture = match (&mat.diffuse_texture, &mesh.uvs) {
                     (Some(file), Some(_)) => {
                         let file = dir.join(file);
                         Some(match textures.get(&file) {
@@ -150,16 +139,7 @@ pub fn parse_obj_parts(path: &Path, bytes: &[u8]) -> Result<Option<Vec<ModelPart
         };
         parts.push(ModelPart {
             name: model.name.clone(),
-            mesh: RawMesh {
-                triangles: m
-                    .indices
-                    .chunks_exact(3)
-                    .map(|t| [t[0], t[1], t[2]])
-                    .collect(),
-                positions,
-                normals,
-                uvs,
-            },
+            mesh,
             material,
         });
     }
@@ -179,7 +159,7 @@ pub fn read_srgb_texture(path: &Path) -> Result<AlbedoTexture, MeshError> {
         height: rgb.height() as usize,
         texels: rgb
             .pixels()
-            .map(|p| Vec3::from_array(p.0).map(super::gltf::srgb_to_linear))
+            .map(|p| Vec3::from_array(p.0).map(crate::image_io::srgb_decode))
             .collect(),
     })
 }

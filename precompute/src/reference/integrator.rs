@@ -42,7 +42,8 @@ pub struct Integrator<'a> {
     pub bounces: u32,
     offset: f32,
     front_normals: Vec<Vec3>,
-    /// Per triangle, its texture in `geometry.textures` or [`NO_TEXTURE`].
+    /// Per triangle, its texture in `geometry.textures` or [`NO_TEXTURE`]; empty for an
+    /// untextured scene, whose hits then read nothing more than before.
     triangle_textures: Vec<u32>,
 }
 
@@ -69,7 +70,11 @@ impl<'a> Integrator<'a> {
             front_normals: (0..mesh.triangle_count())
                 .map(|t| mesh.front_normal(t))
                 .collect(),
-            triangle_textures: geometry.triangle_textures(),
+            triangle_textures: if geometry.is_textured() {
+                geometry.triangle_textures()
+            } else {
+                Vec::new()
+            },
         }
     }
 
@@ -87,8 +92,9 @@ impl<'a> Integrator<'a> {
             normal += mesh.normals[*i as usize] * w;
             albedo += self.geometry.albedo[*i as usize] * w;
         }
-        let texture = self.triangle_textures[hit.triangle as usize];
-        if texture != NO_TEXTURE {
+        if let Some(&texture) = self.triangle_textures.get(hit.triangle as usize)
+            && texture != NO_TEXTURE
+        {
             // The texel's albedo (times the object's factor, interpolated above).
             let uv: glam::Vec2 = corners
                 .iter()
