@@ -15,6 +15,10 @@ struct Frame {
     // Bit 2 of flags: the first pass shades by the normal with these (A_l L_k / π, RGB in
     // xyz, bands 0–2) instead of the per-vertex radiance.
     sh_irradiance: array<vec4<f32>, 9>,
+    // The camera's position (xyz) for glossy surfaces' view direction.
+    camera_position: vec4<f32>,
+    // World → the frame of the reflection maps (the map's own, for a turning map).
+    reflection_to_map: mat4x4<f32>,
 };
 
 struct Light {

@@ -4,10 +4,18 @@
 // Textured objects: their transfer is baked per unit texel value, so the interpolated radiance
 // and the vertex albedo (the texture's factor) are both multiplied by the texel here. Untextured
 // objects are drawn with a white texel: unchanged.
+//
+// Glossy objects add k_s times their specular occlusion times the prefiltered reflection map of
+// their shininess at the mirror direction (the environment beyond the lights; the lights' lobes
+// are the light pass's), and write their material index into the normal's w.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(1) @binding(0) var albedo_texture: texture_2d<f32>;
 @group(1) @binding(1) var albedo_sampler: sampler;
+@group(0) @binding(1) var<uniform> materials: Materials;
+// Six layers (one cube) per shininess slot.
+@group(0) @binding(2) var reflection_maps: texture_2d_array<f32>;
+@group(0) @binding(3) var reflection_sampler: sampler;
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -15,6 +23,11 @@ struct VertexIn {
     @location(2) albedo: vec3<f32>,
     @location(3) radiance: vec4<f32>,
     @location(4) uv: vec2<f32>,
+    @location(5) material: u32,
+    // The bake's unoccluded fraction: the specular occlusion.
+    @location(6) occlusion: f32,
+    // The interreflected part of `radiance`.
+    @location(7) indirect: vec4<f32>,
 };
 
 struct VertexOut {
@@ -23,6 +36,10 @@ struct VertexOut {
     @location(1) albedo: vec3<f32>,
     @location(2) radiance: vec3<f32>,
     @location(3) uv: vec2<f32>,
+    @location(4) @interpolate(flat) material: u32,
+    @location(5) occlusion: f32,
+    @location(6) position: vec3<f32>,
+    @location(7) indirect: vec3<f32>,
 };
 
 @vertex
@@ -33,6 +50,10 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.albedo = in.albedo;
     out.radiance = in.radiance.xyz;
     out.uv = in.uv;
+    out.material = in.material;
+    out.occlusion = in.occlusion;
+    out.position = in.position;
+    out.indirect = in.indirect.xyz;
     return out;
 }
 
@@ -68,7 +89,21 @@ fn fs_main(in: VertexOut) -> FragmentOut {
     if (frame.flags & 4u) != 0u {
         out.color = vec4<f32>(in.albedo * texel * max(sh_irradiance_over_pi(normal), vec3<f32>(0.0)), 1.0);
     }
-    out.normal = vec4<f32>(normal, 1.0);
+    if in.material != 0u {
+        let material = materials.entries[in.material];
+        let r = mirror_direction(normalize(frame.camera_position.xyz - in.position), normal);
+        let r_map = (frame.reflection_to_map * vec4<f32>(r, 0.0)).xyz;
+        let environment = sample_cube(reflection_maps, reflection_sampler, 6u * material.slot.x, r_map, 0.0);
+        // What the occluders send: the bake's interreflected radiance over the albedo is
+        // E_occluded / π, (1 − V) times their cosine-weighted mean radiance (CONVENTIONS.md,
+        // "Glossy materials").
+        let seen_albedo = in.albedo;
+        let occluders = select(vec3<f32>(0.0), in.indirect / max(seen_albedo, vec3<f32>(1e-4)), seen_albedo > vec3<f32>(1e-4));
+        let reflected = in.occlusion * environment + max(occluders, vec3<f32>(0.0));
+        out.color = out.color + vec4<f32>(material.specular.rgb * reflected, 0.0);
+    }
+    // w: the material index (exact in a half float) for the light pass.
+    out.normal = vec4<f32>(normal, f32(in.material));
     out.albedo = vec4<f32>(in.albedo * texel, 1.0);
     out.depth = encode_depth(in.clip.z);
     return out;

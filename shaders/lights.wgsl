@@ -1,5 +1,6 @@
-// Second pass, added onto the first: each directional light's Lambertian contribution
-// ρ/π · power · max(0, n·d) · visibility, visibility by percentage-closer soft shadows on its
+// Second pass, added onto the first: each directional light's contribution
+// (ρ/π · max(0, n·d) + k_s D_s'(r·d)) · power · visibility, the Phong lobe of glossy surfaces
+// widened by the source's size (s' < s, still normalised: CONVENTIONS.md, "Glossy materials"), visibility by percentage-closer soft shadows on its
 // shadow map (blocker search, then PCF over the penumbra the source's size gives). Pixels that see no geometry show the environment map.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -14,6 +15,7 @@
 @group(0) @binding(8) var shadow_depths: texture_2d_array<f32>;
 // Trilinear, wrapping in azimuth.
 @group(0) @binding(9) var environment_sampler: sampler;
+@group(0) @binding(10) var<uniform> materials: Materials;
 
 const PI: f32 = 3.14159265358979;
 
@@ -236,9 +238,16 @@ fn fs_main(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
     }
     let world = frame.inv_view_proj * vec4<f32>(ndc, depth, 1.0);
     let position = world.xyz / world.w;
-    let normal = textureLoad(normal_buffer, texel, 0).xyz;
+    let normal_and_material = textureLoad(normal_buffer, texel, 0);
+    let normal = normal_and_material.xyz;
     let albedo = textureLoad(albedo_buffer, texel, 0).xyz;
     let diffuse = albedo / PI;
+    let material = materials.entries[u32(normal_and_material.w + 0.5)];
+    let glossy = material.specular.r + material.specular.g + material.specular.b > 0.0;
+    var r = vec3<f32>(0.0);
+    if glossy {
+        r = mirror_direction(normalize(frame.camera_position.xyz - position), normal);
+    }
     let phase = pixel_phase(pixel.xy);
     var sum = vec3<f32>(0.0);
     // A constant trip count with an early break lets the compiler unroll the loop and index
@@ -254,7 +263,19 @@ fn fs_main(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
             if SHADOWED {
                 v = visibility(i, position, normal, phase);
             }
-            sum = sum + diffuse * lights[i].power.xyz * (cosine * v);
+            if glossy {
+                // The source's angular variance per axis: core and halo discs (tangents of
+                // their radii) weighted by their shares of the power.
+                let core = lights[i].params.z;
+                let halo = lights[i].source.x;
+                let share = lights[i].source.y;
+                let variance = (share * core * core + (1.0 - share) * halo * halo) / 4.0;
+                let shininess = 1.0 / (1.0 / material.specular.w + variance);
+                let specular = material.specular.rgb * phong_lobe(dot(r, direction), shininess);
+                sum = sum + (diffuse * cosine + specular) * lights[i].power.xyz * v;
+            } else {
+                sum = sum + diffuse * lights[i].power.xyz * (cosine * v);
+            }
         }
     }
     return vec4<f32>(sum, 0.0);

@@ -359,6 +359,7 @@ fn unshadowed_hybrid_is_prt_plus_each_lights_lambert_term() {
         lights_indirect: true,
         shadows: false,
         sh_transfer: ShTransfer::Baked,
+        reflections: Default::default(),
     };
     let cam = camera(Vec3::new(3.0, 4.0, 6.0), Vec3::new(0.0, 0.5, 0.0), 80, 60);
     let image = render(&gpu(), &geometry, &transfer, &cam, &lighting);
@@ -991,6 +992,7 @@ fn vulkan_and_opengl_software_adapters_draw_the_same_image() {
         lights_indirect: true,
         shadows: true,
         sh_transfer: ShTransfer::Baked,
+        reflections: Default::default(),
     };
     let cam = camera(Vec3::new(3.0, 4.0, 6.0), Vec3::new(0.0, 0.5, 0.0), 96, 72);
     let images: Vec<RgbImageF32> = [Backend::Vulkan, Backend::Gl]
@@ -1028,6 +1030,7 @@ fn background_shows_the_map_filtered() {
             lights_indirect: false,
             shadows: false,
             sh_transfer: ShTransfer::Baked,
+            reflections: Default::default(),
         })
         .unwrap();
     renderer.background = true;

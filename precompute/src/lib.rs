@@ -10,6 +10,7 @@ pub mod named_enum;
 pub mod envmap;
 pub mod export;
 pub mod image_io;
+pub mod material;
 pub mod mesh;
 pub mod model_scene;
 pub mod quadrature;

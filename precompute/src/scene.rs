@@ -4,6 +4,7 @@
 use crate::bake_settings::BakeSettings;
 use crate::camera::Camera;
 use crate::color::Rgb;
+use crate::material::{MAX_SHININESS, Material, check_energy};
 use crate::mesh::{
     self, LoadOptions, MeshCleanup, MeshError, TriangleMesh, annulus_mesh, box_mesh,
 };
@@ -75,6 +76,13 @@ pub struct ObjectSpec {
     /// materials give it; when set, it overrides them.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub albedo: Option<[f32; 3]>,
+    /// Phong specular reflectance `k_s`, each channel in [0, 1], with `albedo + specular ≤ 1`
+    /// (CONVENTIONS.md, "Glossy materials"); needs `shininess`. None: purely diffuse.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub specular: Option<[f32; 3]>,
+    /// Phong exponent `s` of the specular lobe, in (0, 10000].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shininess: Option<f32>,
     #[serde(default)]
     pub transform: Transform,
     /// Quads per Bézier patch side (BPT meshes).
@@ -182,6 +190,8 @@ pub struct SceneObject {
     pub triangles: std::ops::Range<u32>,
     /// Index into [`SceneMesh::textures`] of its base colour texture.
     pub texture: Option<usize>,
+    /// Its specular lobe, if glossy (the albedo above is its diffuse `k_d`).
+    pub material: Material,
 }
 
 /// Marks a triangle without a texture in [`SceneMesh::triangle_textures`].
@@ -269,6 +279,7 @@ impl SceneMesh {
             vertices: v0..self.mesh.vertex_count() as u32,
             triangles: t0..self.mesh.triangle_count() as u32,
             texture: None,
+            material: Material::DIFFUSE,
         });
     }
 
@@ -293,6 +304,38 @@ impl SceneMesh {
         if let Some(object) = self.objects.last_mut() {
             object.texture = Some(index);
         }
+    }
+
+    /// Whether any object has a specular lobe.
+    pub fn is_glossy(&self) -> bool {
+        self.objects.iter().any(|o| o.material.is_glossy())
+    }
+
+    /// Per triangle, its object's material.
+    pub fn triangle_materials(&self) -> Vec<Material> {
+        let mut out = vec![Material::DIFFUSE; self.mesh.triangle_count()];
+        for o in &self.objects {
+            out[o.triangles.start as usize..o.triangles.end as usize].fill(o.material);
+        }
+        out
+    }
+
+    /// BLAKE3 hash of the objects' materials where any is glossy (what a reference depends on
+    /// beyond [`Self::content_hash`]); `None` for a diffuse scene.
+    pub fn material_hash(&self) -> Option<[u8; 32]> {
+        if !self.is_glossy() {
+            return None;
+        }
+        let mut hasher = blake3::Hasher::new();
+        hasher.update(b"hprt materials v1");
+        for o in &self.objects {
+            hasher.update(&o.triangles.start.to_le_bytes());
+            for c in o.material.specular.to_array() {
+                hasher.update(&c.to_le_bytes());
+            }
+            hasher.update(&o.material.shininess.to_le_bytes());
+        }
+        Some(*hasher.finalize().as_bytes())
     }
 
     /// Whether any object is textured.
@@ -390,6 +433,7 @@ impl Scene {
                     "{name}: albedo {albedo:?} must be in [0, 1) per channel"
                 )));
             }
+            let material = object_material(object).map_err(|m| invalid(format!("{name}: {m}")))?;
             let parts = load_object_parts(dir, object).map_err(|e| match e {
                 ObjectError::Mesh(cause) => SceneError::Mesh {
                     scene: path.to_owned(),
@@ -416,12 +460,19 @@ impl Scene {
                 };
                 let world = transform_mesh(&part.mesh, &object.transform.matrix())
                     .ok_or_else(|| invalid(format!("{name}: the transform is singular")))?;
+                if material.is_glossy() {
+                    check_energy(albedo, material.specular)
+                        .map_err(|m| invalid(format!("{part_name}: {m}")))?;
+                }
                 // An albedo in the scene file replaces the model's material, texture included.
                 match (object.albedo, part.texture) {
                     (None, Some(texture)) => {
                         geometry.push_textured_object(part_name, &world, albedo, texture)
                     }
                     _ => geometry.push_object(part_name, &world, albedo),
+                }
+                if let Some(o) = geometry.objects.last_mut() {
+                    o.material = material;
                 }
             }
         }
@@ -449,6 +500,31 @@ impl Scene {
             environment,
             bake: file.bake,
         })
+    }
+}
+
+/// The specular lobe an object asks for (its energy is checked against each part's albedo).
+fn object_material(object: &ObjectSpec) -> Result<Material, String> {
+    match (object.specular, object.shininess) {
+        (None, None) => Ok(Material::DIFFUSE),
+        (None, Some(_)) => Err("shininess without specular = [r, g, b]".into()),
+        (Some(_), None) => Err("specular needs a shininess (the Phong exponent)".into()),
+        (Some(specular), Some(shininess)) => {
+            if !specular.iter().all(|c| (0.0..=1.0).contains(c)) {
+                return Err(format!(
+                    "specular {specular:?} must be in [0, 1] per channel"
+                ));
+            }
+            if !(shininess > 0.0 && shininess <= MAX_SHININESS) {
+                return Err(format!(
+                    "shininess {shininess} must be in (0, {MAX_SHININESS}]"
+                ));
+            }
+            Ok(Material {
+                specular: Rgb::from(specular),
+                shininess,
+            })
+        }
     }
 }
 
@@ -705,6 +781,45 @@ mod tests {
             );
         }
         assert!(transform_mesh(&cube, &Mat4::from_scale(Vec3::new(0.0, 1.0, 1.0))).is_none());
+    }
+
+    #[test]
+    fn glossy_materials_are_checked() {
+        let dir = tempfile::tempdir().unwrap();
+        let object = |extra: &str| {
+            format!(
+                "{CAMERA}[[object]]\nbox = {{ min = [0,0,0], max = [1,1,1] }}\nalbedo = [0.5, 0.4, 0.3]\n{extra}\n"
+            )
+        };
+        let good = Scene::load(&write_scene(
+            dir.path(),
+            &object("specular = [0.5, 0.6, 0.7]\nshininess = 60"),
+        ))
+        .unwrap();
+        assert_eq!(
+            good.geometry.objects[0].material,
+            Material {
+                specular: Rgb::new(0.5, 0.6, 0.7),
+                shininess: 60.0
+            }
+        );
+        assert!(good.geometry.is_glossy() && good.geometry.material_hash().is_some());
+        for (extra, needle) in [
+            ("specular = [0.6, 0.1, 0.1]\nshininess = 60", "energy"),
+            ("specular = [0.1, 0.1, 0.1]", "shininess"),
+            ("shininess = 10", "specular"),
+            ("specular = [0.1, 0.1, 0.1]\nshininess = 0", "shininess"),
+            ("specular = [0.1, 0.1, 0.1]\nshininess = 1e6", "shininess"),
+            ("specular = [-0.1, 0.1, 0.1]\nshininess = 8", "specular"),
+        ] {
+            let err = Scene::load(&write_scene(dir.path(), &object(extra)))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("s.toml") && err.contains(needle),
+                "{extra}: {err}"
+            );
+        }
     }
 
     #[test]

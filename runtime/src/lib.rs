@@ -7,6 +7,7 @@ pub mod decompose;
 pub mod light;
 pub mod lighting;
 pub mod peers;
+pub mod reflection;
 pub mod render;
 pub mod sequence;
 pub mod tracking;

@@ -8,7 +8,7 @@
 //! - [`map_rotation`]: which rotation a map gets;
 //! - [`FrameLighting::for_mode`]: what each render mode draws.
 
-use crate::cubemap::{CubeMap, CubeSource};
+use crate::cubemap::{CubeGeometry, CubeMap, CubeSource};
 use crate::decompose::source_size::measure_sources;
 use crate::decompose::{
     DecomposeError, DecomposeMode, DecomposeSettings, Decomposer, Decomposition,
@@ -16,6 +16,7 @@ use crate::decompose::{
 use crate::light::DirectionalLight;
 use crate::peers::median_cut::{MedianCutError, analysis_map, median_cut};
 use crate::peers::sh_sun;
+use crate::reflection::{ReflectedEnvironment, SharedCube, remainder_cube};
 use crate::tracking::{LightTracker, TrackedLight, TrackingSettings};
 use glam::{Mat3, Quat, Vec3};
 use precompute::Rgb;
@@ -94,12 +95,15 @@ pub struct FrameLighting {
     pub shadows: bool,
     /// The transfer the SH part goes through.
     pub sh_transfer: ShTransfer,
+    /// What glossy surfaces reflect besides the lights' lobes.
+    pub reflections: ReflectedEnvironment,
 }
 
 impl FrameLighting {
-    /// Plain PRT under `sh`.
+    /// Plain PRT under `sh`; glossy surfaces reflect `sh` convolved with their lobe.
     pub fn prt(sh: ShCoeffs<Rgb>) -> Self {
         Self {
+            reflections: ReflectedEnvironment::Sh(sh.clone()),
             sh,
             lights: Vec::new(),
             lights_indirect: false,
@@ -116,6 +120,7 @@ impl FrameLighting {
             lights_indirect: false,
             shadows: true,
             sh_transfer: ShTransfer::Baked,
+            reflections: ReflectedEnvironment::None,
         }
     }
 
@@ -137,6 +142,8 @@ impl FrameLighting {
                 lights_indirect,
                 shadows: mode == RenderMode::Hybrid,
                 sh_transfer: ShTransfer::Baked,
+                // The remainder of the map: [`EnvironmentLighting::frame`] fills it in.
+                reflections: ReflectedEnvironment::None,
             },
             RenderMode::Lights => Self {
                 sh: ShCoeffs::zeros(decomposition.sh.order()),
@@ -144,6 +151,7 @@ impl FrameLighting {
                 lights_indirect,
                 shadows: true,
                 sh_transfer: ShTransfer::Baked,
+                reflections: ReflectedEnvironment::None,
             },
             RenderMode::MedianCut => {
                 Self::lights_only(decomposition.sh.order(), decomposition.lights.clone())
@@ -210,6 +218,12 @@ pub struct EnvironmentLighting {
     /// The "SH + sun" decomposer (made on first use, kept across maps while the settings it
     /// follows stay).
     sh_sun_decomposer: Option<Decomposer>,
+    /// Face size of the reflection maps of glossy scenes; `None`: no reflections made.
+    reflection_size: Option<usize>,
+    /// The map as a cube of that size in its own frame, with its geometry (made on first use).
+    reflection_cube: Option<(CubeGeometry, CubeMap)>,
+    /// The last remainder, with the map-frame lights and SH part it was made from.
+    remainder: Option<(Vec<DirectionalLight>, ShCoeffs<Rgb>, SharedCube)>,
 }
 
 impl EnvironmentLighting {
@@ -233,7 +247,58 @@ impl EnvironmentLighting {
             median_cut_map: None,
             sh_sun: None,
             sh_sun_decomposer: None,
+            reflection_size: None,
+            reflection_cube: None,
+            remainder: None,
         })
+    }
+
+    /// Makes the remainder of the map (for glossy reflections, [`ReflectedEnvironment`]) as a
+    /// cube of `face_size` in every hybrid frame; `None` stops.
+    pub fn enable_reflections(&mut self, face_size: Option<usize>) {
+        if self.reflection_size != face_size {
+            self.reflection_size = face_size;
+            self.reflection_cube = None;
+            self.remainder = None;
+        }
+    }
+
+    /// The map's remainder beyond the lights of `world` (a decomposition at the current
+    /// orientation), in the map's own frame; remade only when the lights or SH part change
+    /// in the map's frame, so a turning map reuses it.
+    fn remainder(&mut self, world: &Decomposition) -> ReflectedEnvironment {
+        let Some(size) = self.reflection_size else {
+            return ReflectedEnvironment::None;
+        };
+        let (lights, sh) = match (&self.tracker, &self.decomposition) {
+            (None, Some(base)) if base.lights.len() == world.lights.len() => {
+                (base.lights.clone(), base.sh.clone())
+            }
+            _ => {
+                let back = rotate_decomposition(world, self.orientation.inverse());
+                (back.lights, back.sh)
+            }
+        };
+        let cube = match &self.remainder {
+            Some((l, s, cube)) if *l == lights && *s == sh => cube.clone(),
+            _ => {
+                let (geometry, map) = self.reflection_cube.get_or_insert_with(|| {
+                    (
+                        CubeGeometry::new(size),
+                        CubeSource::new(&self.map, size).cube(0.0),
+                    )
+                });
+                let cube = SharedCube(std::sync::Arc::new(remainder_cube(
+                    map, geometry, &sh, &lights,
+                )));
+                self.remainder = Some((lights, sh, cube.clone()));
+                cube
+            }
+        };
+        ReflectedEnvironment::Remainder {
+            cube,
+            orientation: self.orientation,
+        }
     }
 
     /// Lights of the median-cut peer ([`RenderMode::MedianCut`]); a power of two.
@@ -362,6 +427,8 @@ impl EnvironmentLighting {
         self.median_cut = None;
         self.median_cut_map = None;
         self.sh_sun = None;
+        self.reflection_cube = None;
+        self.remainder = None;
     }
 
     /// Rotates the map about +Y (degrees, counter-clockwise seen from above).
@@ -479,8 +546,13 @@ impl EnvironmentLighting {
         let ms = start.elapsed().as_secs_f64() * 1e3;
         let indirect =
             lights_indirect.unwrap_or_else(|| lights_indirect_default(self.settings().mode));
+        let mut lighting =
+            FrameLighting::for_mode(mode, &decomposition.sh, &decomposition, indirect);
+        if matches!(mode, RenderMode::Hybrid | RenderMode::Unshadowed) {
+            lighting.reflections = self.remainder(&decomposition);
+        }
         LitFrame {
-            lighting: FrameLighting::for_mode(mode, &decomposition.sh, &decomposition, indirect),
+            lighting,
             decomposition: Some(decomposition),
             ms,
         }

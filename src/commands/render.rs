@@ -98,6 +98,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }
     };
     lighting.set_median_cut_lights(args.render.lights)?;
+    if scene.geometry.is_glossy() {
+        lighting.enable_reflections(Some(runtime::render::DEFAULT_REFLECTION_SIZE));
+    }
     let frame = lighting.frame(args.render.mode, args.render.lights_indirect());
     let gpu = GpuContext::headless(args.render.backend)?;
     println!("adapter: {}", gpu.description());

@@ -345,6 +345,9 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
     let order = job.renderer.order();
     let mut lighting = EnvironmentLighting::new(&map, DecomposeSettings::default())?;
     lighting.set_rotation(rotation);
+    if job.scene.geometry.is_glossy() {
+        lighting.enable_reflections(Some(runtime::render::DEFAULT_REFLECTION_SIZE));
+    }
     let default_threshold = DecomposeSettings::default().threshold;
     let mut rendered = Vec::new();
     let mut images = Vec::new();

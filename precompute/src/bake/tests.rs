@@ -182,6 +182,14 @@ fn direct_transfer_under_an_opening_is_its_form_factor() {
         if bounces == 0 {
             assert!(transfer.indirect.as_slice().iter().all(|x| *x == 0.0));
         }
+        // The specular occlusion read back from it is the form factor itself.
+        let fraction = transfer.direct.unoccluded_fraction(&geometry.albedo);
+        let mean =
+            centre.iter().map(|&v| f64::from(fraction[v])).sum::<f64>() / centre.len() as f64;
+        assert!(
+            (mean - form_factor).abs() < 0.005 * form_factor,
+            "unoccluded fraction {mean}, form factor {form_factor}"
+        );
     }
 }
 

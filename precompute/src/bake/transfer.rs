@@ -72,6 +72,29 @@ impl TransferVectors {
         Rgb::from(out)
     }
 
+    /// Per vertex, the cosine-weighted fraction of its hemisphere that sees the sky, read from
+    /// a *direct* transfer baked with `albedo`: its constant coefficient is `ρ Y₀` times that
+    /// fraction (the bake adds the basis of every escaping cosine-distributed ray). Taken from
+    /// the channel with the largest albedo; a black vertex (nothing to read) gets 1. The
+    /// renderer's specular occlusion.
+    pub fn unoccluded_fraction(&self, albedo: &[Rgb]) -> Vec<f32> {
+        const Y00: f32 = 0.282_094_8;
+        albedo
+            .iter()
+            .enumerate()
+            .take(self.vertex_count())
+            .map(|(v, rho)| {
+                let c = (0..3)
+                    .max_by(|a, b| rho[*a].total_cmp(&rho[*b]))
+                    .unwrap_or(0);
+                if rho[c] <= 1e-4 {
+                    return 1.0;
+                }
+                (self.vector(v, c)[0] / (rho[c] * Y00)).clamp(0.0, 1.0)
+            })
+            .collect()
+    }
+
     /// Element-wise sum (direct + indirect = full transfer).
     /// Each vertex's vectors times its albedo, channel by channel.
     pub fn scaled_per_vertex(&self, albedo: &[Rgb]) -> TransferVectors {

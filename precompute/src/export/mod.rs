@@ -19,6 +19,12 @@ use std::path::{Path, PathBuf};
 pub enum ExportError {
     #[error("{}: {message}", path.display())]
     Write { path: PathBuf, message: String },
+    /// A material Mitsuba has no counterpart for in the export yet.
+    #[error(
+        "object {object}: glossy (Phong) materials are not exported to Mitsuba yet; export the \
+         scene without specular/shininess to cross-check its diffuse part"
+    )]
+    Glossy { object: String },
 }
 
 /// What the exported scene renders.
@@ -246,6 +252,12 @@ pub fn export_mitsuba(
         path: path.to_owned(),
         message,
     };
+    // Refused before anything is written: a diffuse stand-in would not be the same scene.
+    if let Some(o) = geometry.objects.iter().find(|o| o.material.is_glossy()) {
+        return Err(ExportError::Glossy {
+            object: o.name.clone(),
+        });
+    }
     let meshes = dir.join("meshes");
     std::fs::create_dir_all(&meshes).map_err(|e| error(&meshes, e.to_string()))?;
     for i in 0..geometry.objects.len() {

@@ -1,11 +1,15 @@
 //! The path tracer: next-event estimation with environment importance sampling, combined by
-//! multiple importance sampling (power heuristic) with cosine-weighted sampling of the surface.
+//! multiple importance sampling (power heuristic) with sampling of the surface's BRDF:
+//! cosine-weighted for a Lambertian surface; for a glossy one ([`crate::material`]) the
+//! diffuse part or the Phong lobe, chosen by their reflectances' luminance (one-sample MIS
+//! over the two: the pdf is their mixture).
 
 use super::environment::EnvironmentLight;
 use super::sampler::PathSampler;
 use crate::bake::RAY_OFFSET_FRACTION;
 use crate::bvh::{Hit, SceneBvh, Skip};
 use crate::color::{Rgb, luminance};
+use crate::material::{Material, front_view, mirror, phong_lobe, sample_phong_lobe};
 use crate::sampling::{Frame, cosine_hemisphere};
 use crate::scene::{NO_TEXTURE, SceneMesh};
 use glam::Vec3;
@@ -20,9 +24,92 @@ pub struct SurfacePoint {
     /// Geometric normal on the front side: rays leave from this side.
     pub front_normal: Vec3,
     pub albedo: Rgb,
+    /// The specular lobe (diffuse surfaces: [`Material::DIFFUSE`]).
+    pub material: Material,
     /// Which triangles a ray leaving the point must not hit: the one it leaves, or, for a ray
     /// leaving a vertex, every triangle sharing the vertex (as in the bake).
     pub leaving: Skip,
+}
+
+/// One path's estimate of the radiance leaving its first point.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PathEstimate {
+    pub radiance: Rgb,
+    /// The part of `radiance` reflected by the first point's specular lobe (zero on diffuse
+    /// surfaces): what decides a report's highlight region.
+    pub specular: Rgb,
+    pub direct: DirectVisibility,
+}
+
+/// A glossy point's BRDF toward one direction: `f cos` of each part and the pdf of the
+/// mixture that samples it.
+#[derive(Debug, Clone, Copy)]
+struct GlossyEval {
+    diffuse: Rgb,
+    specular: Rgb,
+    pdf: f32,
+}
+
+/// How a glossy point samples and evaluates its BRDF for one view.
+#[derive(Debug, Clone, Copy)]
+struct GlossyLobes {
+    n: Vec3,
+    /// The mirror direction of the view.
+    mirror: Vec3,
+    albedo: Rgb,
+    material: Material,
+    /// Probability of sampling the lobe rather than the cosine.
+    lobe_probability: f32,
+}
+
+impl GlossyLobes {
+    /// `None` for a black surface (nothing to sample).
+    fn new(point: &SurfacePoint, wo: Vec3) -> Option<Self> {
+        let n = point.shading_normal;
+        let (d, s) = (
+            luminance(point.albedo).max(0.0),
+            luminance(point.material.specular).max(0.0),
+        );
+        if d + s <= 0.0 {
+            return None;
+        }
+        Some(Self {
+            n,
+            mirror: mirror(front_view(wo, n), n),
+            albedo: point.albedo,
+            material: point.material,
+            lobe_probability: s / (d + s),
+        })
+    }
+
+    fn eval(&self, w: Vec3) -> GlossyEval {
+        let cos = self.n.dot(w);
+        if cos <= 0.0 {
+            return GlossyEval {
+                diffuse: Rgb::ZERO,
+                specular: Rgb::ZERO,
+                pdf: 0.0,
+            };
+        }
+        let lobe = phong_lobe(self.mirror.dot(w), self.material.shininess);
+        GlossyEval {
+            diffuse: self.albedo * (cos * FRAC_1_PI),
+            specular: self.material.specular * lobe,
+            pdf: (1.0 - self.lobe_probability) * cos * FRAC_1_PI + self.lobe_probability * lobe,
+        }
+    }
+
+    /// A direction from the mixture (one 2D sample: its first coordinate also picks the part).
+    fn sample(&self, u: glam::Vec2) -> Vec3 {
+        let p = self.lobe_probability;
+        if u.x < p {
+            let u = glam::Vec2::new((u.x / p).min(1.0 - f32::EPSILON), u.y);
+            Frame::from_normal(self.mirror).to_world(sample_phong_lobe(u, self.material.shininess))
+        } else {
+            let u = glam::Vec2::new(((u.x - p) / (1.0 - p)).min(1.0 - f32::EPSILON), u.y);
+            Frame::from_normal(self.n).to_world(cosine_hemisphere(u))
+        }
+    }
 }
 
 /// Light reaching the first shading point directly from the environment, in luminance: what
@@ -45,6 +132,8 @@ pub struct Integrator<'a> {
     /// Per triangle, its texture in `geometry.textures` or [`NO_TEXTURE`]; empty for an
     /// untextured scene, whose hits then read nothing more than before.
     triangle_textures: Vec<u32>,
+    /// Per triangle, its material; empty for a diffuse scene.
+    triangle_materials: Vec<Material>,
 }
 
 #[inline]
@@ -72,6 +161,11 @@ impl<'a> Integrator<'a> {
                 .collect(),
             triangle_textures: if geometry.is_textured() {
                 geometry.triangle_textures()
+            } else {
+                Vec::new()
+            },
+            triangle_materials: if geometry.is_glossy() {
+                geometry.triangle_materials()
             } else {
                 Vec::new()
             },
@@ -109,6 +203,11 @@ impl<'a> Integrator<'a> {
             shading_normal: normal.try_normalize().unwrap_or(front),
             front_normal: front,
             albedo,
+            material: self
+                .triangle_materials
+                .get(hit.triangle as usize)
+                .copied()
+                .unwrap_or_default(),
             leaving: Skip::Triangle(hit.triangle),
         }
     }
@@ -123,6 +222,12 @@ impl<'a> Integrator<'a> {
             front_normal: normal,
             // On a textured object, the texture's factor: as the bake, per unit texel value.
             albedo: self.geometry.albedo[v as usize],
+            material: self
+                .geometry
+                .objects
+                .iter()
+                .find(|o| o.vertices.contains(&v))
+                .map_or(Material::DIFFUSE, |o| o.material),
             leaving: Skip::VertexTriangles(v),
         }
     }
@@ -144,22 +249,36 @@ impl<'a> Integrator<'a> {
             .occluded(self.origin(p), w, 0.0, f32::INFINITY, p.leaving)
     }
 
-    /// One estimate of the radiance leaving `start` (toward any direction: Lambertian), with
-    /// `self.bounces` indirect bounces, and the direct visibility seen at `start`. Counts the
-    /// rays traced in `rays`.
+    /// One estimate of the radiance leaving `start` toward `wo` (unit, toward the viewer;
+    /// only glossy surfaces depend on it), with `self.bounces` indirect bounces, and the direct
+    /// visibility seen at `start`. Counts the rays traced in `rays`.
     pub fn radiance(
         &self,
         start: &SurfacePoint,
+        wo: Vec3,
         sampler: &mut impl PathSampler,
         rays: &mut u64,
-    ) -> (Rgb, DirectVisibility) {
-        let mut radiance = Rgb::ZERO;
-        let mut direct = DirectVisibility::default();
+    ) -> PathEstimate {
+        let mut out = PathEstimate::default();
         let mut point = *start;
-        // Albedos of every point so far: the path's throughput (cos/pdf cancels out).
-        let mut throughput = point.albedo;
+        let mut wo = wo;
+        // The path's weight up to the current point, not counting its BRDF; and the part of it
+        // that left the first point through its specular lobe.
+        let mut before = Rgb::ONE;
+        let mut specular_before = Rgb::ZERO;
         for depth in 0..=self.bounces {
             let n = point.shading_normal;
+            let glossy = if point.material.is_glossy() {
+                match GlossyLobes::new(&point, wo) {
+                    Some(lobes) => Some(lobes),
+                    None => break,
+                }
+            } else {
+                None
+            };
+            // A Lambertian point's weight (cos/pdf cancels): the arithmetic of a diffuse path
+            // is the same as before glossy surfaces existed.
+            let throughput = before * point.albedo;
             // Next-event estimation toward the environment.
             if let Some((w, pdf_light, le)) = self.light.sample_with_radiance(sampler.next_2d()) {
                 let cos = n.dot(w);
@@ -168,22 +287,77 @@ impl<'a> Integrator<'a> {
                     let visible = !self.occluded(&point, w);
                     if depth == 0 {
                         let weight = luminance(le) * cos / pdf_light;
-                        direct.unoccluded += weight;
+                        out.direct.unoccluded += weight;
                         if visible {
-                            direct.visible += weight;
+                            out.direct.visible += weight;
                         }
                     }
                     if visible {
-                        let pdf_surface = cos * FRAC_1_PI;
-                        let mis = power_heuristic(pdf_light, pdf_surface);
-                        radiance += throughput * le * (cos * FRAC_1_PI / pdf_light * mis);
+                        match &glossy {
+                            None => {
+                                let pdf_surface = cos * FRAC_1_PI;
+                                let mis = power_heuristic(pdf_light, pdf_surface);
+                                let add = throughput * le * (cos * FRAC_1_PI / pdf_light * mis);
+                                out.radiance += add;
+                                out.specular += specular_before
+                                    * point.albedo
+                                    * le
+                                    * (cos * FRAC_1_PI / pdf_light * mis);
+                            }
+                            Some(lobes) => {
+                                let f = lobes.eval(w);
+                                let scale = le * (power_heuristic(pdf_light, f.pdf) / pdf_light);
+                                out.radiance += before * (f.diffuse + f.specular) * scale;
+                                out.specular += if depth == 0 {
+                                    before * f.specular * scale
+                                } else {
+                                    specular_before * (f.diffuse + f.specular) * scale
+                                };
+                            }
+                        }
                     }
                 }
             }
-            // Cosine-weighted continuation; on escape it is the other MIS strategy for the
+            // Continuation by the BRDF; on escape it is the other MIS strategy for the
             // environment.
-            let w = Frame::from_normal(n).to_world(cosine_hemisphere(sampler.next_2d()));
-            let pdf_surface = n.dot(w).max(0.0) * FRAC_1_PI;
+            let u = sampler.next_2d();
+            let (w, pdf_surface, weight, specular_weight) = match &glossy {
+                None => {
+                    let w = Frame::from_normal(n).to_world(cosine_hemisphere(u));
+                    let pdf = n.dot(w).max(0.0) * FRAC_1_PI;
+                    (w, pdf, point.albedo, point.albedo)
+                }
+                Some(lobes) => {
+                    let w = lobes.sample(u);
+                    let f = lobes.eval(w);
+                    if f.pdf <= 0.0 {
+                        // Below the surface: the lobe's part past the horizon reflects nothing.
+                        break;
+                    }
+                    let weight = (f.diffuse + f.specular) / f.pdf;
+                    let specular = if depth == 0 {
+                        f.specular / f.pdf
+                    } else {
+                        weight
+                    };
+                    (w, f.pdf, weight, specular)
+                }
+            };
+            let next = if glossy.is_some() {
+                before * weight
+            } else {
+                throughput
+            };
+            specular_before = if depth == 0 {
+                if glossy.is_some() {
+                    before * specular_weight
+                } else {
+                    Rgb::ZERO
+                }
+            } else {
+                specular_before * specular_weight
+            };
+            before = next;
             // The environment seen along an escaping continuation, MIS-weighted.
             let escaped = |w: Vec3| {
                 let (le, pdf_light) = self.light.radiance_and_pdf(w);
@@ -193,22 +367,26 @@ impl<'a> Integrator<'a> {
             if depth == self.bounces {
                 // Only whether it escapes matters: an occlusion ray suffices.
                 if !self.occluded(&point, w) {
-                    radiance += throughput * escaped(w);
+                    let le = escaped(w);
+                    out.radiance += before * le;
+                    out.specular += specular_before * le;
                 }
                 break;
             }
             match self.trace(&point, w) {
                 None => {
-                    radiance += throughput * escaped(w);
+                    let le = escaped(w);
+                    out.radiance += before * le;
+                    out.specular += specular_before * le;
                     break;
                 }
                 Some(hit) => {
                     point = self.surface(&hit);
-                    throughput *= point.albedo;
+                    wo = -w;
                 }
             }
         }
-        (radiance, direct)
+        out
     }
 }
 

@@ -12,7 +12,7 @@ mod integrator;
 mod sampler;
 
 pub use environment::EnvironmentLight;
-pub use integrator::{DirectVisibility, Integrator, SurfacePoint};
+pub use integrator::{DirectVisibility, Integrator, PathEstimate, SurfacePoint};
 pub use sampler::{MAX_SOBOL_SAMPLES, PathSampler, PixelSampler, SamplerKind, SobolSampler};
 
 use crate::bvh::SceneBvh;
@@ -75,6 +75,9 @@ pub struct ReferenceImage {
     /// For covered pixels, the fraction of the (luminance of the) unoccluded direct
     /// irradiance from the environment that is actually visible; 1 elsewhere.
     pub visibility: Vec<f32>,
+    /// The part of `radiance` reflected by the first surface's specular lobe (zero for
+    /// diffuse surfaces and uncovered pixels).
+    pub specular: RgbImageF32,
     pub stats: RenderStats,
 }
 
@@ -95,8 +98,9 @@ pub fn stream(seed: u64, index: u64) -> Pcg32 {
     Pcg32::new(mix64(seed ^ mix64(index)), index)
 }
 
-/// One image row: radiance, coverage, direct visibility, and the rays it took.
-type RowResult = (Vec<Rgb>, Vec<f32>, Vec<f32>, u64);
+/// One image row: radiance, coverage, direct visibility, the rays it took, and the specular
+/// part of the radiance.
+type RowResult = (Vec<Rgb>, Vec<f32>, Vec<f32>, u64, Vec<Rgb>);
 
 /// Renders `camera`'s view of `geometry` lit by `light`. `progress` counts image rows.
 pub fn render(
@@ -120,6 +124,7 @@ pub fn render(
                 Vec::with_capacity(width),
                 Vec::with_capacity(width),
                 0u64,
+                Vec::with_capacity(width),
             );
             for i in 0..width {
                 let direction = camera.pixel_direction(&basis, i as u32, j as u32);
@@ -129,6 +134,7 @@ pub fn render(
                     row.0.push(light.radiance(direction));
                     row.1.push(0.0);
                     row.2.push(1.0);
+                    row.4.push(Rgb::ZERO);
                     continue;
                 };
                 let point = integrator.surface(&hit);
@@ -138,16 +144,18 @@ pub fn render(
                     (j * width + i) as u64,
                     settings.first_sample,
                 );
-                let mut sum = Rgb::ZERO;
+                let (mut sum, mut specular) = (Rgb::ZERO, Rgb::ZERO);
                 let mut direct = DirectVisibility::default();
                 for _ in 0..settings.spp {
-                    let (l, d) = integrator.radiance(&point, &mut sampler, &mut row.3);
+                    let e = integrator.radiance(&point, -direction, &mut sampler, &mut row.3);
                     sampler.next_sample();
-                    sum += l;
-                    direct.visible += d.visible;
-                    direct.unoccluded += d.unoccluded;
+                    sum += e.radiance;
+                    specular += e.specular;
+                    direct.visible += e.direct.visible;
+                    direct.unoccluded += e.direct.unoccluded;
                 }
                 row.0.push(sum / settings.spp.max(1) as f32);
+                row.4.push(specular / settings.spp.max(1) as f32);
                 row.1.push(1.0);
                 row.2.push(if direct.unoccluded > 0.0 {
                     direct.visible / direct.unoccluded
@@ -165,15 +173,19 @@ pub fn render(
         radiance: RgbImageF32::filled(0, 0, Rgb::ZERO),
         coverage: Vec::with_capacity(width * height),
         visibility: Vec::with_capacity(width * height),
+        specular: RgbImageF32::filled(0, 0, Rgb::ZERO),
         stats: RenderStats::default(),
     };
-    for (radiance, coverage, visibility, rays) in rows {
+    let mut specular = Vec::with_capacity(width * height);
+    for (radiance, coverage, visibility, rays, row_specular) in rows {
         pixels.extend(radiance);
+        specular.extend(row_specular);
         image.coverage.extend(coverage);
         image.visibility.extend(visibility);
         image.stats.rays += rays;
     }
     image.radiance = RgbImageF32::new(width, height, pixels);
+    image.specular = RgbImageF32::new(width, height, specular);
     image.stats.seconds = start.elapsed().as_secs_f64();
     image
 }
@@ -186,7 +198,9 @@ pub fn estimate_vertex(integrator: &Integrator, v: u32, samples: u32, seed: u64)
     let (mut sum, mut sum_sq) = (Rgb::ZERO, Rgb::ZERO);
     let mut rays = 0;
     for _ in 0..samples {
-        let (l, _) = integrator.radiance(&point, &mut rng, &mut rays);
+        let l = integrator
+            .radiance(&point, point.shading_normal, &mut rng, &mut rays)
+            .radiance;
         sum += l;
         sum_sq += l * l;
     }

@@ -28,8 +28,11 @@ pub fn settings(base: &DecomposeSettings) -> DecomposeSettings {
 
 /// The frame's lighting from a decomposition made with [`settings`].
 pub fn lighting(decomposition: &Decomposition) -> FrameLighting {
+    let sh = decomposition.sh.with_order(SH_ORDER);
     FrameLighting {
-        sh: decomposition.sh.with_order(SH_ORDER),
+        // Glossy surfaces reflect the same order-3 SH, convolved with their lobe.
+        reflections: crate::reflection::ReflectedEnvironment::Sh(sh.clone()),
+        sh,
         lights: decomposition.lights.iter().take(1).copied().collect(),
         lights_indirect: false,
         shadows: true,

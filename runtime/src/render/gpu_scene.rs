@@ -3,6 +3,7 @@
 
 use super::RenderError;
 use super::environment::{mip_chain_of, upload_mip_chain};
+use super::materials::GpuMaterials;
 use super::shaders::{MAX_GPU_COEFFS, MAX_GPU_ORDER, Shader, TRANSFER_WORKGROUP};
 use crate::lighting::{FrameLighting, ShTransfer};
 use bytemuck::{Pod, Zeroable};
@@ -40,6 +41,8 @@ pub struct GpuScene {
     pub vertex_buffer: wgpu::Buffer,
     /// Per-vertex PRT radiance (vec4), written by the transfer pass, read as a vertex buffer.
     pub radiance_buffer: wgpu::Buffer,
+    /// Its interreflected part (vec4), read by glossy surfaces.
+    pub indirect_buffer: wgpu::Buffer,
     pub index_buffer: wgpu::Buffer,
     pub index_count: u32,
     pub vertex_count: u32,
@@ -55,6 +58,8 @@ pub struct GpuScene {
     texture_groups: Vec<wgpu::BindGroup>,
     /// Index ranges drawn with one texture group each, in scene order.
     draws: Vec<(std::ops::Range<u32>, usize)>,
+    /// The glossy materials, with each vertex's index and specular occlusion.
+    pub materials: GpuMaterials,
 }
 
 pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
@@ -69,6 +74,12 @@ pub const RADIANCE_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBuffe
     array_stride: 16,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &wgpu::vertex_attr_array![3 => Float32x4],
+};
+
+pub const INDIRECT_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 16,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![7 => Float32x4],
 };
 
 impl GpuScene {
@@ -144,6 +155,14 @@ impl GpuScene {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
             mapped_at_creation: false,
         });
+        let indirect_radiance_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("vertex indirect radiance"),
+            size: (mesh.vertex_count() * 16) as u64,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::VERTEX
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let lighting_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("lighting"),
             size: std::mem::size_of::<LightingUniform>() as u64,
@@ -179,8 +198,15 @@ impl GpuScene {
                     binding: 3,
                     resource: radiance_buffer.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: indirect_radiance_buffer.as_entire_binding(),
+                },
             ],
         });
+        let occlusion = transfer.direct.unoccluded_fraction(&geometry.albedo);
+        let materials = GpuMaterials::new(device, geometry, occlusion)?;
+        materials.write(queue);
         let texture_layout = texture_layout(device);
         let white = Arc::new(AlbedoTexture {
             width: 1,
@@ -192,11 +218,13 @@ impl GpuScene {
             .map(|t| texture_group(device, queue, &texture_layout, t))
             .collect();
         Ok(Self {
+            materials,
             texture_layout,
             texture_groups,
             draws: draws(geometry),
             vertex_buffer,
             radiance_buffer,
+            indirect_buffer: indirect_radiance_buffer,
             index_buffer,
             index_count: indices.len() as u32,
             vertex_count: mesh.vertex_count() as u32,
@@ -215,8 +243,10 @@ impl GpuScene {
         encoder: &mut wgpu::CommandEncoder,
         lighting: &FrameLighting,
     ) {
-        // Unshadowed SH is applied per pixel by the first pass (`shaders/geometry.wgsl`).
+        // Unshadowed SH is applied per pixel by the first pass (`shaders/geometry.wgsl`), with
+        // no interreflection.
         if lighting.sh_transfer == ShTransfer::Unshadowed {
+            encoder.clear_buffer(&self.indirect_buffer, 0, None);
             return;
         }
         let n = num_coeffs(self.order);
@@ -250,6 +280,8 @@ impl GpuScene {
     pub fn draw_with_radiance(&self, pass: &mut wgpu::RenderPass) {
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, self.radiance_buffer.slice(..));
+        pass.set_vertex_buffer(2, self.materials.vertex_buffer.slice(..));
+        pass.set_vertex_buffer(3, self.indirect_buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
         for (range, group) in &self.draws {
             pass.set_bind_group(1, &self.texture_groups[*group], &[]);

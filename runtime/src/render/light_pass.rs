@@ -16,6 +16,8 @@ pub struct LightPassInputs<'a> {
     pub targets: &'a Targets,
     pub shadow_maps: &'a ShadowMaps,
     pub environment: &'a EnvironmentTexture,
+    /// The materials' table (`Materials` in `shaders/glossy.wgsl`).
+    pub materials: &'a wgpu::Buffer,
 }
 
 pub struct LightPass {
@@ -118,6 +120,7 @@ fn bind_group(
         view(&inputs.environment.view),
         view(inputs.shadow_maps.depth_copy_array_view()),
         wgpu::BindingResource::Sampler(&inputs.environment.sampler),
+        inputs.materials.as_entire_binding(),
     ];
     let entries: Vec<wgpu::BindGroupEntry> = resources
         .into_iter()
@@ -134,7 +137,7 @@ fn bind_group(
     })
 }
 
-/// Bindings 0–9 of `shaders/lights.wgsl`, in order.
+/// Bindings 0–10 of `shaders/lights.wgsl`, in order.
 fn layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     use wgpu::{BindingType, TextureSampleType as S, TextureViewDimension as D};
     let uniform = BindingType::Buffer {
@@ -159,6 +162,7 @@ fn layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         texture(S::Float { filterable: true }, D::D2),              // environment
         texture(float, D::D2Array),                                 // shadow depths
         BindingType::Sampler(wgpu::SamplerBindingType::Filtering),  // environment sampler
+        uniform,                                                    // materials
     ]
     .into_iter()
     .enumerate()

@@ -9,6 +9,9 @@
 //! 4. [`light_pass`]: one additive full-screen pass adds every light with percentage-closer
 //!    filtering and shows the [`environment`] behind the scene (`shaders/lights.wgsl`).
 //!
+//! Glossy scenes add [`materials`] and the [`reflection_maps`] the PRT pass reflects,
+//! prefiltered only when the reflected environment changes.
+//!
 //! [`uniforms`] holds what the passes share per frame, [`shaders`] loads the WGSL, [`gpu`]
 //! opens the device, [`readback`] copies images back, [`pass_helpers`] builds the descriptors
 //! every pass repeats.
@@ -17,9 +20,11 @@ pub mod environment;
 pub mod gpu;
 pub mod gpu_scene;
 pub mod light_pass;
+pub mod materials;
 pub mod pass_helpers;
 pub mod prt_pass;
 pub mod readback;
+pub mod reflection_maps;
 pub mod shaders;
 pub mod shadow_maps;
 pub mod targets;
@@ -35,9 +40,11 @@ use precompute::bake::Transfer;
 use precompute::camera::Camera;
 use precompute::envmap::EnvMap;
 use precompute::image_io::RgbImageF32;
+use precompute::material::Material;
 use precompute::scene::SceneMesh;
 use precompute::settings::InvalidSettings;
-use prt_pass::PrtPass;
+use prt_pass::{PrtPass, PrtPassInputs};
+use reflection_maps::ReflectionMaps;
 pub use shaders::{MAX_GPU_ORDER, MAX_LIGHTS};
 use shadow_maps::ShadowMaps;
 pub use shadow_maps::{BoundingSphere, ShadowFit, ShadowSettings};
@@ -98,7 +105,12 @@ struct FrameState {
     camera: Camera,
     lighting: Option<FrameLighting>,
     radiance_dirty: bool,
+    /// The reflection maps must be prefiltered again (glossy scenes only).
+    reflections_dirty: bool,
 }
+
+/// Face size of the reflection maps unless set otherwise.
+pub const DEFAULT_REFLECTION_SIZE: usize = 128;
 
 /// The renderer of one baked scene.
 pub struct Renderer {
@@ -112,6 +124,7 @@ pub struct Renderer {
     environment: EnvironmentTexture,
     prt_pass: PrtPass,
     light_pass: LightPass,
+    reflections: ReflectionMaps,
     frame: FrameState,
     /// Show the environment map where no geometry is.
     pub background: bool,
@@ -145,7 +158,8 @@ impl Renderer {
         let buffers = FrameBuffers::new(&device);
         Ok(Self {
             bounds: BoundingSphere::of_box(scene.bounds.0, scene.bounds.1),
-            prt_pass: PrtPass::new(&device, &buffers.frame, &scene.texture_layout),
+            prt_pass: PrtPass::new(&device, &scene.texture_layout),
+            reflections: ReflectionMaps::new(&device, &gpu.queue, DEFAULT_REFLECTION_SIZE),
             light_pass: LightPass::new(&device),
             shadow_maps: ShadowMaps::new(&device, shadow)?,
             targets: Targets::new(&device, camera.width, camera.height),
@@ -161,6 +175,7 @@ impl Renderer {
                 camera: *camera,
                 lighting: None,
                 radiance_dirty: true,
+                reflections_dirty: true,
             },
             background: true,
             queue: gpu.queue.clone(),
@@ -223,8 +238,53 @@ impl Renderer {
             .into());
         }
         if self.frame.lighting.as_ref() != Some(lighting) {
+            if self.frame.lighting.as_ref().map(|l| &l.reflections) != Some(&lighting.reflections) {
+                self.frame.reflections_dirty = true;
+            }
             self.frame.lighting = Some(lighting.clone());
             self.frame.radiance_dirty = true;
+        }
+        Ok(())
+    }
+
+    /// Whether any object is glossy (reflection maps are made only then).
+    pub fn is_glossy(&self) -> bool {
+        !self.scene.materials.table.glossy.is_empty()
+    }
+
+    /// Gives the objects new materials (one per object of the scene, in order), live.
+    pub fn set_materials(&mut self, materials: &[Material]) -> Result<(), RenderError> {
+        if materials.len() != self.scene.materials.table.object_entries.len() {
+            return Err(InvalidSettings::new(
+                "materials",
+                format!(
+                    "{} materials for {} objects",
+                    materials.len(),
+                    self.scene.materials.table.object_entries.len()
+                ),
+            )
+            .into());
+        }
+        let was_glossy = self.is_glossy();
+        if self.scene.materials.set(&self.queue, materials)? || !was_glossy {
+            self.frame.reflections_dirty = true;
+        }
+        Ok(())
+    }
+
+    /// Face size of the reflection maps (prefiltered again at the next frame).
+    pub fn set_reflection_size(&mut self, face_size: usize) -> Result<(), RenderError> {
+        if !(4..=2048).contains(&face_size) {
+            return Err(InvalidSettings::new(
+                "reflection maps",
+                format!("face size {face_size} outside 4..=2048"),
+            )
+            .into());
+        }
+        if face_size != self.reflections.face_size() {
+            self.reflections = ReflectionMaps::new(&self.device, &self.queue, face_size);
+            self.prt_pass.inputs_changed();
+            self.frame.reflections_dirty = true;
         }
         Ok(())
     }
@@ -249,6 +309,19 @@ impl Renderer {
         let lights = &lighting.lights;
         let shadows = lighting.shadows && !lights.is_empty();
         let mut encoder = self.device.create_command_encoder(&Default::default());
+        if self.frame.reflections_dirty && self.is_glossy() {
+            let recreated = self.reflections.update(
+                &self.device,
+                &self.queue,
+                &mut encoder,
+                &lighting.reflections,
+                &self.scene.materials.table.shininess,
+            );
+            if recreated {
+                self.prt_pass.inputs_changed();
+            }
+            self.frame.reflections_dirty = false;
+        }
         if self.frame.radiance_dirty {
             self.scene
                 .update_radiance(&self.queue, &mut encoder, &lighting);
@@ -264,6 +337,12 @@ impl Renderer {
             background: self.background,
             pcf_taps: shadow.pcf_taps,
             sh_per_pixel: (lighting.sh_transfer == ShTransfer::Unshadowed).then_some(&lighting.sh),
+            reflection_to_map: match &lighting.reflections {
+                crate::reflection::ReflectedEnvironment::Remainder { orientation, .. } => {
+                    glam::Mat4::from_quat(orientation.inverse())
+                }
+                _ => glam::Mat4::IDENTITY,
+            },
         });
         let fits: Vec<ShadowFit> = lights
             .iter()
@@ -281,13 +360,23 @@ impl Renderer {
             self.shadow_maps
                 .render_stale(&self.queue, &mut encoder, &self.scene, &matrices);
         }
-        self.prt_pass
-            .record(&mut encoder, &self.targets, &self.scene);
+        self.prt_pass.record(
+            &self.device,
+            &mut encoder,
+            &self.targets,
+            &self.scene,
+            &PrtPassInputs {
+                frame: &self.buffers.frame,
+                materials: &self.scene.materials.uniform,
+                reflections: &self.reflections,
+            },
+        );
         let inputs = LightPassInputs {
             buffers: &self.buffers,
             targets: &self.targets,
             shadow_maps: &self.shadow_maps,
             environment: &self.environment,
+            materials: &self.scene.materials.uniform,
         };
         self.light_pass
             .record(&self.device, &mut encoder, &inputs, shadows);

@@ -2,9 +2,11 @@
 //! depth, normals and albedo for the light pass (`shaders/geometry.wgsl`).
 
 use super::gpu_scene::{self, GpuScene};
+use super::materials::MATERIAL_LAYOUT;
 use super::pass_helpers::{
     begin_pass, color_attachment, depth_attachment, nearest_depth, two_sided_triangles,
 };
+use super::reflection_maps::ReflectionMaps;
 use super::shaders::Shader;
 use super::targets::{
     ALBEDO_FORMAT, COLOR_FORMAT, DEPTH_COPY_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, Targets,
@@ -12,29 +14,53 @@ use super::targets::{
 
 pub struct PrtPass {
     pipeline: wgpu::RenderPipeline,
-    bind_group: wgpu::BindGroup,
+    frame_layout: wgpu::BindGroupLayout,
+    /// Made on first use after its inputs change (see [`Self::inputs_changed`]).
+    bind_group: Option<wgpu::BindGroup>,
+}
+
+/// What group 0 of the PRT pass binds.
+pub struct PrtPassInputs<'a> {
+    pub frame: &'a wgpu::Buffer,
+    pub materials: &'a wgpu::Buffer,
+    pub reflections: &'a ReflectionMaps,
 }
 
 impl PrtPass {
     /// `texture_layout`: the scene's albedo textures (group 1, [`GpuScene::texture_layout`]).
-    pub fn new(
-        device: &wgpu::Device,
-        frame_buffer: &wgpu::Buffer,
-        texture_layout: &wgpu::BindGroupLayout,
-    ) -> Self {
+    pub fn new(device: &wgpu::Device, texture_layout: &wgpu::BindGroupLayout) -> Self {
         let module = Shader::Geometry.module(device);
+        let uniform = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty,
+            count: None,
+        };
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("prt pass frame"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
+            entries: &[
+                entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, uniform),
+                entry(1, wgpu::ShaderStages::FRAGMENT, uniform),
+                entry(
+                    2,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                ),
+                entry(
+                    3,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                ),
+            ],
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("prt pass"),
@@ -51,6 +77,8 @@ impl PrtPass {
                 buffers: &[
                     Some(gpu_scene::VERTEX_LAYOUT),
                     Some(gpu_scene::RADIANCE_LAYOUT),
+                    Some(MATERIAL_LAYOUT),
+                    Some(gpu_scene::INDIRECT_LAYOUT),
                 ],
             },
             primitive: two_sided_triangles(),
@@ -70,21 +98,51 @@ impl PrtPass {
             multiview_mask: None,
             cache: None,
         });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("prt pass"),
-            layout: &frame_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: frame_buffer.as_entire_binding(),
-            }],
-        });
         Self {
             pipeline,
-            bind_group,
+            frame_layout,
+            bind_group: None,
         }
     }
 
-    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets, scene: &GpuScene) {
+    /// A resource group 0 binds was re-created.
+    pub fn inputs_changed(&mut self) {
+        self.bind_group = None;
+    }
+
+    pub fn record(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &Targets,
+        scene: &GpuScene,
+        inputs: &PrtPassInputs,
+    ) {
+        let layout = &self.frame_layout;
+        let bind_group = self.bind_group.get_or_insert_with(|| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("prt pass"),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: inputs.frame.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: inputs.materials.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&inputs.reflections.view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::Sampler(&inputs.reflections.sampler),
+                    },
+                ],
+            })
+        });
         let clear = Some(wgpu::Color::TRANSPARENT);
         let mut pass = begin_pass(
             encoder,
@@ -99,7 +157,7 @@ impl PrtPass {
             depth_attachment(&targets.depth_view),
         );
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.set_bind_group(0, &*bind_group, &[]);
         scene.draw_with_radiance(&mut pass);
     }
 }

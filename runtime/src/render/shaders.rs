@@ -10,6 +10,9 @@ pub const MAX_LIGHTS: usize = 32;
 pub const MAX_GPU_ORDER: usize = 8;
 /// SH coefficients per channel at [`MAX_GPU_ORDER`].
 pub const MAX_GPU_COEFFS: usize = MAX_GPU_ORDER * MAX_GPU_ORDER;
+/// Distinct glossy materials a scene may have (the materials' uniform array; entry 0 is the
+/// diffuse one).
+pub const MAX_MATERIALS: usize = 32;
 /// Invocations per workgroup of the per-vertex transfer pass.
 pub const TRANSFER_WORKGROUP: u32 = 64;
 
@@ -26,6 +29,8 @@ pub enum Shader {
     Lights,
     /// Tone mapping to a window.
     Display,
+    /// Reflection maps prefiltered with the Phong lobe.
+    Prefilter,
 }
 
 impl Shader {
@@ -36,6 +41,7 @@ impl Shader {
             Shader::Shadow => "shadow.wgsl",
             Shader::Lights => "lights.wgsl",
             Shader::Display => "display.wgsl",
+            Shader::Prefilter => "prefilter.wgsl",
         }
     }
 
@@ -46,6 +52,7 @@ impl Shader {
             Shader::Shadow => include_str!("../../../shaders/shadow.wgsl"),
             Shader::Lights => include_str!("../../../shaders/lights.wgsl"),
             Shader::Display => include_str!("../../../shaders/display.wgsl"),
+            Shader::Prefilter => include_str!("../../../shaders/prefilter.wgsl"),
         }
     }
 
@@ -55,11 +62,14 @@ impl Shader {
     fn prelude(self) -> &'static [&'static str] {
         const COMMON: &str = include_str!("../../../shaders/common.wgsl");
         const FULLSCREEN: &str = include_str!("../../../shaders/fullscreen.wgsl");
+        const GLOSSY: &str = include_str!("../../../shaders/glossy.wgsl");
         match self {
             Shader::Transfer => &[],
-            Shader::Geometry | Shader::Shadow => &[COMMON],
-            Shader::Lights => &[COMMON, FULLSCREEN],
+            Shader::Geometry => &[COMMON, GLOSSY],
+            Shader::Shadow => &[COMMON],
+            Shader::Lights => &[COMMON, FULLSCREEN, GLOSSY],
             Shader::Display => &[FULLSCREEN],
+            Shader::Prefilter => &[FULLSCREEN, GLOSSY],
         }
     }
 
@@ -92,6 +102,7 @@ fn constants() -> String {
         "// Generated from runtime/src/render/shaders.rs.\n\
          const MAX_LIGHTS: u32 = {MAX_LIGHTS}u;\n\
          const MAX_SH_COEFFS: u32 = {}u;\n\
+         const MAX_MATERIALS: u32 = {MAX_MATERIALS}u;\n\
          const TRANSFER_WORKGROUP: u32 = {TRANSFER_WORKGROUP}u;\n",
         num_coeffs(MAX_GPU_ORDER)
     )
@@ -111,6 +122,7 @@ mod tests {
             Shader::Shadow,
             Shader::Lights,
             Shader::Display,
+            Shader::Prefilter,
         ] {
             let source = shader.source();
             let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| {

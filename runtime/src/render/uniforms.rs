@@ -25,6 +25,8 @@ pub struct FrameUniform {
     _pad: u32,
     /// Per-pixel irradiance of bands 0–2 over π, `A_l L_k / π` (RGB in xyz), when flag bit 2.
     sh_irradiance: [[f32; 4]; 9],
+    camera_position: [f32; 4],
+    reflection_to_map: [[f32; 4]; 4],
 }
 
 /// Matches `Light` in `shaders/common.wgsl`.
@@ -57,6 +59,8 @@ pub struct FrameParameters<'a> {
     /// SH lighting (bands 0–2 used) applied per pixel by the normal, unshadowed, instead of
     /// the per-vertex transfer ([`crate::lighting::ShTransfer::Unshadowed`]).
     pub sh_per_pixel: Option<&'a ShCoeffs<Rgb>>,
+    /// World → the reflection maps' frame.
+    pub reflection_to_map: Mat4,
 }
 
 /// World → clip space of `camera`, its depth range fitted to the scene's bounding sphere.
@@ -82,6 +86,8 @@ impl FrameUniform {
             pcf_taps: p.pcf_taps,
             _pad: 0,
             sh_irradiance: p.sh_per_pixel.map_or([[0.0; 4]; 9], irradiance_over_pi),
+            camera_position: p.camera.position.extend(1.0).to_array(),
+            reflection_to_map: p.reflection_to_map.to_cols_array_2d(),
         }
     }
 }

@@ -1,0 +1,252 @@
+//! Surface materials: Lambertian diffuse plus an optional normalised Phong lobe
+//! (CONVENTIONS.md, "Glossy materials").
+//!
+//! `f(ω_i, ω_o) = k_d/π + k_s (s + 1)/(2π) cos^s α / (n·ω_i)`, with `α` the angle between the
+//! incident direction and the mirror direction `r` of the view, for `n·ω_i > 0`. Dividing the
+//! lobe by the cosine makes the reflected radiance `k_d E(n)/π + k_s (D_s ∗ L)(r)`: the map
+//! convolved with the normalised lobe `D_s(α) = (s + 1)/(2π) cos^s α` around `r` (exact
+//! except where the lobe crosses the horizon), so a prefiltered reflection map is exact and a
+//! directional light of power `P` adds `k_s P D_s(α)`.
+//!
+//! Every consumer (the path tracer, the GPU passes, the SH baseline, the Mitsuba plugin) uses
+//! these functions or their WGSL/Python transcriptions.
+
+use crate::color::Rgb;
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// Largest shininess a scene may give (a lobe about 0.6° wide).
+pub const MAX_SHININESS: f32 = 10_000.0;
+
+/// The glossy part of a surface (its diffuse albedo lives with the geometry).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Material {
+    /// `k_s` per channel; zero for a purely diffuse surface.
+    pub specular: Rgb,
+    /// Phong exponent `s` (meaningless when `specular` is zero).
+    pub shininess: f32,
+}
+
+impl Material {
+    /// Lambertian only.
+    pub const DIFFUSE: Material = Material {
+        specular: Rgb::ZERO,
+        shininess: 0.0,
+    };
+
+    pub fn is_glossy(&self) -> bool {
+        self.specular.max_element() > 0.0
+    }
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self::DIFFUSE
+    }
+}
+
+/// The normalised lobe `D_s(α) = (s + 1)/(2π) cos^s α` (zero beyond 90°): integrates to 1
+/// over the sphere.
+#[inline]
+pub fn phong_lobe(cos_alpha: f32, shininess: f32) -> f32 {
+    if cos_alpha <= 0.0 {
+        return 0.0;
+    }
+    (shininess + 1.0) / (2.0 * PI) * cos_alpha.powf(shininess)
+}
+
+/// A direction distributed as [`phong_lobe`] around +Z (its pdf per solid angle is the lobe
+/// itself): `cos α = u₀^(1/(s+1))`, `φ = 2π u₁`.
+#[inline]
+pub fn sample_phong_lobe(u: Vec2, shininess: f32) -> Vec3 {
+    let cos = u.x.powf(1.0 / (shininess + 1.0));
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)
+}
+
+/// The mirror direction of the view `wo` (unit, toward the viewer) about the normal `n`.
+#[inline]
+pub fn mirror(wo: Vec3, n: Vec3) -> Vec3 {
+    2.0 * n.dot(wo) * n - wo
+}
+
+/// The view as the front of the surface sees it: a view from behind (`n·wo < 0`) is mirrored
+/// through the tangent plane, so both sides of a triangle show its front (CONVENTIONS.md,
+/// "Surfaces").
+#[inline]
+pub fn front_view(wo: Vec3, n: Vec3) -> Vec3 {
+    let c = n.dot(wo);
+    if c < 0.0 { wo - 2.0 * c * n } else { wo }
+}
+
+/// The convolution factors `λ_l = 2π ∫ D_s(t) P_l(t) dt = (s + 1) ∫₀¹ t^s P_l(t) dt` of the
+/// normalised lobe for bands `0..order` (Funk–Hecke): the SH of the map convolved with the
+/// lobe are `λ_l L_lm`. For `s = 1` they are the clamped cosine's `A_l / π`.
+pub fn phong_zonal(shininess: f32, order: usize) -> Vec<f32> {
+    let s = f64::from(shininess);
+    // Legendre polynomials as coefficient lists, by Bonnet's recursion:
+    // (l + 1) P_{l+1} = (2l + 1) t P_l − l P_{l−1}.
+    let mut previous: Vec<f64> = vec![1.0];
+    let mut current: Vec<f64> = vec![0.0, 1.0];
+    let integral = |p: &[f64]| -> f64 {
+        p.iter()
+            .enumerate()
+            .map(|(k, c)| c / (s + k as f64 + 1.0))
+            .sum()
+    };
+    let mut out = Vec::with_capacity(order);
+    for l in 0..order {
+        let p = match l {
+            0 => previous.clone(),
+            1 => current.clone(),
+            _ => {
+                let lf = (l - 1) as f64;
+                let mut next = vec![0.0; l + 1];
+                for (k, c) in current.iter().enumerate() {
+                    next[k + 1] += (2.0 * lf + 1.0) * c / (lf + 1.0);
+                }
+                for (k, c) in previous.iter().enumerate() {
+                    next[k] -= lf * c / (lf + 1.0);
+                }
+                previous = std::mem::replace(&mut current, next);
+                current.clone()
+            }
+        };
+        out.push(((s + 1.0) * integral(&p)) as f32);
+    }
+    out
+}
+
+/// The shininess of the lobe seen from a source of angular variance `source_variance` (per
+/// axis, radians²; a uniform disc of radius ρ has ρ²/4): in the small-angle limit the lobe is
+/// a Gaussian of variance `1/s` per axis, and convolving it with the source adds the
+/// variances. The widened lobe stays normalised, so a light's specular energy is kept.
+#[inline]
+pub fn widened_shininess(shininess: f32, source_variance: f32) -> f32 {
+    1.0 / (1.0 / shininess.max(1e-6) + source_variance.max(0.0))
+}
+
+/// The angular variance per axis of a source made of a uniform core disc of radius `core`
+/// holding `core_fraction` of the power and a uniform halo disc of radius `halo`.
+#[inline]
+pub fn source_variance(core: f32, halo: f32, core_fraction: f32) -> f32 {
+    (core_fraction * core * core + (1.0 - core_fraction) * halo * halo) / 4.0
+}
+
+/// `k_d + k_s ≤ 1` per channel (energy conservation), with a reason when it does not hold.
+pub fn check_energy(albedo: Rgb, specular: Rgb) -> Result<(), String> {
+    let sum = albedo + specular;
+    if sum.max_element() > 1.0 + 1e-6 {
+        return Err(format!(
+            "albedo + specular is {:.3?}: it must be at most 1 per channel (energy conservation)",
+            sum.to_array()
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Frame;
+
+    /// ∫ over the sphere by a fine (θ, φ)-midpoint rule.
+    fn sphere_integral(f: impl Fn(Vec3) -> f64) -> f64 {
+        let (nt, np) = (2000, 64);
+        let mut sum = 0.0;
+        for i in 0..nt {
+            let theta = (i as f64 + 0.5) / nt as f64 * std::f64::consts::PI;
+            for j in 0..np {
+                let phi = (j as f64 + 0.5) / np as f64 * 2.0 * std::f64::consts::PI;
+                let w = Vec3::new(
+                    (theta.sin() * phi.cos()) as f32,
+                    (theta.sin() * phi.sin()) as f32,
+                    theta.cos() as f32,
+                );
+                sum += f(w) * theta.sin();
+            }
+        }
+        sum * std::f64::consts::PI / nt as f64 * 2.0 * std::f64::consts::PI / np as f64
+    }
+
+    #[test]
+    fn lobe_is_normalised() {
+        for s in [0.0, 1.0, 10.0, 60.0, 500.0] {
+            let total = sphere_integral(|w| f64::from(phong_lobe(w.z, s)));
+            assert!((total - 1.0).abs() < 2e-3, "s = {s}: {total}");
+        }
+    }
+
+    #[test]
+    fn sampled_directions_follow_the_lobe() {
+        // The mean of cos α under D_s is (s + 1)/(s + 2).
+        let s = 60.0;
+        let n = 64 * 64;
+        let mean: f32 = (0..n)
+            .map(|i| {
+                let u = crate::sampling::hammersley(i, n);
+                sample_phong_lobe(u, s).z
+            })
+            .sum::<f32>()
+            / n as f32;
+        assert!((mean - 61.0 / 62.0).abs() < 1e-4, "{mean}");
+        // Turned onto any axis, the samples stay unit and within the hemisphere of the axis.
+        let frame = Frame::from_normal(Vec3::new(0.3, -0.5, 0.8).normalize());
+        let w = frame.to_world(sample_phong_lobe(Vec2::new(0.3, 0.7), s));
+        assert!((w.length() - 1.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn zonal_factors_match_quadrature_and_the_clamped_cosine() {
+        let a = crate::sh::clamped_cosine_bands(6);
+        for (l, (lambda, a)) in phong_zonal(1.0, 6).iter().zip(a).enumerate() {
+            assert!(
+                (lambda - a / PI).abs() < 1e-5,
+                "l = {l}: {lambda} vs {}",
+                a / PI
+            );
+        }
+        for s in [4.0, 60.0] {
+            let lambda = phong_zonal(s, 5);
+            // P_l(z) by its closed forms.
+            let p = |l: usize, t: f64| match l {
+                0 => 1.0,
+                1 => t,
+                2 => 0.5 * (3.0 * t * t - 1.0),
+                3 => 0.5 * (5.0 * t * t * t - 3.0 * t),
+                _ => (35.0 * t.powi(4) - 30.0 * t * t + 3.0) / 8.0,
+            };
+            for (l, value) in lambda.iter().enumerate() {
+                let expected =
+                    sphere_integral(|w| f64::from(phong_lobe(w.z, s)) * p(l, f64::from(w.z)));
+                assert!(
+                    (f64::from(*value) - expected).abs() < 2e-3,
+                    "s = {s}, l = {l}: {value} vs {expected}"
+                );
+            }
+            assert!((lambda[0] - 1.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn back_views_mirror_onto_the_front() {
+        let n = Vec3::Y;
+        let wo = Vec3::new(0.6, -0.8, 0.0);
+        let front = front_view(wo, n);
+        assert!((front - Vec3::new(0.6, 0.8, 0.0)).length() < 1e-6);
+        assert_eq!(front_view(front, n), front);
+        let r = mirror(front, n);
+        assert!((r - Vec3::new(-0.6, 0.8, 0.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn widening_adds_variances_and_energy_is_checked() {
+        assert!((widened_shininess(100.0, 0.0) - 100.0).abs() < 1e-3);
+        // A disc of radius 0.2 (variance 0.01) on a lobe of variance 0.01: half the shininess.
+        let v = source_variance(0.2, 0.2, 1.0);
+        assert!((widened_shininess(100.0, v) - 50.0).abs() < 1e-3);
+        assert!(check_energy(Rgb::splat(0.5), Rgb::splat(0.5)).is_ok());
+        assert!(check_energy(Rgb::new(0.5, 0.7, 0.1), Rgb::splat(0.4)).is_err());
+    }
+}

@@ -1,0 +1,219 @@
+//! Glossy materials on the GPU: a uniform table of the scene's distinct specular lobes (entry
+//! 0 the diffuse one), a per-vertex index into it with the vertex's specular occlusion, and the
+//! shininess slots the reflection maps are prefiltered for (`shaders/glossy.wgsl`).
+
+use super::RenderError;
+use super::pass_helpers::writable_buffer;
+use super::shaders::MAX_MATERIALS;
+use bytemuck::{Pod, Zeroable};
+use precompute::material::Material;
+use precompute::scene::SceneMesh;
+use precompute::settings::InvalidSettings;
+use wgpu::util::DeviceExt;
+
+/// Matches `Material` in `shaders/glossy.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct MaterialUniform {
+    specular: [f32; 4],
+    slot: [u32; 4],
+}
+
+/// Per vertex: its material's index and its specular occlusion.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct MaterialVertex {
+    index: u32,
+    occlusion: f32,
+}
+
+pub const MATERIAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: std::mem::size_of::<MaterialVertex>() as u64,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![5 => Uint32, 6 => Float32],
+};
+
+/// The distinct glossy materials of a set of objects, and each object's index (0: diffuse).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MaterialTable {
+    /// Distinct glossy materials; table entry `i + 1`.
+    pub glossy: Vec<Material>,
+    /// Per object, its entry.
+    pub object_entries: Vec<u32>,
+    /// Distinct shininess values: the reflection maps' slots.
+    pub shininess: Vec<f32>,
+}
+
+impl MaterialTable {
+    pub fn new(materials: &[Material]) -> Result<Self, InvalidSettings> {
+        let mut glossy: Vec<Material> = Vec::new();
+        let mut shininess: Vec<f32> = Vec::new();
+        let mut object_entries = Vec::with_capacity(materials.len());
+        for m in materials {
+            if !m.is_glossy() {
+                object_entries.push(0);
+                continue;
+            }
+            let i = match glossy.iter().position(|g| g == m) {
+                Some(i) => i,
+                None => {
+                    glossy.push(*m);
+                    glossy.len() - 1
+                }
+            };
+            if !shininess.contains(&m.shininess) {
+                shininess.push(m.shininess);
+            }
+            object_entries.push(i as u32 + 1);
+        }
+        if glossy.len() >= MAX_MATERIALS {
+            return Err(InvalidSettings::new(
+                "materials",
+                format!(
+                    "{} distinct glossy materials, the renderer draws at most {}",
+                    glossy.len(),
+                    MAX_MATERIALS - 1
+                ),
+            ));
+        }
+        Ok(Self {
+            glossy,
+            object_entries,
+            shininess,
+        })
+    }
+
+    fn uniform(&self) -> Vec<MaterialUniform> {
+        let mut out = vec![MaterialUniform::zeroed(); MAX_MATERIALS];
+        for (entry, m) in out[1..].iter_mut().zip(&self.glossy) {
+            let slot = self
+                .shininess
+                .iter()
+                .position(|s| *s == m.shininess)
+                .unwrap_or(0);
+            *entry = MaterialUniform {
+                specular: m.specular.extend(m.shininess).to_array(),
+                slot: [slot as u32, 0, 0, 0],
+            };
+        }
+        out
+    }
+}
+
+/// The table and the per-vertex buffer on the GPU.
+pub struct GpuMaterials {
+    pub uniform: wgpu::Buffer,
+    pub vertex_buffer: wgpu::Buffer,
+    pub table: MaterialTable,
+    /// Per vertex: its object and occlusion (to rewrite indices when materials change).
+    vertex_objects: Vec<u32>,
+    occlusion: Vec<f32>,
+}
+
+impl GpuMaterials {
+    /// `occlusion`: per vertex, the specular occlusion (the bake's unoccluded fraction).
+    pub fn new(
+        device: &wgpu::Device,
+        geometry: &SceneMesh,
+        occlusion: Vec<f32>,
+    ) -> Result<Self, RenderError> {
+        let materials: Vec<Material> = geometry.objects.iter().map(|o| o.material).collect();
+        let table = MaterialTable::new(&materials)?;
+        let mut vertex_objects = vec![0u32; geometry.mesh.vertex_count()];
+        for (i, o) in geometry.objects.iter().enumerate() {
+            vertex_objects[o.vertices.start as usize..o.vertices.end as usize].fill(i as u32);
+        }
+        let uniform = writable_buffer(
+            device,
+            "materials",
+            std::mem::size_of::<MaterialUniform>() * MAX_MATERIALS,
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("vertex materials"),
+            contents: bytemuck::cast_slice(&vertices(&table, &vertex_objects, &occlusion)),
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        });
+        Ok(Self {
+            uniform,
+            vertex_buffer,
+            table,
+            vertex_objects,
+            occlusion,
+        })
+    }
+
+    /// Uploads the table (call once after [`Self::new`] and after every change).
+    pub fn write(&self, queue: &wgpu::Queue) {
+        queue.write_buffer(
+            &self.uniform,
+            0,
+            bytemuck::cast_slice(&self.table.uniform()),
+        );
+    }
+
+    /// Gives the objects new materials (one per object); returns whether the shininess
+    /// slots changed (the reflection maps must be prefiltered again).
+    pub fn set(
+        &mut self,
+        queue: &wgpu::Queue,
+        materials: &[Material],
+    ) -> Result<bool, RenderError> {
+        let table = MaterialTable::new(materials)?;
+        let slots_changed = table.shininess != self.table.shininess;
+        if table.object_entries != self.table.object_entries {
+            let data = vertices(&table, &self.vertex_objects, &self.occlusion);
+            queue.write_buffer(&self.vertex_buffer, 0, bytemuck::cast_slice(&data));
+        }
+        self.table = table;
+        self.write(queue);
+        Ok(slots_changed)
+    }
+}
+
+fn vertices(table: &MaterialTable, objects: &[u32], occlusion: &[f32]) -> Vec<MaterialVertex> {
+    objects
+        .iter()
+        .zip(occlusion)
+        .map(|(o, occlusion)| MaterialVertex {
+            index: table.object_entries.get(*o as usize).copied().unwrap_or(0),
+            occlusion: *occlusion,
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use precompute::Rgb;
+
+    #[test]
+    fn distinct_materials_share_entries_and_slots() {
+        let a = Material {
+            specular: Rgb::splat(0.2),
+            shininess: 60.0,
+        };
+        let b = Material {
+            specular: Rgb::splat(0.4),
+            shininess: 60.0,
+        };
+        let c = Material {
+            specular: Rgb::splat(0.2),
+            shininess: 10.0,
+        };
+        let table = MaterialTable::new(&[a, Material::DIFFUSE, b, a, c]).unwrap();
+        assert_eq!(table.object_entries, [1, 0, 2, 1, 3]);
+        assert_eq!(table.shininess, [60.0, 10.0]);
+        let uniform = table.uniform();
+        assert_eq!(uniform[2].specular, [0.4, 0.4, 0.4, 60.0]);
+        assert_eq!(uniform[3].slot[0], 1);
+        assert_eq!(uniform[0].specular, [0.0; 4]);
+        let many: Vec<Material> = (0..MAX_MATERIALS)
+            .map(|i| Material {
+                specular: Rgb::splat(0.1),
+                shininess: 1.0 + i as f32,
+            })
+            .collect();
+        assert!(MaterialTable::new(&many).is_err());
+    }
+}
