@@ -24,8 +24,9 @@ struct VertexIn {
     @location(3) radiance: vec4<f32>,
     @location(4) uv: vec2<f32>,
     @location(5) material: u32,
-    // The bake's unoccluded fraction: the specular occlusion.
-    @location(6) occlusion: f32,
+    // The cone the vertex sees the sky in: its bent normal (xyz) and the bake's unoccluded
+    // fraction V (w), cosine-weighted.
+    @location(6) visibility: vec4<f32>,
     // The interreflected part of `radiance`.
     @location(7) indirect: vec4<f32>,
 };
@@ -37,7 +38,7 @@ struct VertexOut {
     @location(2) radiance: vec3<f32>,
     @location(3) uv: vec2<f32>,
     @location(4) @interpolate(flat) material: u32,
-    @location(5) occlusion: f32,
+    @location(5) visibility: vec4<f32>,
     @location(6) position: vec3<f32>,
     @location(7) indirect: vec3<f32>,
 };
@@ -51,7 +52,7 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.radiance = in.radiance.xyz;
     out.uv = in.uv;
     out.material = in.material;
-    out.occlusion = in.occlusion;
+    out.visibility = in.visibility;
     out.position = in.position;
     out.indirect = in.indirect.xyz;
     return out;
@@ -94,12 +95,22 @@ fn fs_main(in: VertexOut) -> FragmentOut {
         let r = mirror_direction(normalize(frame.camera_position.xyz - in.position), normal);
         let r_map = (frame.reflection_to_map * vec4<f32>(r, 0.0)).xyz;
         let environment = sample_cube(reflection_maps, reflection_sampler, 6u * material.slot.x, r_map, 0.0);
-        // What the occluders send: the bake's interreflected radiance over the albedo is
-        // E_occluded / π, (1 − V) times their cosine-weighted mean radiance (CONVENTIONS.md,
-        // "Glossy materials").
+        // Specular occlusion by cones (CONVENTIONS.md, "Glossy materials"): the sky is seen
+        // in a cone around the bent normal whose cosine-weighted share of the hemisphere is V
+        // (half-angle asin √V), the lobe is a cone of about 1/√(s + 1) around r, and the share
+        // of the lobe inside the sky's cone sees the environment, the rest the occluders,
+        // whose mean radiance is the bake's interreflected radiance over the albedo,
+        // E_occluded / π, divided by their share 1 − V.
+        let unoccluded = clamp(in.visibility.w, 0.0, 1.0);
+        let bent = normalize(in.visibility.xyz + vec3<f32>(0.0, 0.0, 1e-12));
+        let sky_cone = asin(sqrt(unoccluded));
+        let lobe_cone = 1.0 / sqrt(material.specular.w + 1.0);
+        let offset = acos(clamp(dot(r, bent), -1.0, 1.0));
+        let seen = clamp((sky_cone - offset) / (2.0 * lobe_cone) + 0.5, 0.0, 1.0);
         let seen_albedo = in.albedo;
-        let occluders = select(vec3<f32>(0.0), in.indirect / max(seen_albedo, vec3<f32>(1e-4)), seen_albedo > vec3<f32>(1e-4));
-        let reflected = in.occlusion * environment + max(occluders, vec3<f32>(0.0));
+        let occluded_light = select(vec3<f32>(0.0), in.indirect / max(seen_albedo, vec3<f32>(1e-4)), seen_albedo > vec3<f32>(1e-4));
+        let occluders = max(occluded_light, vec3<f32>(0.0)) / max(1.0 - unoccluded, 0.05);
+        let reflected = seen * environment + (1.0 - seen) * occluders;
         out.color = out.color + vec4<f32>(material.specular.rgb * reflected, 0.0);
     }
     // w: the material index (exact in a half float) for the light pass.

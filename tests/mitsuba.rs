@@ -12,6 +12,8 @@
 //! as hprt does (CONVENTIONS.md, "Surfaces"); Mitsuba's own `twosided` fails the test there.
 //! On the floor lies a poster textured with four colours, one per quadrant (an OBJ with
 //! `map_Kd`): a texture exported mirrored, turned or as its mean moves colour between blocks.
+//! The cube is glossy (a Phong lobe of shininess 40 over its diffuse colour): Mitsuba renders it
+//! with the `hprtphong` plugin the export writes (CONVENTIONS.md, "Glossy materials").
 
 mod common;
 
@@ -104,7 +106,9 @@ albedo = [0.3, 0.6, 0.8]
 [[object]]
 name = "cube"
 box = {{ min = [-0.5, 0, -0.6], max = [0.5, 1.2, 0.4], skip_faces = ["-y"] }}
-albedo = [0.7, 0.35, 0.2]
+albedo = [0.6, 0.3, 0.15]
+specular = [0.3, 0.4, 0.5]
+shininess = 40
 "#
         ),
     )
@@ -253,6 +257,7 @@ import mitsuba as mi
 mi.set_variant("scalar_rgb")
 sys.path.insert(0, "mts")
 import thinsheet
+import phong
 scene = mi.load_file("mts/scene.xml", surface="thinsheet")
 for seed in (0, 1):
     mi.util.write_bitmap(f"mitsuba-{seed}.exr", mi.render(scene, seed=seed))

@@ -54,8 +54,15 @@ const MODEL_SAMPLE_MAP: &str = "scenes/env/city.exr";
 /// Reference samples of the sample's report: a small scene, a quick reference (its noise
 /// floor is stated in the report).
 const MODEL_SAMPLE_SPP: u32 = 512;
+/// Glossy materials: the teapot (shininess 60) under every bundled map, and the dragon under
+/// one, with a quick reference.
+const GLOSSY_TEAPOT: &str = "scenes/teapot_glossy.toml";
+const GLOSSY_DRAGON: &str = "scenes/dragon_glossy.toml";
+const GLOSSY_DRAGON_MAP: &str = "scenes/env/sunrise.exr";
+const GLOSSY_DRAGON_SPP: u32 = 512;
 
 pub fn run(args: DemoArgs) -> anyhow::Result<()> {
+    let bundled_scenes = args.scene.is_none();
     let scene = load_scene(&args.scene.unwrap_or_else(|| bundled("scenes/teapot.toml")))?;
     let Some(environment) = &scene.environment else {
         anyhow::bail!("{} names no [environment]", scene.path.display());
@@ -78,6 +85,29 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         backend: args.backend,
     };
     write_report(&scene, &envs, &options, &args.output)?;
+
+    if bundled_scenes {
+        // Glossy materials: shadowed highlights from the lights, prefiltered reflections of
+        // the rest, against the path tracer's Phong lobe.
+        println!("\nthe glossy teapot {GLOSSY_TEAPOT}:");
+        let teapot = load_scene(&bundled(GLOSSY_TEAPOT))?;
+        write_report(&teapot, &envs, &options, &args.output.join("teapot-glossy"))?;
+        println!("\nthe glossy dragon {GLOSSY_DRAGON}:");
+        let dragon = load_scene(&bundled(GLOSSY_DRAGON))?;
+        let dragon_options = ReportOptions {
+            spp: GLOSSY_DRAGON_SPP,
+            target_noise: None,
+            thresholds: vec![0.0, 0.05],
+            frames: 1,
+            ..options.clone()
+        };
+        write_report(
+            &dragon,
+            &[bundled(GLOSSY_DRAGON_MAP)],
+            &dragon_options,
+            &args.output.join("dragon-glossy"),
+        )?;
+    }
 
     // A model as users bring theirs: the textured glTF sample, placed on its own, through
     // bake, hybrid, PRT and the path-traced reference.

@@ -91,6 +91,7 @@ import drjit as dr
 import mitsuba as mi
 mi.set_variant("{variant}")
 import thinsheet
+import phong
 # Timed with Mitsuba's own two-sided BSDF, its fastest; the image to compare shows the
 # front on both sides, as hprt does (CONVENTIONS.md, "Surfaces").
 scene = mi.load_file("scene.xml")

@@ -69,10 +69,19 @@ fn ranks_by_mean(methods: &[MethodResult]) -> Vec<usize> {
 }
 
 fn summary_table(html: &mut String, maps: &[&MapReport]) {
+    // Glossy scenes: the highlight region's column.
+    let glossy = maps
+        .iter()
+        .any(|m| m.methods.iter().any(|x| x.stats.highlight_pixels > 0));
     html.push_str(
         "<table><tr><th>map</th><th>method</th><th>rank</th><th>mean ± std</th><th>shadow mean ± std</th>\
-         <th>penumbra mean ± std</th><th>relative RMSE</th><th>relative RMSE, noise-corrected</th><th>lights</th><th>decomposition (ms)</th><th>frame (ms)</th></tr>",
+         <th>penumbra mean ± std</th><th>relative RMSE</th><th>relative RMSE, noise-corrected</th><th>lights</th><th>decomposition (ms)</th><th>frame (ms)</th>",
     );
+    html.push_str(if glossy {
+        "<th>highlight mean ± std</th></tr>"
+    } else {
+        "</tr>"
+    });
     for map in maps {
         let best = |key: fn(&MethodResult) -> f64| {
             map.methods
@@ -85,6 +94,7 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
         let best_shadow = best(|m| m.stats.shadow_mean);
         let best_penumbra = best(|m| m.stats.penumbra_mean);
         let best_rmse = best(|m| m.stats.relative_rmse);
+        let best_highlight = best(|m| m.stats.highlight_mean);
         let cell = |value: f64, best: f64, text: String| {
             let class = if value == best { " class=\"best\"" } else { "" };
             format!("<td{class}>{text}</td>")
@@ -103,7 +113,7 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
             };
             let _ = write!(
                 html,
-                "<tr>{name}<td class=\"name\">{}</td><td>{}</td>{}{}{}{}<td>{:.4}</td><td>{}</td><td>{:.2}</td><td>{:.1}</td></tr>",
+                "<tr>{name}<td class=\"name\">{}</td><td>{}</td>{}{}{}{}<td>{:.4}</td><td>{}</td><td>{:.2}</td><td>{:.1}</td>{}</tr>",
                 escape(&m.method),
                 ranks[k],
                 cell(s.mean, best_mean, mean_std(s.mean, s.std)),
@@ -126,6 +136,15 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
                 m.lights,
                 m.decomposition_ms,
                 m.frame_ms,
+                if glossy {
+                    cell(
+                        s.highlight_mean,
+                        best_highlight,
+                        mean_std(s.highlight_mean, s.highlight_std),
+                    )
+                } else {
+                    String::new()
+                },
             );
         }
         if !map.methods.is_empty() {
@@ -265,7 +284,9 @@ pub fn page(report: &Report, out: &Path) -> anyhow::Result<String> {
          per map; the shadow region is the covered pixels whose direct visibility of the \
          environment is below {threshold}, the penumbra region those whose visibility lies \
          strictly between {low} and {high} (partly lit: where filter widths and source sizes \
-         show); relative RMSE is of linear luminance, relative to the \
+         show); in glossy scenes the highlight region is the covered pixels where the \
+         reference's specular part (light the first surface's Phong lobe reflects) exceeds the \
+         rest; relative RMSE is of linear luminance, relative to the \
          reference's mean. Bold: the lowest error per map.</p>\
          <p class=\"note\">{w}×{h} pixels · reference {spp} paths per pixel, {bounces} bounces, \
          seed {seed} · bake {bake} · adapter {adapter} · frame time: median of {frames} frames</p>",

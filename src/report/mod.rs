@@ -367,7 +367,7 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
 
     let request = job.settings.reference_request(exposure);
     let best_error = |reference: &ReferenceImages| {
-        let masks = Masks::new(&reference.coverage, &reference.visibility);
+        let masks = reference.masks();
         images
             .iter()
             .map(|image| error_stats(image, &reference.radiance, &masks, exposure).mean)
@@ -396,7 +396,7 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
         noise.mean, noise.shadow_mean
     );
     write_reference(&dir, &reference, exposure)?;
-    let masks = Masks::new(&reference.coverage, &reference.visibility);
+    let masks = reference.masks();
     let methods: Vec<MethodResult> = rendered
         .iter()
         .zip(&images)
@@ -549,7 +549,7 @@ pub fn run_report(
 }
 
 /// The columns of `stats.csv`.
-const CSV_COLUMNS: [&str; 22] = [
+const CSV_COLUMNS: [&str; 25] = [
     "map",
     "status",
     "method",
@@ -572,6 +572,9 @@ const CSV_COLUMNS: [&str; 22] = [
     "noise_floor_shadow_mean",
     "noise_floor_relative_rmse",
     "noise_warning",
+    "highlight_mean",
+    "highlight_std",
+    "highlight_pixels",
 ];
 
 fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
@@ -609,6 +612,9 @@ fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
                 format!("{:.6}", map.noise.shadow_mean),
                 format!("{:.6}", map.noise.relative_rmse),
                 map.noise_warning.to_string(),
+                format!("{:.6}", s.highlight_mean),
+                format!("{:.6}", s.highlight_std),
+                s.highlight_pixels.to_string(),
             ])?;
         }
     }
@@ -634,17 +640,31 @@ pub fn write_report(
     let settings = ReportSettings::new(options, &camera, &transfer);
     let report = run_report(scene, &transfer, &bake_path, envs, &settings, output)?;
     println!();
+    // Glossy scenes add the highlight region's mean error.
+    let glossy = scene.geometry.is_glossy();
     println!(
-        "{:<12} {:<18} {:>8} {:>8} {:>8} {:>8} {:>6}",
-        "map", "method", "mean", "shadow", "penumbra", "rel.rmse", "lights"
+        "{:<12} {:<18} {:>8} {:>8} {:>8} {:>8} {:>6}{}",
+        "map",
+        "method",
+        "mean",
+        "shadow",
+        "penumbra",
+        "rel.rmse",
+        "lights",
+        if glossy { "  highlight" } else { "" }
     );
     for map in &report.maps {
         if map.methods.is_empty() {
             println!("{:<12} failed", map.name);
         }
         for m in &map.methods {
+            let highlight = if glossy {
+                format!(" {:>10.4}", m.stats.highlight_mean)
+            } else {
+                String::new()
+            };
             println!(
-                "{:<12} {:<18} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>6}",
+                "{:<12} {:<18} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>6}{highlight}",
                 map.name,
                 m.method,
                 m.stats.mean,

@@ -68,6 +68,8 @@ pub(crate) struct ReferenceImages {
     pub(crate) halves: [RgbImageF32; 2],
     pub(crate) coverage: Vec<f32>,
     pub(crate) visibility: Vec<f32>,
+    /// Glossy scenes: the part of `radiance` reflected by the first surface's specular lobe.
+    pub(crate) specular: Option<RgbImageF32>,
     pub(crate) samples_per_half: u32,
     /// Nothing had to be rendered.
     pub(crate) cached: bool,
@@ -78,8 +80,17 @@ pub(crate) struct ReferenceImages {
 impl ReferenceImages {
     /// The noise floor of the statistics on this reference.
     pub(crate) fn noise(&self, exposure: f32) -> NoiseFloor {
+        noise_floor(&self.halves[0], &self.halves[1], &self.masks(), exposure)
+    }
+
+    /// The statistics' regions on this reference (the highlight region where it has a
+    /// specular part).
+    pub(crate) fn masks(&self) -> Masks {
         let masks = Masks::new(&self.coverage, &self.visibility);
-        noise_floor(&self.halves[0], &self.halves[1], &masks, exposure)
+        match &self.specular {
+            Some(specular) => masks.with_highlight(&self.radiance, specular),
+            None => masks,
+        }
     }
 }
 
@@ -129,6 +140,7 @@ struct CachePaths {
     halves: [PathBuf; 2],
     coverage: PathBuf,
     visibility: PathBuf,
+    specular: PathBuf,
     meta: PathBuf,
 }
 
@@ -140,11 +152,13 @@ impl CachePaths {
             halves: [file("half0.exr"), file("half1.exr")],
             coverage: file("coverage.exr"),
             visibility: file("visibility.exr"),
+            specular: file("specular.exr"),
             meta: file("json"),
         }
     }
 
-    fn load(&self) -> anyhow::Result<ReferenceImages> {
+    /// `glossy`: the entry must have its specular part.
+    fn load(&self, glossy: bool) -> anyhow::Result<ReferenceImages> {
         let meta: CacheMeta = serde_json::from_slice(&std::fs::read(&self.meta)?)?;
         let halves = [read_exr(&self.halves[0])?, read_exr(&self.halves[1])?];
         Ok(ReferenceImages {
@@ -160,6 +174,11 @@ impl CachePaths {
                 .iter()
                 .map(|p| p.x)
                 .collect(),
+            specular: if glossy {
+                Some(read_exr(&self.specular)?)
+            } else {
+                None
+            },
             samples_per_half: meta.samples_per_half,
             cached: true,
             seconds: 0.0,
@@ -181,6 +200,9 @@ impl CachePaths {
             &self.visibility,
             &RgbImageF32::from_grey(w, h, &images.visibility),
         )?;
+        if let Some(specular) = &images.specular {
+            write_exr(&self.specular, specular)?;
+        }
         let meta = CacheMeta {
             samples_per_half: images.samples_per_half,
         };
@@ -246,6 +268,15 @@ fn render_pass(
         .collect();
     let [a, b]: [ReferenceImage; 2] = passes.try_into().ok().expect("two halves");
     let visibility = weighted(&a.visibility, 1, &b.visibility, 1);
+    let specular = view
+        .scene
+        .geometry
+        .is_glossy()
+        .then(|| weighted_image(&a.specular, 1, &b.specular, 1));
+    let specular = match (specular, current.as_ref().and_then(|c| c.specular.as_ref())) {
+        (Some(new), Some(old)) => Some(weighted_image(old, first, &new, count)),
+        (new, _) => new,
+    };
     let (halves, visibility) = match current {
         None => ([a.radiance, b.radiance], visibility),
         Some(c) => (
@@ -261,6 +292,7 @@ fn render_pass(
         halves,
         coverage: a.coverage,
         visibility,
+        specular,
         samples_per_half: first + count,
         cached: false,
         seconds: 0.0,
@@ -281,7 +313,7 @@ pub(crate) fn reference_images(
     let key = reference_key(scene, camera, map, rotation_deg, request)?;
     let paths = CachePaths::new(&key);
     let mut current = if paths.meta.exists() {
-        match paths.load() {
+        match paths.load(scene.geometry.is_glossy()) {
             Ok(images) => Some(images),
             Err(e) => {
                 log::warn!("the cached reference {key} is unreadable ({e:#}); rendering it again");

@@ -6,7 +6,7 @@
 //! reference), `sequence.json`, `sequence.csv`, the plots as SVG and the GIF.
 
 use super::figures;
-use super::stats::{Masks, error_stats};
+use super::stats::error_stats;
 use super::{ReferenceRequest, ReportSettings, reference_images};
 use crate::bake_cache;
 use crate::cli::ReportOptions;
@@ -237,7 +237,7 @@ pub fn write_sequence_report(
         };
         let reference =
             reference_images(scene, &camera, &map, rotation, &request, &|_| f64::INFINITY)?;
-        let masks = Masks::new(&reference.coverage, &reference.visibility);
+        let masks = reference.masks();
         let reference_y = tonemapped_luminance(&reference.radiance, exposure);
         renderer.set_environment(&map, rotation);
         let mut results = Vec::new();

@@ -1,6 +1,6 @@
 //! Error statistics of a test image against the reference (CONVENTIONS.md, "Error
 //! statistics"): `|Y(tonemap(test)) − Y(tonemap(reference))|` over covered pixels and over the
-//! shadow region and the penumbra region, and the RMSE of linear luminance relative to the reference's mean.
+//! shadow region, the penumbra region and (glossy scenes) the highlight region, and the RMSE of linear luminance relative to the reference's mean.
 
 use precompute::image_io::{RgbImageF32, tonemap};
 use precompute::luminance;
@@ -23,11 +23,18 @@ pub struct ErrorStats {
     /// The same over the penumbra region (NaN when it is empty).
     pub penumbra_mean: f64,
     pub penumbra_std: f64,
+    /// The same over the highlight region (NaN when it is empty, as in diffuse scenes).
+    #[serde(default)]
+    pub highlight_mean: f64,
+    #[serde(default)]
+    pub highlight_std: f64,
     /// RMSE of linear luminance over covered pixels, relative to the reference's mean there.
     pub relative_rmse: f64,
     pub covered_pixels: usize,
     pub shadow_pixels: usize,
     pub penumbra_pixels: usize,
+    #[serde(default)]
+    pub highlight_pixels: usize,
 }
 
 /// The masks the statistics use, from the reference's auxiliary images.
@@ -35,6 +42,9 @@ pub struct Masks {
     pub covered: Vec<bool>,
     pub shadow: Vec<bool>,
     pub penumbra: Vec<bool>,
+    /// Covered pixels where the reference's specular part (reflected by the first surface's
+    /// lobe) exceeds the rest, in luminance; none unless [`Masks::with_highlight`].
+    pub highlight: Vec<bool>,
 }
 
 impl Masks {
@@ -52,10 +62,26 @@ impl Masks {
             .map(|(c, v)| *c && *v > low && *v < high)
             .collect();
         Self {
+            highlight: vec![false; covered.len()],
             covered,
             shadow,
             penumbra,
         }
+    }
+
+    /// Adds the highlight region of a reference `radiance` whose specular part is `specular`.
+    pub fn with_highlight(mut self, radiance: &RgbImageF32, specular: &RgbImageF32) -> Self {
+        self.highlight = self
+            .covered
+            .iter()
+            .zip(&radiance.pixels)
+            .zip(&specular.pixels)
+            .map(|((c, r), s)| {
+                let s = luminance(*s);
+                *c && s > luminance(*r) - s
+            })
+            .collect();
+        self
     }
 }
 
@@ -112,9 +138,11 @@ pub fn error_stats(
     let covered = masked(&masks.covered);
     let shadow = masked(&masks.shadow);
     let penumbra = masked(&masks.penumbra);
+    let highlight = masked(&masks.highlight);
     let (mean, std, covered_pixels) = mean_std(covered.iter().copied());
     let (shadow_mean, shadow_std, shadow_pixels) = mean_std(shadow.iter().copied());
     let (penumbra_mean, penumbra_std, penumbra_pixels) = mean_std(penumbra.iter().copied());
+    let (highlight_mean, highlight_std, highlight_pixels) = mean_std(highlight.iter().copied());
     let (mut squared, mut reference_sum) = (0.0f64, 0.0f64);
     for ((t, r), _) in test
         .pixels
@@ -134,10 +162,13 @@ pub fn error_stats(
         shadow_std,
         penumbra_mean,
         penumbra_std,
+        highlight_mean,
+        highlight_std,
         relative_rmse: (squared / n).sqrt() / (reference_sum / n).max(1e-12),
         covered_pixels,
         shadow_pixels,
         penumbra_pixels,
+        highlight_pixels,
     }
 }
 
@@ -278,5 +309,18 @@ mod tests {
         // The penumbra's bounds are strict.
         let bounds = Masks::new(&[1.0; 2], &[0.05, 0.95]);
         assert_eq!(bounds.penumbra, [false, false]);
+        assert!(lit.highlight_mean.is_nan() && lit.highlight_pixels == 0);
+        // Highlight: covered pixels whose specular part exceeds the rest (pixel 1: 0.6 of
+        // 1; pixel 0: 0.4 of 1; pixel 3 is not covered).
+        let specular = RgbImageF32::new(
+            2,
+            2,
+            vec![Rgb::splat(0.4), Rgb::splat(0.6), Rgb::ZERO, Rgb::splat(0.9)],
+        );
+        let glossy =
+            Masks::new(&[1.0, 1.0, 1.0, 0.0], &[1.0; 4]).with_highlight(&reference, &specular);
+        assert_eq!(glossy.highlight, [false, true, false, false]);
+        let stats = error_stats(&test, &reference, &glossy, exposure);
+        assert!((stats.highlight_mean - e).abs() < 1e-6 && stats.highlight_pixels == 1);
     }
 }

@@ -223,6 +223,7 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         lights_indirect: lights_indirect_default(decompose_mode),
         median_cut_lights: 8,
         exposure: 1.0,
+        materials: scene.geometry.objects.iter().map(|o| o.material).collect(),
     };
     let event_loop = EventLoop::new().map_err(|e| {
         anyhow::anyhow!(
@@ -387,9 +388,33 @@ impl App {
             return Ok(());
         };
         renderer.set_shadow_settings(self.settings.shadow)?;
+        let materials_changed = self
+            .lighting
+            .lit_for
+            .as_ref()
+            .is_none_or(|previous| previous.materials != self.settings.materials);
+        if materials_changed {
+            // Kept within energy conservation: k_s at most 1 − k_d per channel.
+            for (m, o) in self
+                .settings
+                .materials
+                .iter_mut()
+                .zip(&self.scene.geometry.objects)
+            {
+                m.specular = m
+                    .specular
+                    .min(precompute::Rgb::ONE - o.albedo)
+                    .max(precompute::Rgb::ZERO);
+            }
+            renderer.set_materials(&self.settings.materials)?;
+            if renderer.is_glossy() {
+                env.enable_reflections(Some(runtime::render::DEFAULT_REFLECTION_SIZE));
+            }
+        }
         let needs = match &self.lighting.lit_for {
             Some(previous) => {
-                previous.rotation_deg != self.settings.rotation_deg
+                materials_changed
+                    || previous.rotation_deg != self.settings.rotation_deg
                     || previous.decompose_settings() != self.settings.decompose_settings()
                     || previous.mode != self.settings.mode
                     || previous.lights_indirect != self.settings.lights_indirect
@@ -572,6 +597,12 @@ impl App {
             "rotation_deg": self.settings.rotation_deg,
             "window": [camera.width, camera.height],
             "command": self.command_line(Path::new("render.png")),
+            "materials": self
+                .settings
+                .materials
+                .iter()
+                .map(|m| [m.specular.x, m.specular.y, m.specular.z, m.shininess])
+                .collect::<Vec<_>>(),
         })
     }
 
@@ -607,6 +638,13 @@ impl App {
             adapter: &self.stats.adapter,
             message: &self.stats.message,
             command_line,
+            objects: self
+                .scene
+                .geometry
+                .objects
+                .iter()
+                .map(|o| (o.name.as_str(), o.albedo))
+                .collect(),
         }
     }
 

@@ -1,6 +1,8 @@
 //! What the viewer's panel controls, and the `hprt render` command line that reproduces it.
 
+use precompute::Rgb;
 use precompute::camera::Camera;
+use precompute::material::{MAX_SHININESS, Material};
 use runtime::lighting::lights_indirect_default;
 use runtime::render::{RenderMode, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings};
@@ -23,6 +25,27 @@ pub struct ViewSettings {
     /// Lights of the median-cut peer (a power of two).
     pub median_cut_lights: usize,
     pub exposure: f32,
+    /// Per object of the scene, its specular lobe (edited live; the scene file keeps its
+    /// own).
+    pub materials: Vec<Material>,
+}
+
+/// `r,g,b` or one value, each in [0, 1].
+fn parse_specular(name: &str, value: &str) -> anyhow::Result<Rgb> {
+    let values: Vec<f32> = value
+        .split(',')
+        .map(|v| crate::cli::parse_finite(v.trim()).map_err(|m| anyhow::anyhow!("{name}: {m}")))
+        .collect::<anyhow::Result<_>>()?;
+    let rgb = match values[..] {
+        [v] => Rgb::splat(v),
+        [r, g, b] => Rgb::new(r, g, b),
+        _ => anyhow::bail!("{name}: expected r,g,b or one value, got {value:?}"),
+    };
+    anyhow::ensure!(
+        rgb.min_element() >= 0.0 && rgb.max_element() <= 1.0,
+        "{name}: specular {value} outside [0, 1]"
+    );
+    Ok(rgb)
 }
 
 impl ViewSettings {
@@ -68,7 +91,32 @@ impl ViewSettings {
             }
             "exposure" => self.exposure = number()?,
             "env" => self.env = PathBuf::from(value),
-            _ => anyhow::bail!("unknown setting {name:?}"),
+            _ => {
+                // `specular:N r,g,b` (or one value for all three) and `shininess:N s`, for
+                // object N (from 0).
+                let Some((what, index)) = name.split_once(':') else {
+                    anyhow::bail!("unknown setting {name:?}")
+                };
+                let index: usize = index
+                    .parse()
+                    .map_err(|_| anyhow::anyhow!("{name}: expected an object index after ':'"))?;
+                let count = self.materials.len();
+                let material = self.materials.get_mut(index).ok_or_else(|| {
+                    anyhow::anyhow!("{name}: no object {index} (the scene has {count})")
+                })?;
+                match what {
+                    "specular" => material.specular = parse_specular(name, value)?,
+                    "shininess" => {
+                        let s = number()?;
+                        anyhow::ensure!(
+                            s > 0.0 && s <= MAX_SHININESS,
+                            "{name}: shininess {s} outside (0, {MAX_SHININESS}]"
+                        );
+                        material.shininess = s;
+                    }
+                    _ => anyhow::bail!("unknown setting {name:?}"),
+                }
+            }
         }
         Ok(())
     }
@@ -157,6 +205,28 @@ mod tests {
             lights_indirect: true,
             median_cut_lights: 8,
             exposure: 0.6,
+            materials: vec![Material::DIFFUSE; 2],
+        }
+    }
+
+    #[test]
+    fn materials_are_set_per_object() {
+        let mut s = settings();
+        s.set("specular:1", "0.1,0.2,0.3").unwrap();
+        s.set("shininess:1", "60").unwrap();
+        s.set("specular:0", "0.25").unwrap();
+        assert_eq!(s.materials[1].specular, Rgb::new(0.1, 0.2, 0.3));
+        assert_eq!(s.materials[1].shininess, 60.0);
+        assert_eq!(s.materials[0].specular, Rgb::splat(0.25));
+        for (name, value) in [
+            ("specular:2", "0.1"),
+            ("specular:x", "0.1"),
+            ("specular:0", "1.5"),
+            ("specular:0", "0.1,0.2"),
+            ("shininess:0", "0"),
+            ("gloss:0", "1"),
+        ] {
+            assert!(s.set(name, value).is_err(), "{name} {value}");
         }
     }
 

@@ -42,6 +42,8 @@ pub struct PanelInfo<'a> {
     pub message: &'a str,
     /// The `hprt render` command line of the current view.
     pub command_line: String,
+    /// Each object's name and diffuse albedo (the bound on its specular).
+    pub objects: Vec<(&'a str, precompute::Rgb)>,
 }
 
 /// What the user asked for in the panel.
@@ -65,6 +67,8 @@ pub struct PanelState {
     pub headings: Vec<String>,
     /// Width of the panel in pixels (the scene fills the rest of the window).
     pub width_px: u32,
+    /// The object whose material the panel edits.
+    material_object: usize,
 }
 
 impl PanelState {
@@ -104,6 +108,7 @@ pub fn panel(
                 panel.environment_section(ui);
                 panel.decomposition_section(ui);
                 panel.shadow_section(ui);
+                panel.material_section(ui);
                 panel.display_section(ui);
                 panel.lights_section(ui);
                 panel.save_section(ui);
@@ -293,6 +298,48 @@ impl Panel<'_> {
             &mut shadow.from_angular_radius,
             "penumbra from the light's size",
         );
+    }
+
+    /// Per object: its specular reflectance (each channel at most 1 − its albedo) and
+    /// shininess, applied live (the scene file is not changed).
+    fn material_section(&mut self, ui: &mut egui::Ui) {
+        self.heading(ui, "Material");
+        let objects = &self.info.objects;
+        if objects.is_empty() || self.settings.materials.len() != objects.len() {
+            return;
+        }
+        let index = self.state.material_object.min(objects.len() - 1);
+        egui::ComboBox::from_label("object")
+            .selected_text(objects[index].0)
+            .show_ui(ui, |ui| {
+                for (i, (name, _)) in objects.iter().enumerate() {
+                    ui.selectable_value(&mut self.state.material_object, i, *name);
+                }
+            });
+        let albedo = objects[index].1;
+        let material = &mut self.settings.materials[index];
+        for (c, label) in ["specular R", "specular G", "specular B"]
+            .iter()
+            .enumerate()
+        {
+            let bound = (1.0 - albedo[c]).max(0.0);
+            ui.add(egui::Slider::new(&mut material.specular[c], 0.0..=bound).text(*label));
+        }
+        if material.shininess <= 0.0 {
+            material.shininess = 60.0;
+        }
+        ui.add(
+            egui::Slider::new(
+                &mut material.shininess,
+                1.0..=precompute::material::MAX_SHININESS,
+            )
+            .logarithmic(true)
+            .text("shininess"),
+        );
+        ui.label(format!(
+            "albedo {:.2} {:.2} {:.2} (k_d)",
+            albedo.x, albedo.y, albedo.z
+        ));
     }
 
     fn display_section(&mut self, ui: &mut egui::Ui) {

@@ -182,6 +182,24 @@ fn direct_transfer_under_an_opening_is_its_form_factor() {
         if bounces == 0 {
             assert!(transfer.indirect.as_slice().iter().all(|x| *x == 0.0));
         }
+        // The bent normal of the floor's centre is straight up; near a wall it leans away
+        // from it.
+        let bent = transfer
+            .direct
+            .bent_normals(&geometry.albedo, &geometry.mesh.normals);
+        for &v in &centre {
+            assert!(bent[v].dot(Vec3::Y) > 0.999, "{}", bent[v]);
+        }
+        let near_wall: Vec<usize> = (0..geometry.mesh.vertex_count())
+            .filter(|&v| {
+                let p = geometry.mesh.positions[v];
+                p.y.abs() < 1e-6 && (p.x - 0.75).abs() < 1e-6 && p.z.abs() < 1e-6
+            })
+            .collect();
+        assert!(!near_wall.is_empty());
+        for &v in &near_wall {
+            assert!(bent[v].x < -0.1 && bent[v].y > 0.7, "{}", bent[v]);
+        }
         // The specular occlusion read back from it is the form factor itself.
         let fraction = transfer.direct.unoccluded_fraction(&geometry.albedo);
         let mean =

@@ -95,6 +95,32 @@ impl TransferVectors {
             .collect()
     }
 
+    /// Per vertex, its bent normal: the mean unoccluded direction (cosine-weighted), read
+    /// from a *direct* transfer's band-1 coefficients (the SH of `V(ω) max(0, n·ω)` are
+    /// proportional to them; coefficients 1, 2, 3 go with x, y, z: CONVENTIONS.md), on the
+    /// channel with the largest albedo. Where nothing is read (black, or fully occluded), the
+    /// vertex normal.
+    pub fn bent_normals(&self, albedo: &[Rgb], normals: &[glam::Vec3]) -> Vec<glam::Vec3> {
+        albedo
+            .iter()
+            .zip(normals)
+            .enumerate()
+            .take(self.vertex_count())
+            .map(|(v, (rho, n))| {
+                let c = (0..3)
+                    .max_by(|a, b| rho[*a].total_cmp(&rho[*b]))
+                    .unwrap_or(0);
+                if self.order < 2 || rho[c] <= 1e-4 {
+                    return *n;
+                }
+                let t = self.vector(v, c);
+                glam::Vec3::new(t[1], t[2], t[3])
+                    .try_normalize()
+                    .unwrap_or(*n)
+            })
+            .collect()
+    }
+
     /// Element-wise sum (direct + indirect = full transfer).
     /// Each vertex's vectors times its albedo, channel by channel.
     pub fn scaled_per_vertex(&self, albedo: &[Rgb]) -> TransferVectors {

@@ -19,12 +19,6 @@ use std::path::{Path, PathBuf};
 pub enum ExportError {
     #[error("{}: {message}", path.display())]
     Write { path: PathBuf, message: String },
-    /// A material Mitsuba has no counterpart for in the export yet.
-    #[error(
-        "object {object}: glossy (Phong) materials are not exported to Mitsuba yet; export the \
-         scene without specular/shininess to cross-check its diffuse part"
-    )]
-    Glossy { object: String },
 }
 
 /// What the exported scene renders.
@@ -150,7 +144,8 @@ pub fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
     <!-- How the backs of triangles look. twosided: as surfaces of their own, facing the
          other way. hprt shows the front's radiance on both sides (CONVENTIONS.md,
          "Surfaces"); for exactly that, import thinsheet.py from this folder and load with
-         surface="thinsheet". -->
+         surface="thinsheet". Glossy objects use hprt's Phong material: import phong.py
+         from this folder before loading. -->
     <default name="surface" value="twosided"/>
     <integrator type="path">
         <!-- hprt bounces = {bounces} -->
@@ -209,15 +204,30 @@ pub fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
                 a.x, a.y, a.z
             ),
         };
+        let m = &o.material;
+        let inner = if m.is_glossy() {
+            format!(
+                r#"<bsdf type="hprtphong">
+                {reflectance}
+                <rgb name="specular" value="{}, {}, {}"/>
+                <float name="exponent" value="{}"/>
+            </bsdf>"#,
+                m.specular.x, m.specular.y, m.specular.z, m.shininess
+            )
+        } else {
+            format!(
+                r#"<bsdf type="diffuse">
+                {reflectance}
+            </bsdf>"#
+            )
+        };
         let _ = write!(
             xml,
             r#"    <shape type="ply" id="{id}">
         <string name="filename" value="meshes/{file}"/>
         <boolean name="face_normals" value="false"/>
         <bsdf type="$surface">
-            <bsdf type="diffuse">
-                {reflectance}
-            </bsdf>
+            {inner}
         </bsdf>
     </shape>
 "#,
@@ -240,7 +250,11 @@ fn xml_escape(s: &str) -> String {
 /// as `thinsheet` when imported.
 pub const THIN_SHEET_PLUGIN: &str = include_str!("thinsheet.py");
 
-/// Writes `dir/scene.xml`, `dir/thinsheet.py`, `dir/envmap.exr`, `dir/meshes/*.ply` and, for
+/// The Mitsuba 3 plugin of hprt's glossy material (Lambert plus a normalised Phong lobe,
+/// CONVENTIONS.md, "Glossy materials"), registered as `hprtphong` when imported.
+pub const PHONG_PLUGIN: &str = include_str!("phong.py");
+
+/// Writes `dir/scene.xml`, `dir/thinsheet.py`, `dir/phong.py`, `dir/envmap.exr`, `dir/meshes/*.ply` and, for
 /// textured objects, `dir/textures/*.exr`.
 pub fn export_mitsuba(
     dir: &Path,
@@ -252,12 +266,6 @@ pub fn export_mitsuba(
         path: path.to_owned(),
         message,
     };
-    // Refused before anything is written: a diffuse stand-in would not be the same scene.
-    if let Some(o) = geometry.objects.iter().find(|o| o.material.is_glossy()) {
-        return Err(ExportError::Glossy {
-            object: o.name.clone(),
-        });
-    }
     let meshes = dir.join("meshes");
     std::fs::create_dir_all(&meshes).map_err(|e| error(&meshes, e.to_string()))?;
     for i in 0..geometry.objects.len() {
@@ -278,9 +286,14 @@ pub fn export_mitsuba(
     let env_path = dir.join("envmap.exr");
     let image = RgbImageF32::new(map.width(), map.height(), map.texels().to_vec());
     write_exr(&env_path, &image).map_err(|e| error(&env_path, e.to_string()))?;
-    let plugin_path = dir.join("thinsheet.py");
-    write_atomic(&plugin_path, THIN_SHEET_PLUGIN.as_bytes())
-        .map_err(|e| error(&plugin_path, e.to_string()))?;
+    for (name, plugin) in [
+        ("thinsheet.py", THIN_SHEET_PLUGIN),
+        ("phong.py", PHONG_PLUGIN),
+    ] {
+        let plugin_path = dir.join(name);
+        write_atomic(&plugin_path, plugin.as_bytes())
+            .map_err(|e| error(&plugin_path, e.to_string()))?;
+    }
     let xml_path = dir.join("scene.xml");
     write_atomic(&xml_path, scene_xml(geometry, settings).as_bytes())
         .map_err(|e| error(&xml_path, e.to_string()))?;

@@ -204,8 +204,16 @@ impl GpuScene {
                 },
             ],
         });
-        let occlusion = transfer.direct.unoccluded_fraction(&geometry.albedo);
-        let materials = GpuMaterials::new(device, geometry, occlusion)?;
+        let unoccluded = transfer.direct.unoccluded_fraction(&geometry.albedo);
+        let bent = transfer
+            .direct
+            .bent_normals(&geometry.albedo, &mesh.normals);
+        let visibility = bent
+            .iter()
+            .zip(&unoccluded)
+            .map(|(b, v)| b.extend(*v).to_array())
+            .collect();
+        let materials = GpuMaterials::new(device, geometry, visibility)?;
         materials.write(queue);
         let texture_layout = texture_layout(device);
         let white = Arc::new(AlbedoTexture {

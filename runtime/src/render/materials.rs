@@ -19,18 +19,18 @@ struct MaterialUniform {
     slot: [u32; 4],
 }
 
-/// Per vertex: its material's index and its specular occlusion.
+/// Per vertex: its material's index and its visibility cone.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct MaterialVertex {
     index: u32,
-    occlusion: f32,
+    visibility: [f32; 4],
 }
 
 pub const MATERIAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: std::mem::size_of::<MaterialVertex>() as u64,
     step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &wgpu::vertex_attr_array![5 => Uint32, 6 => Float32],
+    attributes: &wgpu::vertex_attr_array![5 => Uint32, 6 => Float32x4],
 };
 
 /// The distinct glossy materials of a set of objects, and each object's index (0: diffuse).
@@ -105,17 +105,18 @@ pub struct GpuMaterials {
     pub uniform: wgpu::Buffer,
     pub vertex_buffer: wgpu::Buffer,
     pub table: MaterialTable,
-    /// Per vertex: its object and occlusion (to rewrite indices when materials change).
+    /// Per vertex: its object and visibility (to rewrite indices when materials change).
     vertex_objects: Vec<u32>,
-    occlusion: Vec<f32>,
+    visibility: Vec<[f32; 4]>,
 }
 
 impl GpuMaterials {
-    /// `occlusion`: per vertex, the specular occlusion (the bake's unoccluded fraction).
+    /// `visibility`: per vertex, its bent normal (xyz) and unoccluded fraction (w) from the
+    /// bake: the cone of directions it sees the sky in (`shaders/geometry.wgsl`).
     pub fn new(
         device: &wgpu::Device,
         geometry: &SceneMesh,
-        occlusion: Vec<f32>,
+        visibility: Vec<[f32; 4]>,
     ) -> Result<Self, RenderError> {
         let materials: Vec<Material> = geometry.objects.iter().map(|o| o.material).collect();
         let table = MaterialTable::new(&materials)?;
@@ -131,7 +132,7 @@ impl GpuMaterials {
         );
         let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("vertex materials"),
-            contents: bytemuck::cast_slice(&vertices(&table, &vertex_objects, &occlusion)),
+            contents: bytemuck::cast_slice(&vertices(&table, &vertex_objects, &visibility)),
             usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
         });
         Ok(Self {
@@ -139,7 +140,7 @@ impl GpuMaterials {
             vertex_buffer,
             table,
             vertex_objects,
-            occlusion,
+            visibility,
         })
     }
 
@@ -162,7 +163,7 @@ impl GpuMaterials {
         let table = MaterialTable::new(materials)?;
         let slots_changed = table.shininess != self.table.shininess;
         if table.object_entries != self.table.object_entries {
-            let data = vertices(&table, &self.vertex_objects, &self.occlusion);
+            let data = vertices(&table, &self.vertex_objects, &self.visibility);
             queue.write_buffer(&self.vertex_buffer, 0, bytemuck::cast_slice(&data));
         }
         self.table = table;
@@ -171,13 +172,17 @@ impl GpuMaterials {
     }
 }
 
-fn vertices(table: &MaterialTable, objects: &[u32], occlusion: &[f32]) -> Vec<MaterialVertex> {
+fn vertices(
+    table: &MaterialTable,
+    objects: &[u32],
+    visibility: &[[f32; 4]],
+) -> Vec<MaterialVertex> {
     objects
         .iter()
-        .zip(occlusion)
-        .map(|(o, occlusion)| MaterialVertex {
+        .zip(visibility)
+        .map(|(o, visibility)| MaterialVertex {
             index: table.object_entries.get(*o as usize).copied().unwrap_or(0),
-            occlusion: *occlusion,
+            visibility: *visibility,
         })
         .collect()
 }

@@ -309,19 +309,7 @@ impl Renderer {
         let lights = &lighting.lights;
         let shadows = lighting.shadows && !lights.is_empty();
         let mut encoder = self.device.create_command_encoder(&Default::default());
-        if self.frame.reflections_dirty && self.is_glossy() {
-            let recreated = self.reflections.update(
-                &self.device,
-                &self.queue,
-                &mut encoder,
-                &lighting.reflections,
-                &self.scene.materials.table.shininess,
-            );
-            if recreated {
-                self.prt_pass.inputs_changed();
-            }
-            self.frame.reflections_dirty = false;
-        }
+        self.record_reflections(&mut encoder, &lighting);
         if self.frame.radiance_dirty {
             self.scene
                 .update_radiance(&self.queue, &mut encoder, &lighting);
@@ -382,6 +370,38 @@ impl Renderer {
             .record(&self.device, &mut encoder, &inputs, shadows);
         self.queue.submit([encoder.finish()]);
         Ok(())
+    }
+
+    /// Prefilters the reflection maps now, if the lighting or the materials changed them
+    /// (a frame does it otherwise); with [`Self::wait`], what a lighting change costs.
+    pub fn update_reflections(&mut self) -> Result<(), RenderError> {
+        let Some(lighting) = self.frame.lighting.clone() else {
+            return Ok(());
+        };
+        let device = self.device.clone();
+        checked(&device, || {
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            self.record_reflections(&mut encoder, &lighting);
+            self.queue.submit([encoder.finish()]);
+            Ok(())
+        })
+    }
+
+    fn record_reflections(&mut self, encoder: &mut wgpu::CommandEncoder, lighting: &FrameLighting) {
+        if !(self.frame.reflections_dirty && self.is_glossy()) {
+            return;
+        }
+        let recreated = self.reflections.update(
+            &self.device,
+            &self.queue,
+            encoder,
+            &lighting.reflections,
+            &self.scene.materials.table.shininess,
+        );
+        if recreated {
+            self.prt_pass.inputs_changed();
+        }
+        self.frame.reflections_dirty = false;
     }
 
     /// Waits for the last frame and copies it to the CPU as linear radiance.
