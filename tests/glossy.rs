@@ -8,7 +8,6 @@ use precompute::bake::{BakeSettings, Transfer};
 use precompute::bvh::SceneBvh;
 use precompute::camera::Camera;
 use precompute::envmap::EnvMap;
-use precompute::image_io::{RgbImageF32, tonemap};
 use precompute::material::{Material, mirror, phong_zonal};
 use precompute::mesh::{box_mesh, sphere_mesh};
 use precompute::progress::NoProgress;
@@ -17,14 +16,9 @@ use precompute::scene::SceneMesh;
 use precompute::sh::ShCoeffs;
 use precompute::{Rgb, luminance};
 use runtime::reflection::{ReflectedEnvironment, SharedCube, convolve_exact};
-use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
+use runtime::render::{FrameLighting, RenderMode};
 use runtime::{CubeGeometry, CubeMap, DecomposeSettings, EnvironmentLighting};
 use std::sync::Arc;
-
-fn gpu() -> GpuContext {
-    GpuContext::headless(Backend::Auto)
-        .expect("a (software) GPU adapter; run tests/run.sh to install one")
-}
 
 fn bake_of(geometry: &SceneMesh, samples: u32, bounces: u32) -> Transfer {
     let bvh = SceneBvh::build(&geometry.mesh);
@@ -53,21 +47,6 @@ fn camera(position: Vec3, target: Vec3, size: u32) -> Camera {
         width: size,
         height: size,
     }
-}
-
-fn render(
-    gpu: &GpuContext,
-    geometry: &SceneMesh,
-    transfer: &Transfer,
-    camera: &Camera,
-    lighting: &FrameLighting,
-) -> RgbImageF32 {
-    let mut renderer =
-        Renderer::new(gpu, geometry, transfer, camera, ShadowSettings::default()).unwrap();
-    renderer.background = false;
-    renderer.set_lighting(lighting).unwrap();
-    renderer.render().unwrap();
-    renderer.read_back().unwrap()
 }
 
 /// Pixels whose centre ray meets the unit sphere at the origin with `n·v > min_cos`, with the
@@ -221,20 +200,6 @@ fn glossy_white_furnace_on_the_gpu() {
     }
 }
 
-fn tone_mapped_error(a: &RgbImageF32, b: &RgbImageF32, mask: &[bool], exposure: f32) -> f32 {
-    let (sum, n) = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .zip(mask)
-        .filter(|(_, m)| **m)
-        .fold((0.0f32, 0usize), |(s, n), ((x, y), _)| {
-            let error = luminance(tonemap(*x, exposure)) - luminance(tonemap(*y, exposure));
-            (s + error.abs(), n + 1)
-        });
-    sum / n.max(1) as f32
-}
-
 /// A glossy sphere on a diffuse floor under a sunny sky: the hybrid's shadowed, widened light
 /// lobe plus the prefiltered remainder follows the path tracer in the highlight (pixels where
 /// the reference's specular part exceeds its diffuse part), where plain PRT's order-5 SH cannot
@@ -302,18 +267,6 @@ fn glossy_highlights_follow_the_reference() {
     for mode in [RenderMode::Hybrid, RenderMode::Prt] {
         let frame = lighting.frame(mode, None);
         let image = render(&gpu, &geometry, &transfer, &cam, &frame.lighting);
-        if let Ok(dir) = std::env::var("HPRT_GLOSSY_DUMP") {
-            let dir = std::path::Path::new(&dir);
-            precompute::image_io::write_png(&dir.join(format!("{mode:?}.png")), &image, exposure)
-                .unwrap();
-            precompute::image_io::write_png(&dir.join("reference.png"), &truth.radiance, exposure)
-                .unwrap();
-            precompute::image_io::write_png(&dir.join("specular.png"), &truth.specular, exposure)
-                .unwrap();
-            precompute::image_io::write_exr(&dir.join(format!("{mode:?}.exr")), &image).unwrap();
-            precompute::image_io::write_exr(&dir.join("reference.exr"), &truth.radiance).unwrap();
-            precompute::image_io::write_exr(&dir.join("specular.exr"), &truth.specular).unwrap();
-        }
         errors.push((
             tone_mapped_error(&image, &truth.radiance, &covered, exposure),
             tone_mapped_error(&image, &truth.radiance, &highlight, exposure),

@@ -8,7 +8,7 @@ use precompute::bake::{BakeSettings, Transfer};
 use precompute::bvh::{Hit, SceneBvh, Skip};
 use precompute::camera::Camera;
 use precompute::envmap::EnvMap;
-use precompute::image_io::{RgbImageF32, tonemap};
+use precompute::image_io::RgbImageF32;
 use precompute::mesh::{box_mesh, sphere_mesh};
 use precompute::progress::NoProgress;
 use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
@@ -18,11 +18,6 @@ use precompute::{Rgb, luminance};
 use runtime::lighting::ShTransfer;
 use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
 use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer, DirectionalLight};
-
-fn gpu() -> GpuContext {
-    GpuContext::headless(Backend::Auto)
-        .expect("a (software) GPU adapter; run tests/run.sh to install one")
-}
 
 fn bake_of(geometry: &SceneMesh, order: usize, samples: u32, bounces: u32) -> Transfer {
     let bvh = SceneBvh::build(&geometry.mesh);
@@ -61,21 +56,6 @@ fn camera(position: Vec3, target: Vec3, width: u32, height: u32) -> Camera {
         width,
         height,
     }
-}
-
-fn render(
-    gpu: &GpuContext,
-    geometry: &SceneMesh,
-    transfer: &Transfer,
-    camera: &Camera,
-    lighting: &FrameLighting,
-) -> RgbImageF32 {
-    let mut renderer =
-        Renderer::new(gpu, geometry, transfer, camera, ShadowSettings::default()).unwrap();
-    renderer.background = false;
-    renderer.set_lighting(lighting).unwrap();
-    renderer.render().unwrap();
-    renderer.read_back().unwrap()
 }
 
 fn uniform_sh(order: usize, value: f32) -> ShCoeffs<Rgb> {
@@ -752,22 +732,6 @@ fn a_source_with_a_halo_casts_its_wide_penumbra() {
 }
 
 /// Mean |Y(tonemap(a)) - Y(tonemap(b))| over the masked pixels.
-fn tone_mapped_error(a: &RgbImageF32, b: &RgbImageF32, mask: &[bool], exposure: f32) -> f32 {
-    let (sum, n) = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .zip(mask)
-        .filter(|(_, m)| **m)
-        .fold((0.0f32, 0usize), |(s, n), ((x, y), _)| {
-            (
-                s + (luminance(tonemap(*x, exposure)) - luminance(tonemap(*y, exposure))).abs(),
-                n + 1,
-            )
-        });
-    sum / n.max(1) as f32
-}
-
 #[test]
 fn hybrid_beats_prt_in_the_shadows_against_the_reference() {
     let teapot = Scene::load(&scene("teapot.toml")).unwrap();

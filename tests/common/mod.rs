@@ -91,3 +91,53 @@ pub fn bake_teapot(dir: &Path, name: &str, settings: &[&str]) -> PathBuf {
     assert!(out.status.success(), "the bake failed: {}", stderr(&out));
     output
 }
+
+/// The (software) GPU adapter the renderer tests draw with.
+pub fn gpu() -> runtime::render::GpuContext {
+    runtime::render::GpuContext::headless(runtime::render::Backend::Auto)
+        .expect("a (software) GPU adapter; run tests/run.sh to install one")
+}
+
+/// One frame of `geometry` under `lighting`, without the background.
+pub fn render(
+    gpu: &runtime::render::GpuContext,
+    geometry: &precompute::scene::SceneMesh,
+    transfer: &precompute::bake::Transfer,
+    camera: &precompute::camera::Camera,
+    lighting: &runtime::render::FrameLighting,
+) -> precompute::image_io::RgbImageF32 {
+    let mut renderer = runtime::render::Renderer::new(
+        gpu,
+        geometry,
+        transfer,
+        camera,
+        runtime::render::ShadowSettings::default(),
+    )
+    .unwrap();
+    renderer.background = false;
+    renderer.set_lighting(lighting).unwrap();
+    renderer.render().unwrap();
+    renderer.read_back().unwrap()
+}
+
+/// Mean `|Y(tonemap(a)) − Y(tonemap(b))|` over `mask` (the reports' mean error).
+pub fn tone_mapped_error(
+    a: &precompute::image_io::RgbImageF32,
+    b: &precompute::image_io::RgbImageF32,
+    mask: &[bool],
+    exposure: f32,
+) -> f32 {
+    use precompute::image_io::tonemap;
+    use precompute::luminance;
+    let (sum, n) = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .zip(mask)
+        .filter(|(_, m)| **m)
+        .fold((0.0f32, 0usize), |(s, n), ((x, y), _)| {
+            let error = luminance(tonemap(*x, exposure)) - luminance(tonemap(*y, exposure));
+            (s + error.abs(), n + 1)
+        });
+    sum / n.max(1) as f32
+}

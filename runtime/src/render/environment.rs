@@ -71,6 +71,17 @@ impl EnvironmentTexture {
     }
 }
 
+/// `texels` as Rgba16Float data (alpha 1), each channel clamped to `[0, HALF_MAX]`.
+pub fn rgba16f_texels(texels: &[Rgb]) -> Vec<half::f16> {
+    texels
+        .iter()
+        .flat_map(|c| {
+            let c = c.clamp(Rgb::ZERO, Rgb::splat(HALF_MAX));
+            [c.x, c.y, c.z, 1.0].map(half::f16::from_f32)
+        })
+        .collect()
+}
+
 /// A mipmapped Rgba16Float texture (filterable on every backend) holding `levels`, full
 /// resolution first; values beyond the largest half float are clamped to it.
 pub fn upload_mip_chain(
@@ -95,13 +106,7 @@ pub fn upload_mip_chain(
         view_formats: &[],
     });
     for (level, (texels, w, h)) in levels.iter().enumerate() {
-        let data: Vec<half::f16> = texels
-            .iter()
-            .flat_map(|c| {
-                let c = c.clamp(Rgb::ZERO, Rgb::splat(HALF_MAX));
-                [c.x, c.y, c.z, 1.0].map(half::f16::from_f32)
-            })
-            .collect();
+        let data = rgba16f_texels(texels);
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &texture,

@@ -6,7 +6,7 @@
 //! lobe on the remainder's mip chain); an SH environment is convolved exactly on the CPU by
 //! its zonal factors and uploaded.
 
-use super::environment::mip_chain_of;
+use super::environment::{mip_chain_of, rgba16f_texels};
 use super::pass_helpers::{FullscreenPass, begin_pass, color_attachment};
 use super::shaders::Shader;
 use crate::cubemap::{CubeGeometry, CubeMap};
@@ -15,8 +15,6 @@ use bytemuck::{Pod, Zeroable};
 use precompute::Rgb;
 
 pub const REFLECTION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// Largest finite half float (the remainder has no sun left in it).
-const HALF_MAX: f32 = 65504.0;
 /// Uniform offsets must be multiples of the adapter's alignment, at most 256 bytes.
 const JOB_STRIDE: u64 = 256;
 /// Most shininess slots (the jobs buffer is sized for them).
@@ -307,13 +305,7 @@ fn write_layers(
 ) {
     for (i, texels) in layers.iter().enumerate() {
         let side = (texels.len() as f64).sqrt() as u32;
-        let data: Vec<half::f16> = texels
-            .iter()
-            .flat_map(|c| {
-                let c = c.clamp(Rgb::ZERO, Rgb::splat(HALF_MAX));
-                [c.x, c.y, c.z, 1.0].map(half::f16::from_f32)
-            })
-            .collect();
+        let data = rgba16f_texels(texels);
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture,
