@@ -310,3 +310,70 @@ fn glossy_highlights_follow_the_reference() {
         got[1]
     );
 }
+
+/// The targets on the glossy teapot (shininess 60) under every bundled map, at the
+/// demo's settings: `hybrid/consistent` below `prt` in mean error, and below half of it in
+/// the highlight region. Minutes of references on two cores (cached afterwards): run with
+/// `cargo test --release --test glossy -- --ignored`.
+#[test]
+#[ignore]
+fn glossy_teapot_meets_the_targets_on_every_bundled_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = hprt(
+        dir.path(),
+        &[
+            "report",
+            scene("teapot_glossy.toml").to_str().unwrap(),
+            "--width",
+            "200",
+            "--height",
+            "150",
+            "--spp",
+            "1024",
+            "--target-noise",
+            "20%",
+            "--frames",
+            "1",
+            "--thresholds",
+            "0.05",
+            "-o",
+            "report",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let stats: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("report/stats.json")).unwrap())
+            .unwrap();
+    let mut checked = 0;
+    for map in stats["maps"].as_array().unwrap() {
+        if map["status"] != "ok" {
+            continue;
+        }
+        let method = |name: &str| {
+            map["methods"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|m| m["method"] == name)
+                .unwrap()
+                .clone()
+        };
+        let (hybrid, prt) = (method("hybrid/consistent"), method("prt"));
+        let value = |m: &serde_json::Value, key: &str| m[key].as_f64().unwrap();
+        let name = map["name"].as_str().unwrap();
+        println!(
+            "{name}: mean {:.4} vs {:.4}, highlight {:.4} vs {:.4}",
+            value(&hybrid, "mean"),
+            value(&prt, "mean"),
+            value(&hybrid, "highlight_mean"),
+            value(&prt, "highlight_mean")
+        );
+        assert!(value(&hybrid, "mean") < value(&prt, "mean"), "{name}: mean");
+        assert!(
+            value(&hybrid, "highlight_mean") < 0.5 * value(&prt, "highlight_mean"),
+            "{name}: highlight region"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 6, "{checked} maps checked");
+}

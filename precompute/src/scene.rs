@@ -212,7 +212,8 @@ pub struct SceneMesh {
 }
 
 impl SceneMesh {
-    /// BLAKE3 hash of everything a bake depends on: positions, normals, triangles, albedos.
+    /// BLAKE3 hash of everything a bake depends on: positions, normals, triangles, albedos,
+    /// textures and glossy materials.
     pub fn content_hash(&self) -> [u8; 32] {
         let mut hasher = blake3::Hasher::new();
         hasher.update(b"hprt scene mesh v1");
@@ -254,6 +255,11 @@ impl SceneMesh {
                     }
                 }
             }
+        }
+        // Glossy objects reflect their specular energy in the interreflection; diffuse scenes
+        // keep their hashes.
+        if let Some(materials) = self.material_hash() {
+            hasher.update(&materials);
         }
         *hasher.finalize().as_bytes()
     }
@@ -320,8 +326,8 @@ impl SceneMesh {
         out
     }
 
-    /// BLAKE3 hash of the objects' materials where any is glossy (what a reference depends on
-    /// beyond [`Self::content_hash`]); `None` for a diffuse scene.
+    /// BLAKE3 hash of the objects' materials where any is glossy (part of
+    /// [`Self::content_hash`]); `None` for a diffuse scene.
     pub fn material_hash(&self) -> Option<[u8; 32]> {
         if !self.is_glossy() {
             return None;
@@ -356,7 +362,9 @@ impl SceneMesh {
 
     /// Per vertex, the albedo it reflects toward other surfaces in the bake's interreflection:
     /// its object's albedo, or for a textured object the factor times the texture averaged
-    /// around the vertex ([`crate::texture::vertex_average`]).
+    /// around the vertex ([`crate::texture::vertex_average`]); a glossy object adds its
+    /// specular reflectance, reflected as if diffusely (its lobe's energy reaches the other
+    /// surfaces; its direction does not: CONVENTIONS.md, "Glossy materials").
     pub fn reflected_albedo(&self) -> Vec<Rgb> {
         let mut albedo = self.albedo.clone();
         for o in &self.objects {
@@ -371,6 +379,11 @@ impl SceneMesh {
                 crate::texture::vertex_average(&self.textures[t], &self.mesh.uvs[v0..v1], &local);
             for (a, avg) in albedo[v0..v1].iter_mut().zip(averages) {
                 *a *= avg;
+            }
+        }
+        for o in self.objects.iter().filter(|o| o.material.is_glossy()) {
+            for a in &mut albedo[o.vertices.start as usize..o.vertices.end as usize] {
+                *a += o.material.specular;
             }
         }
         albedo
@@ -804,6 +817,25 @@ mod tests {
             }
         );
         assert!(good.geometry.is_glossy() && good.geometry.material_hash().is_some());
+        // The interreflection carries the lobe's energy: albedo + specular.
+        assert!(
+            good.geometry
+                .reflected_albedo()
+                .iter()
+                .all(|a| (*a - Rgb::new(1.0, 1.0, 1.0)).abs().max_element() < 1e-6)
+        );
+        // The bake depends on the material, so the content hash does.
+        let mut duller = good.geometry.clone();
+        duller.objects[0].material.specular = Rgb::splat(0.1);
+        assert_ne!(duller.content_hash(), good.geometry.content_hash());
+        let mut diffuse = good.geometry.clone();
+        diffuse.objects[0].material = Material::DIFFUSE;
+        assert!(
+            diffuse
+                .reflected_albedo()
+                .iter()
+                .all(|a| *a == Rgb::new(0.5, 0.4, 0.3))
+        );
         for (extra, needle) in [
             ("specular = [0.6, 0.1, 0.1]\nshininess = 60", "energy"),
             ("specular = [0.1, 0.1, 0.1]", "shininess"),

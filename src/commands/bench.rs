@@ -325,7 +325,7 @@ fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
         args.frames
     );
     println!(
-        "{:<8} {:>10} {:>12} {:>8} {:>11} {:>13} {:>8} {:>13} {:>10} {:>16}",
+        "{:<14} {:>10} {:>12} {:>8} {:>11} {:>13} {:>8} {:>13} {:>10} {:>16}",
         "scene",
         "prt ms",
         "hybrid ms",
@@ -411,7 +411,7 @@ fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
                 .collect(),
         );
         println!(
-            "{:<8} {:>10.2} {:>12.2} {:>8.2} {:>11.2} {:>13.2} {:>8.2} {:>13.3} {:>10.4} {:>16.2}",
+            "{:<14} {:>10.2} {:>12.2} {:>8.2} {:>11.2} {:>13.2} {:>8.2} {:>13.3} {:>10.4} {:>16.2}",
             scene.name,
             results[0],
             results[1],

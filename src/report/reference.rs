@@ -116,10 +116,6 @@ fn reference_key(
     let mut hasher = blake3::Hasher::new();
     hasher.update(b"hprt reference v3 (halves)");
     hasher.update(&scene.geometry.content_hash());
-    // Diffuse scenes keep their keys (and cached references).
-    if let Some(materials) = scene.geometry.material_hash() {
-        hasher.update(&materials);
-    }
     hasher.update(serde_json::to_string(camera)?.as_bytes());
     hasher.update(&(map.width() as u64).to_le_bytes());
     hasher.update(&(map.height() as u64).to_le_bytes());

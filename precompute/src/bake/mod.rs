@@ -142,7 +142,9 @@ pub fn trace(
     let reflected_albedo = geometry.reflected_albedo();
     let mut reflected_direct = traced.direct_transfer(&reflected_albedo, settings.order);
     fill_inside(&mut reflected_direct, &traced.inside, &neighbours);
-    let (direct, textured) = if geometry.is_textured() {
+    // Textured and glossy scenes reflect toward other surfaces another albedo than the one
+    // their vertices' transfer is stored with.
+    let (direct, textured) = if geometry.is_textured() || geometry.is_glossy() {
         let albedo = geometry.albedo.clone();
         let mut direct = traced.direct_transfer(&albedo, settings.order);
         fill_inside(&mut direct, &traced.inside, &neighbours);
