@@ -270,10 +270,10 @@ impl EnvironmentLighting {
         let Some(size) = self.reflection_size else {
             return ReflectedEnvironment::None;
         };
+        // Untracked, `world` is the map-frame decomposition turned: use it as it is, so a
+        // turning map compares equal and reuses the remainder.
         let (lights, sh) = match (&self.tracker, &self.decomposition) {
-            (None, Some(base)) if base.lights.len() == world.lights.len() => {
-                (base.lights.clone(), base.sh.clone())
-            }
+            (None, Some(base)) => (base.lights.clone(), base.sh.clone()),
             _ => {
                 let back = rotate_decomposition(world, self.orientation.inverse());
                 (back.lights, back.sh)

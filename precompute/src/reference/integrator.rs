@@ -297,12 +297,12 @@ impl<'a> Integrator<'a> {
                             None => {
                                 let pdf_surface = cos * FRAC_1_PI;
                                 let mis = power_heuristic(pdf_light, pdf_surface);
-                                let add = throughput * le * (cos * FRAC_1_PI / pdf_light * mis);
-                                out.radiance += add;
-                                out.specular += specular_before
-                                    * point.albedo
-                                    * le
-                                    * (cos * FRAC_1_PI / pdf_light * mis);
+                                let factor = cos * FRAC_1_PI / pdf_light * mis;
+                                out.radiance += throughput * le * factor;
+                                // Only paths through a glossy first point carry a specular part.
+                                if !self.triangle_materials.is_empty() {
+                                    out.specular += specular_before * point.albedo * le * factor;
+                                }
                             }
                             Some(lobes) => {
                                 let f = lobes.eval(w);
