@@ -26,6 +26,7 @@ pub mod bake_settings;
 pub mod bakefile;
 pub mod bvh;
 pub mod camera;
+pub mod prefetch;
 pub mod progress;
 pub mod scene;
 pub mod settings;

@@ -151,6 +151,18 @@ impl EnvSampler {
     /// [`Self::sample`], with the index `j · width + i` of the texel drawn (its radiance is
     /// the map's there, so the caller need not look the direction up again).
     pub fn sample_texel(&self, u: Vec2) -> (Vec3, f32, usize) {
+        let (w, sin_theta, texel) = self.locate(u);
+        (
+            w,
+            self.density(self.texel_probability[texel], sin_theta),
+            texel,
+        )
+    }
+
+    /// The direction `u` maps to, the sine of its polar angle and its texel's index, without
+    /// the density (whose read a caller may put off: see [`Self::texel_density_factor`]).
+    #[inline]
+    pub fn locate(&self, u: Vec2) -> (Vec3, f32, usize) {
         let (j, tv) = invert_guided(&self.marginal_cdf, &self.marginal_guide, u.y);
         let row = &self.conditional_cdf[j * (self.width + 1)..(j + 1) * (self.width + 1)];
         let guide = &self.conditional_guide[j * self.width..(j + 1) * self.width];
@@ -159,10 +171,7 @@ impl EnvSampler {
         // Keep off the poles, where the density is zero (a measure-zero event, but
         // Hammersley point 0 hits it exactly).
         let vv = (j as f32 + tv.clamp(1e-4, 1.0 - 1e-4)) / self.height as f32;
-        let w = direction_of_uv(uu, vv);
-        let texel = j * self.width + i;
-        let p = self.texel_probability[texel];
-        (w, self.density(p, (PI * vv).sin()), texel)
+        (direction_of_uv(uu, vv), (PI * vv).sin(), j * self.width + i)
     }
 
     /// Solid-angle density of sampling direction `w` (map frame).

@@ -16,6 +16,14 @@ pub struct EnvironmentLight<'a> {
     rotation: f32,
 }
 
+/// A texel of the map chosen ahead of its use (see [`EnvironmentLight::sample_texel`]).
+#[derive(Debug, Clone, Copy)]
+pub struct PendingTexel {
+    index: usize,
+    /// Sine of the polar angle of the direction it was chosen for.
+    sin_theta: f32,
+}
+
 impl<'a> EnvironmentLight<'a> {
     /// `rotation_deg` turns the map about +Y, counter-clockwise seen from above.
     pub fn new(map: &'a EnvMap, rotation_deg: f32) -> Self {
@@ -57,31 +65,54 @@ impl<'a> EnvironmentLight<'a> {
     /// [`Self::sample`] with the radiance arriving from the direction drawn (one lookup).
     #[inline]
     pub fn sample_with_radiance(&self, u: Vec2) -> Option<(Vec3, f32, Rgb)> {
-        let (w, pdf, texel) = self.sampler.as_ref()?.sample_texel(u);
-        (pdf > 0.0).then(|| {
-            (
-                rotate_y(w, self.rotation),
-                pdf,
-                self.texels[texel].truncate(),
-            )
-        })
+        let (w, texel) = self.sample_texel(u)?;
+        let (radiance, pdf) = self.texel_value(texel);
+        (pdf > 0.0).then_some((w, pdf, radiance))
+    }
+
+    /// A world direction drawn as by [`Self::sample`], with its texel: asked of the cache
+    /// now, read by [`Self::texel_value`] once the shadow ray has decided whether it counts,
+    /// so that the read waits on memory while the ray is traced.
+    #[inline]
+    pub fn sample_texel(&self, u: Vec2) -> Option<(Vec3, PendingTexel)> {
+        let (w, sin_theta, index) = self.sampler.as_ref()?.locate(u);
+        Some((rotate_y(w, self.rotation), self.pending(index, sin_theta)))
+    }
+
+    /// The texel a path escaping along world direction `w` sees, asked of the cache now (as
+    /// [`Self::sample_texel`]): computed before the ray that finds out whether it escapes.
+    #[inline]
+    pub fn escape_texel(&self, w: Vec3) -> PendingTexel {
+        let local = rotate_y(w, -self.rotation);
+        let (i, j) = self.map.texel_of(local);
+        // From x and z, which keep their precision near the poles (unlike 1 − y²).
+        let sin_theta = (local.x * local.x + local.z * local.z).sqrt();
+        self.pending(j * self.map.width() + i, sin_theta)
+    }
+
+    #[inline]
+    fn pending(&self, index: usize, sin_theta: f32) -> PendingTexel {
+        crate::prefetch::prefetch(self.texels.as_ptr().wrapping_add(index));
+        PendingTexel { index, sin_theta }
+    }
+
+    /// The texel's radiance and the solid-angle density of sampling its direction.
+    #[inline]
+    pub fn texel_value(&self, texel: PendingTexel) -> (Rgb, f32) {
+        let value = self.texels[texel.index];
+        let pdf = if texel.sin_theta > 0.0 {
+            value.w / texel.sin_theta
+        } else {
+            0.0
+        };
+        (value.truncate(), pdf)
     }
 
     /// The radiance arriving from world direction `w` and the density of sampling it (one
     /// lookup for both: what a path escaping along `w` needs).
     #[inline]
     pub fn radiance_and_pdf(&self, w: Vec3) -> (Rgb, f32) {
-        let local = rotate_y(w, -self.rotation);
-        let (i, j) = self.map.texel_of(local);
-        let texel = self.texels[j * self.map.width() + i];
-        // From x and z, which keep their precision near the poles (unlike 1 − y²).
-        let sin_theta = (local.x * local.x + local.z * local.z).sqrt();
-        let pdf = if sin_theta > 0.0 {
-            texel.w / sin_theta
-        } else {
-            0.0
-        };
-        (texel.truncate(), pdf)
+        self.texel_value(self.escape_texel(w))
     }
 
     /// Density of [`Self::sample`] producing world direction `w`.

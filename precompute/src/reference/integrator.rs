@@ -120,6 +120,21 @@ pub struct DirectVisibility {
     pub unoccluded: f32,
 }
 
+/// What a hit reads of each corner.
+#[derive(Debug, Clone, Copy)]
+struct ShadingVertex {
+    position: Vec3,
+    normal: Vec3,
+    albedo: Rgb,
+}
+
+/// What a hit reads of its triangle.
+#[derive(Debug, Clone, Copy)]
+struct ShadingTriangle {
+    corners: [u32; 3],
+    front_normal: Vec3,
+}
+
 /// One radiance estimate per call; everything it needs is borrowed.
 pub struct Integrator<'a> {
     pub geometry: &'a SceneMesh,
@@ -128,7 +143,10 @@ pub struct Integrator<'a> {
     /// Indirect bounces after the first shading point (0: direct lighting only).
     pub bounces: u32,
     offset: f32,
-    front_normals: Vec<Vec3>,
+    /// The mesh's shading data regrouped so that a hit reads one record per corner and one
+    /// per triangle (a path's hits land anywhere in the mesh: each read is a cache miss).
+    vertices: Vec<ShadingVertex>,
+    triangles: Vec<ShadingTriangle>,
     /// Per triangle, its texture in `geometry.textures` or [`NO_TEXTURE`]; empty for an
     /// untextured scene, whose hits then read nothing more than before.
     triangle_textures: Vec<u32>,
@@ -156,8 +174,18 @@ impl<'a> Integrator<'a> {
             light,
             bounces,
             offset: RAY_OFFSET_FRACTION * geometry.diagonal(),
-            front_normals: (0..mesh.triangle_count())
-                .map(|t| mesh.front_normal(t))
+            vertices: (0..mesh.vertex_count())
+                .map(|v| ShadingVertex {
+                    position: mesh.positions[v],
+                    normal: mesh.normals[v],
+                    albedo: geometry.albedo[v],
+                })
+                .collect(),
+            triangles: (0..mesh.triangle_count())
+                .map(|t| ShadingTriangle {
+                    corners: mesh.triangles[t],
+                    front_normal: mesh.front_normal(t),
+                })
                 .collect(),
             triangle_textures: if geometry.is_textured() {
                 geometry.triangle_textures()
@@ -176,15 +204,17 @@ impl<'a> Integrator<'a> {
     /// triangle shows its front (CONVENTIONS.md, "Surfaces").
     pub fn surface(&self, hit: &Hit) -> SurfacePoint {
         let mesh = &self.geometry.mesh;
-        let corners = mesh.triangles[hit.triangle as usize];
+        let triangle = &self.triangles[hit.triangle as usize];
+        let corners = triangle.corners;
         let weights = hit.barycentrics();
         let mut position = Vec3::ZERO;
         let mut normal = Vec3::ZERO;
         let mut albedo = Rgb::ZERO;
         for (i, w) in corners.iter().zip(weights) {
-            position += mesh.positions[*i as usize] * w;
-            normal += mesh.normals[*i as usize] * w;
-            albedo += self.geometry.albedo[*i as usize] * w;
+            let vertex = &self.vertices[*i as usize];
+            position += vertex.position * w;
+            normal += vertex.normal * w;
+            albedo += vertex.albedo * w;
         }
         if let Some(&texture) = self.triangle_textures.get(hit.triangle as usize)
             && texture != NO_TEXTURE
@@ -197,7 +227,7 @@ impl<'a> Integrator<'a> {
                 .sum();
             albedo *= self.geometry.textures[texture as usize].bilinear(uv);
         }
-        let front = self.front_normals[hit.triangle as usize];
+        let front = triangle.front_normal;
         SurfacePoint {
             position,
             shading_normal: normal.try_normalize().unwrap_or(front),
@@ -280,19 +310,21 @@ impl<'a> Integrator<'a> {
             // is the same as before glossy surfaces existed.
             let throughput = before * point.albedo;
             // Next-event estimation toward the environment.
-            if let Some((w, pdf_light, le)) = self.light.sample_with_radiance(sampler.next_2d()) {
+            if let Some((w, texel)) = self.light.sample_texel(sampler.next_2d()) {
                 let cos = n.dot(w);
                 if cos > 0.0 {
                     *rays += 1;
                     let visible = !self.occluded(&point, w);
-                    if depth == 0 {
+                    // Read after the ray, which gave the texel time to arrive.
+                    let (le, pdf_light) = self.light.texel_value(texel);
+                    if depth == 0 && pdf_light > 0.0 {
                         let weight = luminance(le) * cos / pdf_light;
                         out.direct.unoccluded += weight;
                         if visible {
                             out.direct.visible += weight;
                         }
                     }
-                    if visible {
+                    if visible && pdf_light > 0.0 {
                         match &glossy {
                             None => {
                                 let pdf_surface = cos * FRAC_1_PI;
@@ -358,16 +390,18 @@ impl<'a> Integrator<'a> {
                 specular_before * specular_weight
             };
             before = next;
-            // The environment seen along an escaping continuation, MIS-weighted.
-            let escaped = |w: Vec3| {
-                let (le, pdf_light) = self.light.radiance_and_pdf(w);
+            // The environment seen along an escaping continuation, MIS-weighted; its texel
+            // is asked for now and read after the ray.
+            let escape = self.light.escape_texel(w);
+            let escaped = || {
+                let (le, pdf_light) = self.light.texel_value(escape);
                 le * power_heuristic(pdf_surface, pdf_light)
             };
             *rays += 1;
             if depth == self.bounces {
                 // Only whether it escapes matters: an occlusion ray suffices.
                 if !self.occluded(&point, w) {
-                    let le = escaped(w);
+                    let le = escaped();
                     out.radiance += before * le;
                     out.specular += specular_before * le;
                 }
@@ -375,7 +409,7 @@ impl<'a> Integrator<'a> {
             }
             match self.trace(&point, w) {
                 None => {
-                    let le = escaped(w);
+                    let le = escaped();
                     out.radiance += before * le;
                     out.specular += specular_before * le;
                     break;

@@ -1,0 +1,349 @@
+//! A four-wide BVH laid out for CPU traversal: each node holds its four children's boxes as
+//! full-precision planes side by side, tested together with one set of SIMD operations, and
+//! children are visited nearest first. The tree itself is obvhs's (PLOC with pre-splitting,
+//! reinsertion and leaf collapse): only its binary nodes are regrouped by fours.
+//!
+//! obvhs's own compressed wide BVH is designed for GPUs: on a CPU its quantised boxes must be
+//! decoded at every node, and its children come in a fixed order per ray octant.
+
+use glam::{Vec3A, Vec4};
+use obvhs::bvh2::Bvh2;
+
+/// Four children: their boxes as planes (`min x, min y, min z, max x, max y, max z`, each
+/// for the four), and what each is.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
+pub(super) struct Node4 {
+    planes: [Vec4; 6],
+    /// Inner child: its node's index. Leaf child: its first triangle slot.
+    child: [u32; 4],
+    /// Leaf child: its number of triangles; inner child: [`INNER`]; empty slot: 0 (with a
+    /// box no ray enters).
+    count: [u32; 4],
+}
+
+const INNER: u32 = u32::MAX;
+
+/// One child reference: an inner node or a run of triangle slots.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct ChildRef {
+    pub index: u32,
+    pub count: u32,
+}
+
+impl ChildRef {
+    #[inline(always)]
+    pub fn is_inner(&self) -> bool {
+        self.count == INNER
+    }
+}
+
+/// A padding slot of a leaf's last packet.
+pub(super) const NO_TRIANGLE: u32 = u32::MAX;
+
+/// The regrouped tree: nodes in depth-first order (the root first), and for each triangle
+/// slot the index of the obvhs primitive it holds (leaves start on a multiple of four: their
+/// triangles are tested by packets of four).
+#[derive(Debug, Default)]
+pub(super) struct Bvh4 {
+    nodes: Vec<Node4>,
+    /// What a ray starts from: the root node, or the single leaf of a tiny mesh.
+    root: Option<ChildRef>,
+    pub slots: Vec<u32>,
+}
+
+impl Bvh4 {
+    /// Regroups `bvh2`'s binary nodes by fours: a node takes its two children and keeps
+    /// opening its largest inner child (by surface area) until it has four.
+    pub fn from_bvh2(bvh2: &Bvh2) -> Self {
+        let mut tree = Self::default();
+        let Some(root) = bvh2.nodes.first() else {
+            return tree;
+        };
+        if root.prim_count > 0 {
+            tree.root = Some(tree.leaf(bvh2, 0));
+        } else {
+            tree.root = Some(ChildRef {
+                index: 0,
+                count: INNER,
+            });
+            tree.node(bvh2, 0);
+        }
+        tree
+    }
+
+    /// Appends a leaf's triangles, padded to whole packets of four with [`NO_TRIANGLE`].
+    fn leaf(&mut self, bvh2: &Bvh2, node: usize) -> ChildRef {
+        let n = &bvh2.nodes[node];
+        let first = self.slots.len() as u32;
+        let start = n.first_index as usize;
+        self.slots
+            .extend_from_slice(&bvh2.primitive_indices[start..start + n.prim_count as usize]);
+        while !self.slots.len().is_multiple_of(4) {
+            self.slots.push(NO_TRIANGLE);
+        }
+        ChildRef {
+            index: first,
+            count: n.prim_count,
+        }
+    }
+
+    /// Appends the four-wide node for binary inner node `node`, then its subtrees; returns
+    /// its index.
+    fn node(&mut self, bvh2: &Bvh2, node: usize) -> u32 {
+        let first = bvh2.nodes[node].first_index as usize;
+        let mut group = vec![first, first + 1];
+        while group.len() < 4 {
+            let widest = group
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| bvh2.nodes[**c].prim_count == 0)
+                .max_by(|(_, a), (_, b)| {
+                    let area = |c: usize| bvh2.nodes[c].aabb().half_area();
+                    area(**a).total_cmp(&area(**b))
+                })
+                .map(|(k, _)| k);
+            let Some(k) = widest else { break };
+            let opened = group.swap_remove(k);
+            let children = bvh2.nodes[opened].first_index as usize;
+            group.extend([children, children + 1]);
+        }
+        let index = self.nodes.len();
+        self.nodes.push(Node4 {
+            planes: [
+                Vec4::splat(f32::INFINITY),
+                Vec4::splat(f32::INFINITY),
+                Vec4::splat(f32::INFINITY),
+                Vec4::splat(f32::NEG_INFINITY),
+                Vec4::splat(f32::NEG_INFINITY),
+                Vec4::splat(f32::NEG_INFINITY),
+            ],
+            child: [0; 4],
+            count: [0; 4],
+        });
+        for (k, &c) in group.iter().enumerate() {
+            let aabb = *bvh2.nodes[c].aabb();
+            let reference = if bvh2.nodes[c].prim_count > 0 {
+                self.leaf(bvh2, c)
+            } else {
+                ChildRef {
+                    index: self.node(bvh2, c),
+                    count: INNER,
+                }
+            };
+            let n = &mut self.nodes[index];
+            for axis in 0..3 {
+                n.planes[axis][k] = aabb.min[axis];
+                n.planes[3 + axis][k] = aabb.max[axis];
+            }
+            n.child[k] = reference.index;
+            n.count[k] = reference.count;
+        }
+        index as u32
+    }
+
+    #[inline(always)]
+    pub fn prefetch(&self, node: u32) {
+        crate::prefetch::prefetch(self.nodes.as_ptr().wrapping_add(node as usize));
+    }
+
+    pub fn root(&self) -> Option<ChildRef> {
+        self.root
+    }
+
+    #[inline(always)]
+    pub fn child(&self, node: u32, k: usize) -> ChildRef {
+        let n = &self.nodes[node as usize];
+        ChildRef {
+            index: n.child[k],
+            count: n.count[k],
+        }
+    }
+
+    /// Entry distance of the ray into each of `node`'s four children, and the mask of those
+    /// it enters within `[tmin, tmax]`.
+    #[inline(always)]
+    pub fn enter(&self, node: u32, ray: &WideRay, tmax: f32) -> (Vec4, u32) {
+        let n = &self.nodes[node as usize];
+        let slab = |plane: usize, axis: usize| (n.planes[plane] - ray.origin[axis]) * ray.inv[axis];
+        let t_near = slab(ray.near[0], 0)
+            .max(slab(ray.near[1], 1))
+            .max(slab(ray.near[2], 2).max(Vec4::splat(ray.tmin)));
+        let t_far = slab(ray.far[0], 0)
+            .min(slab(ray.far[1], 1))
+            .min(slab(ray.far[2], 2).min(Vec4::splat(tmax)))
+            * ROUNDING;
+        (t_near, t_near.cmple(t_far).bitmask())
+    }
+}
+
+/// Slack on the far distance so that rounding never loses a box the ray grazes (Ize 2013:
+/// `1 + 2γ₃`).
+const ROUNDING: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+
+/// A ray prepared for box and packet tests: each component splatted across four lanes.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct WideRay {
+    pub origin: [Vec4; 3],
+    pub direction: [Vec4; 3],
+    inv: [Vec4; 3],
+    /// Per axis, which plane the ray meets first: min (`axis`) for a positive direction,
+    /// max (`axis + 3`) for a negative one; `far` is the other.
+    near: [usize; 3],
+    far: [usize; 3],
+    tmin: f32,
+}
+
+impl WideRay {
+    pub fn new(origin: Vec3A, direction: Vec3A, tmin: f32) -> Self {
+        // A zero component would give 0 · ∞ = NaN; a tiny one keeps the arithmetic finite
+        // and the answer the same.
+        let inverse = |d: f32| {
+            1.0 / if d.abs() < 1e-30 {
+                1e-30f32.copysign(d)
+            } else {
+                d
+            }
+        };
+        let inv = [
+            inverse(direction.x),
+            inverse(direction.y),
+            inverse(direction.z),
+        ];
+        let near = |k: usize| if inv[k] >= 0.0 { k } else { k + 3 };
+        let far = |k: usize| if inv[k] >= 0.0 { k + 3 } else { k };
+        Self {
+            origin: [
+                Vec4::splat(origin.x),
+                Vec4::splat(origin.y),
+                Vec4::splat(origin.z),
+            ],
+            direction: [
+                Vec4::splat(direction.x),
+                Vec4::splat(direction.y),
+                Vec4::splat(direction.z),
+            ],
+            inv: inv.map(Vec4::splat),
+            near: [near(0), near(1), near(2)],
+            far: [far(0), far(1), far(2)],
+            // obvhs's rule, kept: a box the ray has left within `MIN_BOX_DISTANCE` is not
+            // entered, so a ray leaving a seam of an unwelded mesh does not stop on the
+            // neighbour touching its origin (the bake's furnace tests rest on it).
+            tmin: tmin.max(MIN_BOX_DISTANCE),
+        }
+    }
+}
+
+/// Nearest distance at which a box counts as entered (obvhs's `EPSILON`).
+const MIN_BOX_DISTANCE: f32 = 1e-4;
+
+/// Arithmetic on one value or on four side by side: what the triangle test is written over.
+pub(super) trait Lanes:
+    Copy
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Div<Output = Self>
+{
+    const ONE: Self;
+}
+
+impl Lanes for f32 {
+    const ONE: Self = 1.0;
+}
+
+impl Lanes for Vec4 {
+    const ONE: Self = Vec4::ONE;
+}
+
+#[inline(always)]
+fn cross<T: Lanes>(a: [T; 3], b: [T; 3]) -> [T; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+#[inline(always)]
+fn dot<T: Lanes>(a: [T; 3], b: [T; 3]) -> T {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Möller–Trumbore, for one triangle (`f32`) or four (`Vec4`): the same operations in the
+/// same order, so a packet's lane gives its triangle's answer bit for bit. Returns `(u, v,
+/// t)`: the barycentric weights of the second and third vertex and the distance; all NaN for
+/// a ray in the triangle's plane (which then fails every comparison).
+#[inline(always)]
+pub(super) fn moller_trumbore<T: Lanes>(
+    origin: [T; 3],
+    direction: [T; 3],
+    v0: [T; 3],
+    e1: [T; 3],
+    e2: [T; 3],
+) -> (T, T, T) {
+    let p = cross(direction, e2);
+    let inv_det = T::ONE / dot(e1, p);
+    let s = [origin[0] - v0[0], origin[1] - v0[1], origin[2] - v0[2]];
+    let q = cross(s, e1);
+    (
+        dot(s, p) * inv_det,
+        dot(direction, q) * inv_det,
+        dot(e2, q) * inv_det,
+    )
+}
+
+/// Four triangles side by side: first vertices and edges, per axis.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(16))]
+pub(super) struct TrianglePacket {
+    pub v0: [Vec4; 3],
+    pub e1: [Vec4; 3],
+    pub e2: [Vec4; 3],
+}
+
+impl TrianglePacket {
+    /// Packs `corners(slot)` for each slot; a padding slot gets a triangle no ray hits.
+    pub fn pack(slots: &[u32], corners: impl Fn(u32) -> [Vec3A; 3]) -> Vec<Self> {
+        slots
+            .chunks(4)
+            .map(|chunk| {
+                let mut packet = Self {
+                    v0: [Vec4::ZERO; 3],
+                    e1: [Vec4::ZERO; 3],
+                    e2: [Vec4::ZERO; 3],
+                };
+                for (lane, &slot) in chunk.iter().enumerate() {
+                    if slot == NO_TRIANGLE {
+                        continue;
+                    }
+                    let [a, b, c] = corners(slot);
+                    for axis in 0..3 {
+                        packet.v0[axis][lane] = a[axis];
+                        packet.e1[axis][lane] = b[axis] - a[axis];
+                        packet.e2[axis][lane] = c[axis] - a[axis];
+                    }
+                }
+                packet
+            })
+            .collect()
+    }
+
+    /// Distances to the four triangles, and the mask of those hit within `[tmin, tmax]`.
+    #[inline(always)]
+    pub fn intersect(&self, ray: &WideRay, tmin: f32, tmax: f32) -> (Vec4, u32) {
+        let (u, v, t) = moller_trumbore(ray.origin, ray.direction, self.v0, self.e1, self.e2);
+        let hit = u.cmpge(Vec4::ZERO)
+            & v.cmpge(Vec4::ZERO)
+            & (u + v).cmple(Vec4::ONE)
+            & t.cmpge(Vec4::splat(tmin))
+            & t.cmple(Vec4::splat(tmax));
+        (t, hit.bitmask())
+    }
+
+    /// One lane's triangle: first vertex and edges.
+    pub fn lane(&self, lane: usize) -> [[f32; 3]; 3] {
+        let get = |v: &[Vec4; 3]| [v[0][lane], v[1][lane], v[2][lane]];
+        [get(&self.v0), get(&self.e1), get(&self.e2)]
+    }
+}
