@@ -296,6 +296,9 @@ impl<'a> Integrator<'a> {
         // that left the first point through its specular lobe.
         let mut before = Rgb::ONE;
         let mut specular_before = Rgb::ZERO;
+        // The first vertex's light sample; later ones are drawn as soon as the ray that finds
+        // their vertex returns (below).
+        let mut light_sample = self.light.sample_texel(sampler.next_2d());
         for depth in 0..=self.bounces {
             let n = point.shading_normal;
             let glossy = if point.material.is_glossy() {
@@ -310,7 +313,7 @@ impl<'a> Integrator<'a> {
             // is the same as before glossy surfaces existed.
             let throughput = before * point.albedo;
             // Next-event estimation toward the environment.
-            if let Some((w, texel)) = self.light.sample_texel(sampler.next_2d()) {
+            if let Some((w, texel)) = light_sample {
                 let cos = n.dot(w);
                 if cos > 0.0 {
                     *rays += 1;
@@ -415,6 +418,13 @@ impl<'a> Integrator<'a> {
                     break;
                 }
                 Some(hit) => {
+                    // The next vertex's light sample does not depend on where it is: drawn
+                    // first (the sampler's order is unchanged), its table reads overlap the
+                    // reads of the hit's shading data, asked of the cache before it.
+                    crate::prefetch::prefetch(
+                        self.triangles.as_ptr().wrapping_add(hit.triangle as usize),
+                    );
+                    light_sample = self.light.sample_texel(sampler.next_2d());
                     point = self.surface(&hit);
                     wo = -w;
                 }
