@@ -115,8 +115,7 @@ impl SceneBvh {
             obvhs::BvhBuildParams::slow_build(),
             &mut std::time::Duration::default(),
         );
-        let tree = Bvh4::from_bvh2(&bvh2);
-        let ids = tree.slots.clone();
+        let (tree, ids) = Bvh4::from_bvh2(&bvh2);
         let packets = TrianglePacket::pack(&ids, |i| {
             let t = &tris[i as usize];
             [t.v0, t.v1, t.v2]

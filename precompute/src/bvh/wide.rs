@@ -41,44 +41,59 @@ impl ChildRef {
 /// A padding slot of a leaf's last packet.
 pub(super) const NO_TRIANGLE: u32 = u32::MAX;
 
-/// The regrouped tree: nodes in depth-first order (the root first), and for each triangle
-/// slot the index of the obvhs primitive it holds (leaves start on a multiple of four: their
-/// triangles are tested by packets of four).
-#[derive(Debug, Default)]
+/// The regrouped tree: nodes in depth-first order (the root first).
+#[derive(Debug)]
 pub(super) struct Bvh4 {
     nodes: Vec<Node4>,
     /// What a ray starts from: the root node, or the single leaf of a tiny mesh.
     root: Option<ChildRef>,
-    pub slots: Vec<u32>,
+}
+
+/// What regrouping builds up: the nodes, and for each triangle slot the index of the obvhs
+/// primitive it holds (leaves start on a multiple of four: their triangles are tested by
+/// packets of four).
+struct Builder<'a> {
+    bvh2: &'a Bvh2,
+    nodes: Vec<Node4>,
+    slots: Vec<u32>,
 }
 
 impl Bvh4 {
     /// Regroups `bvh2`'s binary nodes by fours: a node takes its two children and keeps
-    /// opening its largest inner child (by surface area) until it has four.
-    pub fn from_bvh2(bvh2: &Bvh2) -> Self {
-        let mut tree = Self::default();
-        let Some(root) = bvh2.nodes.first() else {
-            return tree;
+    /// opening its largest inner child (by surface area) until it has four. Returns the tree
+    /// and, per triangle slot, the obvhs primitive it holds ([`NO_TRIANGLE`] for padding).
+    pub fn from_bvh2(bvh2: &Bvh2) -> (Self, Vec<u32>) {
+        let mut builder = Builder {
+            bvh2,
+            nodes: Vec::new(),
+            slots: Vec::new(),
         };
-        if root.prim_count > 0 {
-            tree.root = Some(tree.leaf(bvh2, 0));
-        } else {
-            tree.root = Some(ChildRef {
-                index: 0,
-                count: INNER,
-            });
-            tree.node(bvh2, 0);
-        }
-        tree
+        let root = bvh2.nodes.first().map(|root| {
+            if root.prim_count > 0 {
+                builder.leaf(0)
+            } else {
+                ChildRef {
+                    index: builder.node(0),
+                    count: INNER,
+                }
+            }
+        });
+        let tree = Self {
+            nodes: builder.nodes,
+            root,
+        };
+        (tree, builder.slots)
     }
+}
 
+impl Builder<'_> {
     /// Appends a leaf's triangles, padded to whole packets of four with [`NO_TRIANGLE`].
-    fn leaf(&mut self, bvh2: &Bvh2, node: usize) -> ChildRef {
-        let n = &bvh2.nodes[node];
+    fn leaf(&mut self, node: usize) -> ChildRef {
+        let n = &self.bvh2.nodes[node];
         let first = self.slots.len() as u32;
         let start = n.first_index as usize;
         self.slots
-            .extend_from_slice(&bvh2.primitive_indices[start..start + n.prim_count as usize]);
+            .extend_from_slice(&self.bvh2.primitive_indices[start..start + n.prim_count as usize]);
         while !self.slots.len().is_multiple_of(4) {
             self.slots.push(NO_TRIANGLE);
         }
@@ -90,7 +105,8 @@ impl Bvh4 {
 
     /// Appends the four-wide node for binary inner node `node`, then its subtrees; returns
     /// its index.
-    fn node(&mut self, bvh2: &Bvh2, node: usize) -> u32 {
+    fn node(&mut self, node: usize) -> u32 {
+        let bvh2 = self.bvh2;
         let first = bvh2.nodes[node].first_index as usize;
         let mut group = vec![first, first + 1];
         while group.len() < 4 {
@@ -124,10 +140,10 @@ impl Bvh4 {
         for (k, &c) in group.iter().enumerate() {
             let aabb = *bvh2.nodes[c].aabb();
             let reference = if bvh2.nodes[c].prim_count > 0 {
-                self.leaf(bvh2, c)
+                self.leaf(c)
             } else {
                 ChildRef {
-                    index: self.node(bvh2, c),
+                    index: self.node(c),
                     count: INNER,
                 }
             };
@@ -141,7 +157,9 @@ impl Bvh4 {
         }
         index as u32
     }
+}
 
+impl Bvh4 {
     #[inline(always)]
     pub fn prefetch(&self, node: u32) {
         crate::prefetch::prefetch(self.nodes.as_ptr().wrapping_add(node as usize));
