@@ -26,6 +26,7 @@ pub mod bake_settings;
 pub mod bakefile;
 pub mod bvh;
 pub mod camera;
+pub mod huge_pages;
 pub mod prefetch;
 pub mod progress;
 pub mod scene;

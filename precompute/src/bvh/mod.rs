@@ -1,6 +1,7 @@
 //! Ray casting against the scene: obvhs builds the tree, [`wide`] lays it out four-wide for
 //! the CPU, and the traversals here visit it.
 
+use crate::huge_pages::HugePageTable;
 use crate::mesh::TriangleMesh;
 use glam::{Vec3, Vec3A};
 use obvhs::bvh2::builder::build_bvh2_from_tris;
@@ -33,11 +34,11 @@ impl Hit {
 pub struct SceneBvh {
     tree: Bvh4,
     /// The leaves' triangles, four to a packet, slot `4k + lane` in packet `k`.
-    packets: Vec<TrianglePacket>,
+    packets: HugePageTable<TrianglePacket>,
     /// Scene triangle index of each leaf slot ([`NO_TRIANGLE`] for padding).
-    ids: Vec<u32>,
+    ids: HugePageTable<u32>,
     /// Vertex indices of each leaf slot's triangle (the bake skips a vertex's own triangles).
-    corners: Vec<[u32; 3]>,
+    corners: HugePageTable<[u32; 3]>,
 }
 
 /// A ray: where it starts, where it goes, and how far it is searched (`tmax` shrinks to the
@@ -120,19 +121,16 @@ impl SceneBvh {
             let t = &tris[i as usize];
             [t.v0, t.v1, t.v2]
         });
-        let corners = ids
-            .iter()
-            .map(|&i| {
-                mesh.triangles
-                    .get(i as usize)
-                    .copied()
-                    .unwrap_or([NO_TRIANGLE; 3])
-            })
-            .collect();
+        let corners = HugePageTable::new(ids.iter().map(|&i| {
+            mesh.triangles
+                .get(i as usize)
+                .copied()
+                .unwrap_or([NO_TRIANGLE; 3])
+        }));
         Self {
             tree,
             packets,
-            ids,
+            ids: HugePageTable::new(ids.into_iter()),
             corners,
         }
     }

@@ -6,6 +6,7 @@
 //! obvhs's own compressed wide BVH is designed for GPUs: on a CPU its quantised boxes must be
 //! decoded at every node, and its children come in a fixed order per ray octant.
 
+use crate::huge_pages::HugePageTable;
 use glam::{Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
 
@@ -44,7 +45,7 @@ pub(super) const NO_TRIANGLE: u32 = u32::MAX;
 /// The regrouped tree: nodes in depth-first order (the root first).
 #[derive(Debug)]
 pub(super) struct Bvh4 {
-    nodes: Vec<Node4>,
+    nodes: HugePageTable<Node4>,
     /// What a ray starts from: the root node, or the single leaf of a tiny mesh.
     root: Option<ChildRef>,
 }
@@ -79,7 +80,7 @@ impl Bvh4 {
             }
         });
         let tree = Self {
-            nodes: builder.nodes,
+            nodes: HugePageTable::new(builder.nodes.into_iter()),
             root,
         };
         (tree, builder.slots)
@@ -322,29 +323,26 @@ pub(super) struct TrianglePacket {
 
 impl TrianglePacket {
     /// Packs `corners(slot)` for each slot; a padding slot gets a triangle no ray hits.
-    pub fn pack(slots: &[u32], corners: impl Fn(u32) -> [Vec3A; 3]) -> Vec<Self> {
-        slots
-            .chunks(4)
-            .map(|chunk| {
-                let mut packet = Self {
-                    v0: [Vec4::ZERO; 3],
-                    e1: [Vec4::ZERO; 3],
-                    e2: [Vec4::ZERO; 3],
-                };
-                for (lane, &slot) in chunk.iter().enumerate() {
-                    if slot == NO_TRIANGLE {
-                        continue;
-                    }
-                    let [a, b, c] = corners(slot);
-                    for axis in 0..3 {
-                        packet.v0[axis][lane] = a[axis];
-                        packet.e1[axis][lane] = b[axis] - a[axis];
-                        packet.e2[axis][lane] = c[axis] - a[axis];
-                    }
+    pub fn pack(slots: &[u32], corners: impl Fn(u32) -> [Vec3A; 3]) -> HugePageTable<Self> {
+        HugePageTable::new(slots.chunks(4).map(|chunk| {
+            let mut packet = Self {
+                v0: [Vec4::ZERO; 3],
+                e1: [Vec4::ZERO; 3],
+                e2: [Vec4::ZERO; 3],
+            };
+            for (lane, &slot) in chunk.iter().enumerate() {
+                if slot == NO_TRIANGLE {
+                    continue;
                 }
-                packet
-            })
-            .collect()
+                let [a, b, c] = corners(slot);
+                for axis in 0..3 {
+                    packet.v0[axis][lane] = a[axis];
+                    packet.e1[axis][lane] = b[axis] - a[axis];
+                    packet.e2[axis][lane] = c[axis] - a[axis];
+                }
+            }
+            packet
+        }))
     }
 
     /// Distances to the four triangles, and the mask of those hit within `[tmin, tmax]`.

@@ -2,6 +2,7 @@
 //! shared convention (CONVENTIONS.md, "Environment maps"). Every input layout (cube crosses,
 //! six faces, light probes) is resampled into this one form when loaded.
 
+mod column;
 pub mod cube;
 mod load;
 pub mod sampling;
@@ -42,8 +43,29 @@ pub fn uv_of_direction(w: Vec3) -> (f32, f32) {
 /// Rotation of a direction about +Y by `angle` radians (counter-clockwise seen from above).
 #[inline]
 pub fn rotate_y(w: Vec3, angle: f32) -> Vec3 {
-    let (s, c) = angle.sin_cos();
-    Vec3::new(w.x * c + w.z * s, w.y, -w.x * s + w.z * c)
+    YRotation::new(angle).apply(w)
+}
+
+/// A rotation about +Y with its sine and cosine computed once: what a caller rotating many
+/// directions by one angle keeps (the path tracer rotates two per bounce).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct YRotation {
+    sin: f32,
+    cos: f32,
+}
+
+impl YRotation {
+    /// By `angle` radians, counter-clockwise seen from above.
+    pub fn new(angle: f32) -> Self {
+        let (sin, cos) = angle.sin_cos();
+        Self { sin, cos }
+    }
+
+    #[inline]
+    pub fn apply(self, w: Vec3) -> Vec3 {
+        let (s, c) = (self.sin, self.cos);
+        Vec3::new(w.x * c + w.z * s, w.y, -w.x * s + w.z * c)
+    }
 }
 
 impl EnvMap {
@@ -124,9 +146,10 @@ impl EnvMap {
     /// Texel containing direction `w`.
     #[inline]
     pub fn texel_of(&self, w: Vec3) -> (usize, usize) {
-        let (u, v) = uv_of_direction(w);
+        // As `uv_of_direction`, whose `u` takes an arctangent: `column_of` mostly does not.
+        let v = w.y.clamp(-1.0, 1.0).acos() / PI;
         (
-            ((u * self.width as f32) as usize).min(self.width - 1),
+            column::column_of(w, self.width),
             ((v * self.height as f32) as usize).min(self.height - 1),
         )
     }

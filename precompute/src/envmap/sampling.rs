@@ -3,6 +3,7 @@
 
 use super::{EnvMap, direction_of_uv, uv_of_direction};
 use crate::color::luminance;
+use crate::huge_pages::HugePageTable;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -15,8 +16,8 @@ pub struct EnvSampler {
     marginal_cdf: Vec<f32>,
     marginal_guide: Vec<u32>,
     /// `height` rows of `width + 1` entries, each from 0 to 1.
-    conditional_cdf: Vec<f32>,
-    /// `height` rows of `width` entries.
+    conditional_cdf: HugePageTable<f32>,
+    /// `height` rows of `width / GUIDE_STRIDE` entries (rounded up).
     conditional_guide: Vec<u32>,
     /// Probability of each texel (sums to 1).
     texel_probability: Vec<f32>,
@@ -46,14 +47,22 @@ fn position_in(cdf: &[f32], k: usize, x: f32) -> f32 {
     }
 }
 
+/// How many intervals of a CDF one guide-table bucket spans: coarse enough that a map's guide
+/// tables stay in cache (a sixteenth of its CDFs), fine enough that the scan from a bucket's
+/// start reads one or two cache lines of the CDF, where one entry per interval cost a second
+/// cache miss before that read.
+const GUIDE_STRIDE: usize = 16;
+
 /// A guide table for inverting `cdf` (Chen and Asau's cutpoint method): entry b is the
-/// interval holding `b / m`, so inversion starts next to its answer instead of bisecting.
+/// interval holding `b / m`, for `m` buckets of about [`GUIDE_STRIDE`] intervals, so
+/// inversion starts next to its answer instead of bisecting.
 fn guide_table(cdf: &[f32]) -> Vec<u32> {
     let n = cdf.len() - 1;
+    let m = n.div_ceil(GUIDE_STRIDE);
     let mut k = 0usize;
-    (0..n)
+    (0..m)
         .map(|b| {
-            let lower = b as f32 / n as f32;
+            let lower = b as f32 / m as f32;
             while k + 1 < n && cdf[k + 1] <= lower {
                 k += 1;
             }
@@ -62,19 +71,31 @@ fn guide_table(cdf: &[f32]) -> Vec<u32> {
         .collect()
 }
 
-/// [`invert_cdf`] through `guide` (from [`guide_table`]): the same answer, in a step or two.
+/// [`invert_cdf`] through `guide` (from [`guide_table`]): the same answer, from a short scan.
 #[inline]
 fn invert_guided(cdf: &[f32], guide: &[u32], x: f32) -> (usize, f32) {
     let n = cdf.len() - 1;
-    let bucket = ((x * n as f32) as usize).min(n - 1);
+    let m = guide.len();
+    let bucket = ((x * m as f32) as usize).min(m - 1);
     let mut k = guide[bucket] as usize;
     // Rounding can put x in a neighbouring bucket: walk to the last k with cdf[k] <= x.
     while k > 0 && cdf[k] > x {
         k -= 1;
     }
+    // Forward eight entries at a time, without a branch per entry: the CDF never decreases,
+    // so the entries of a chunk at most x are its first ones.
+    while let Some(chunk) = cdf[k + 1..].first_chunk::<8>() {
+        let below = chunk.iter().filter(|&&c| c <= x).count();
+        k += below;
+        if below < chunk.len() {
+            break;
+        }
+    }
     while k + 1 < n && cdf[k + 1] <= x {
         k += 1;
     }
+    // A chunk may count the final entry (1) for x = 1.
+    let k = k.min(n - 1);
     (k, position_in(cdf, k, x))
 }
 
@@ -102,7 +123,7 @@ impl EnvSampler {
     pub fn new(map: &EnvMap) -> Option<Self> {
         let (w, h) = (map.width(), map.height());
         let mut conditional_cdf = Vec::with_capacity(h * (w + 1));
-        let mut conditional_guide = Vec::with_capacity(h * w);
+        let mut conditional_guide = Vec::with_capacity(h * w.div_ceil(GUIDE_STRIDE));
         let mut row_weights = Vec::with_capacity(h);
         let mut texel_weights = Vec::with_capacity(w * h);
         for j in 0..h {
@@ -125,7 +146,7 @@ impl EnvSampler {
             height: h,
             marginal_guide: guide_table(&marginal_cdf),
             marginal_cdf,
-            conditional_cdf,
+            conditional_cdf: HugePageTable::new(conditional_cdf.into_iter()),
             conditional_guide,
             texel_probability: texel_weights.iter().map(|x| (x / total) as f32).collect(),
         })
@@ -165,7 +186,8 @@ impl EnvSampler {
     pub fn locate(&self, u: Vec2) -> (Vec3, f32, usize) {
         let (j, tv) = invert_guided(&self.marginal_cdf, &self.marginal_guide, u.y);
         let row = &self.conditional_cdf[j * (self.width + 1)..(j + 1) * (self.width + 1)];
-        let guide = &self.conditional_guide[j * self.width..(j + 1) * self.width];
+        let stride = self.width.div_ceil(GUIDE_STRIDE);
+        let guide = &self.conditional_guide[j * stride..(j + 1) * stride];
         let (i, tu) = invert_guided(row, guide, u.x);
         let uu = (i as f32 + tu) / self.width as f32;
         // Keep off the poles, where the density is zero (a measure-zero event, but
@@ -260,6 +282,41 @@ mod tests {
                 "x = {x}"
             );
         }
+    }
+
+    /// Just below a bucket's lower edge, `x · m` can round up into that bucket, whose
+    /// guide entry then starts past the answer: the inversion walks back to it.
+    #[test]
+    fn guided_inversion_walks_back_from_rounding() {
+        let mut rounded_up = 0;
+        for m in [3usize, 7, 13, 29, 61, 125] {
+            // Interval boundaries on the bucket edges, as the guide table computes them.
+            let n = m * GUIDE_STRIDE;
+            let cdf: Vec<f32> = (0..=n)
+                .map(|j| {
+                    let (b, r) = (j / GUIDE_STRIDE, j % GUIDE_STRIDE);
+                    let edge = |b: usize| b as f32 / m as f32;
+                    let f = r as f32 / GUIDE_STRIDE as f32;
+                    if b >= m {
+                        1.0
+                    } else {
+                        edge(b) + f * (edge(b + 1) - edge(b))
+                    }
+                })
+                .collect();
+            let guide = guide_table(&cdf);
+            assert_eq!(guide.len(), m);
+            for b in 1..m {
+                let x = (b as f32 / m as f32).next_down();
+                rounded_up += usize::from((x * m as f32) as usize == b);
+                assert_eq!(
+                    invert_guided(&cdf, &guide, x),
+                    invert_cdf(&cdf, x),
+                    "m = {m}, x = {x}"
+                );
+            }
+        }
+        assert!(rounded_up > 0, "no case of rounding up was exercised");
     }
 
     #[test]

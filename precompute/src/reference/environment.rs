@@ -3,7 +3,8 @@
 
 use crate::color::Rgb;
 use crate::envmap::sampling::EnvSampler;
-use crate::envmap::{EnvMap, rotate_y};
+use crate::envmap::{EnvMap, YRotation};
+use crate::huge_pages::HugePageTable;
 use glam::{Vec2, Vec3, Vec4};
 
 /// Distant lighting `L(ω) = map(R_y(−rotation) ω)` (CONVENTIONS.md, "Rotating an environment").
@@ -12,8 +13,11 @@ pub struct EnvironmentLight<'a> {
     sampler: Option<EnvSampler>,
     /// Per texel: its radiance and its sampling density times `sin θ`, side by side, so a
     /// path escaping the scene reads one cache line for both.
-    texels: Vec<Vec4>,
-    rotation: f32,
+    texels: HugePageTable<Vec4>,
+    /// The map's rotation (map to world) and its inverse (world to map), each with its sine
+    /// and cosine computed once.
+    to_world: YRotation,
+    to_map: YRotation,
 }
 
 /// A texel of the map chosen ahead of its use (see [`EnvironmentLight::sample_texel`]).
@@ -28,20 +32,16 @@ impl<'a> EnvironmentLight<'a> {
     /// `rotation_deg` turns the map about +Y, counter-clockwise seen from above.
     pub fn new(map: &'a EnvMap, rotation_deg: f32) -> Self {
         let sampler = EnvSampler::new(map);
-        let texels = map
-            .texels()
-            .iter()
-            .enumerate()
-            .map(|(k, l)| {
-                let factor = sampler.as_ref().map_or(0.0, |s| s.texel_density_factor(k));
-                Vec4::new(l.x, l.y, l.z, factor)
-            })
-            .collect();
+        let texels = HugePageTable::new(map.texels().iter().enumerate().map(|(k, l)| {
+            let factor = sampler.as_ref().map_or(0.0, |s| s.texel_density_factor(k));
+            Vec4::new(l.x, l.y, l.z, factor)
+        }));
         Self {
             map,
             sampler,
             texels,
-            rotation: rotation_deg.to_radians(),
+            to_world: YRotation::new(rotation_deg.to_radians()),
+            to_map: YRotation::new(-rotation_deg.to_radians()),
         }
     }
 
@@ -52,7 +52,7 @@ impl<'a> EnvironmentLight<'a> {
     /// Radiance arriving from world direction `w`.
     #[inline]
     pub fn radiance(&self, w: Vec3) -> Rgb {
-        self.map.radiance(rotate_y(w, -self.rotation))
+        self.map.radiance(self.to_map.apply(w))
     }
 
     /// A world direction drawn proportionally to luminance × solid angle, with its density;
@@ -76,14 +76,14 @@ impl<'a> EnvironmentLight<'a> {
     #[inline]
     pub fn sample_texel(&self, u: Vec2) -> Option<(Vec3, PendingTexel)> {
         let (w, sin_theta, index) = self.sampler.as_ref()?.locate(u);
-        Some((rotate_y(w, self.rotation), self.pending(index, sin_theta)))
+        Some((self.to_world.apply(w), self.pending(index, sin_theta)))
     }
 
     /// The texel a path escaping along world direction `w` sees, asked of the cache now (as
     /// [`Self::sample_texel`]): computed before the ray that finds out whether it escapes.
     #[inline]
     pub fn escape_texel(&self, w: Vec3) -> PendingTexel {
-        let local = rotate_y(w, -self.rotation);
+        let local = self.to_map.apply(w);
         let (i, j) = self.map.texel_of(local);
         // From x and z, which keep their precision near the poles (unlike 1 − y²).
         let sin_theta = (local.x * local.x + local.z * local.z).sqrt();
@@ -120,7 +120,7 @@ impl<'a> EnvironmentLight<'a> {
     pub fn pdf(&self, w: Vec3) -> f32 {
         self.sampler
             .as_ref()
-            .map_or(0.0, |s| s.pdf(rotate_y(w, -self.rotation)))
+            .map_or(0.0, |s| s.pdf(self.to_map.apply(w)))
     }
 }
 

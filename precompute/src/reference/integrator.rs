@@ -9,6 +9,7 @@ use super::sampler::PathSampler;
 use crate::bake::RAY_OFFSET_FRACTION;
 use crate::bvh::{Hit, SceneBvh, Skip};
 use crate::color::{Rgb, luminance};
+use crate::huge_pages::HugePageTable;
 use crate::material::{Material, front_view, mirror, phong_lobe, sample_phong_lobe};
 use crate::sampling::{Frame, cosine_hemisphere};
 use crate::scene::{NO_TEXTURE, SceneMesh};
@@ -145,13 +146,13 @@ pub struct Integrator<'a> {
     offset: f32,
     /// The mesh's shading data regrouped so that a hit reads one record per corner and one
     /// per triangle (a path's hits land anywhere in the mesh: each read is a cache miss).
-    vertices: Vec<ShadingVertex>,
-    triangles: Vec<ShadingTriangle>,
+    vertices: HugePageTable<ShadingVertex>,
+    triangles: HugePageTable<ShadingTriangle>,
     /// Per triangle, its texture in `geometry.textures` or [`NO_TEXTURE`]; empty for an
     /// untextured scene, whose hits then read nothing more than before.
     triangle_textures: Vec<u32>,
     /// Per triangle, its material; empty for a diffuse scene.
-    triangle_materials: Vec<Material>,
+    triangle_materials: HugePageTable<Material>,
 }
 
 #[inline]
@@ -174,19 +175,15 @@ impl<'a> Integrator<'a> {
             light,
             bounces,
             offset: RAY_OFFSET_FRACTION * geometry.diagonal(),
-            vertices: (0..mesh.vertex_count())
-                .map(|v| ShadingVertex {
-                    position: mesh.positions[v],
-                    normal: mesh.normals[v],
-                    albedo: geometry.albedo[v],
-                })
-                .collect(),
-            triangles: (0..mesh.triangle_count())
-                .map(|t| ShadingTriangle {
-                    corners: mesh.triangles[t],
-                    front_normal: mesh.front_normal(t),
-                })
-                .collect(),
+            vertices: HugePageTable::new((0..mesh.vertex_count()).map(|v| ShadingVertex {
+                position: mesh.positions[v],
+                normal: mesh.normals[v],
+                albedo: geometry.albedo[v],
+            })),
+            triangles: HugePageTable::new((0..mesh.triangle_count()).map(|t| ShadingTriangle {
+                corners: mesh.triangles[t],
+                front_normal: mesh.front_normal(t),
+            })),
             triangle_textures: if geometry.is_textured() {
                 geometry.triangle_textures()
             } else {
@@ -196,7 +193,8 @@ impl<'a> Integrator<'a> {
                 geometry.triangle_materials()
             } else {
                 Vec::new()
-            },
+            }
+            .into(),
         }
     }
 
