@@ -129,10 +129,12 @@ struct ShadingVertex {
     albedo: Rgb,
 }
 
-/// What a hit reads of its triangle.
+/// What a hit reads of its triangle: its corners' records in one place (two cache lines,
+/// asked for together), not behind their indices.
 #[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
 struct ShadingTriangle {
-    corners: [u32; 3],
+    corners: [ShadingVertex; 3],
     front_normal: Vec3,
 }
 
@@ -144,9 +146,9 @@ pub struct Integrator<'a> {
     /// Indirect bounces after the first shading point (0: direct lighting only).
     pub bounces: u32,
     offset: f32,
-    /// The mesh's shading data regrouped so that a hit reads one record per corner and one
-    /// per triangle (a path's hits land anywhere in the mesh: each read is a cache miss).
-    vertices: HugePageTable<ShadingVertex>,
+    /// The mesh's shading data regrouped so that a hit reads one record, its triangle's,
+    /// with its corners inside (a path's hits land anywhere in the mesh: each read is a cache
+    /// miss, and a corner read through an index would wait on the triangle's).
     triangles: HugePageTable<ShadingTriangle>,
     /// Per triangle, its texture in `geometry.textures` or [`NO_TEXTURE`]; empty for an
     /// untextured scene, whose hits then read nothing more than before.
@@ -175,13 +177,15 @@ impl<'a> Integrator<'a> {
             light,
             bounces,
             offset: RAY_OFFSET_FRACTION * geometry.diagonal(),
-            vertices: HugePageTable::new((0..mesh.vertex_count()).map(|v| ShadingVertex {
-                position: mesh.positions[v],
-                normal: mesh.normals[v],
-                albedo: geometry.albedo[v],
-            })),
             triangles: HugePageTable::new((0..mesh.triangle_count()).map(|t| ShadingTriangle {
-                corners: mesh.triangles[t],
+                corners: mesh.triangles[t].map(|v| {
+                    let v = v as usize;
+                    ShadingVertex {
+                        position: mesh.positions[v],
+                        normal: mesh.normals[v],
+                        albedo: geometry.albedo[v],
+                    }
+                }),
                 front_normal: mesh.front_normal(t),
             })),
             triangle_textures: if geometry.is_textured() {
@@ -203,13 +207,11 @@ impl<'a> Integrator<'a> {
     pub fn surface(&self, hit: &Hit) -> SurfacePoint {
         let mesh = &self.geometry.mesh;
         let triangle = &self.triangles[hit.triangle as usize];
-        let corners = triangle.corners;
         let weights = hit.barycentrics();
         let mut position = Vec3::ZERO;
         let mut normal = Vec3::ZERO;
         let mut albedo = Rgb::ZERO;
-        for (i, w) in corners.iter().zip(weights) {
-            let vertex = &self.vertices[*i as usize];
+        for (vertex, w) in triangle.corners.iter().zip(weights) {
             position += vertex.position * w;
             normal += vertex.normal * w;
             albedo += vertex.albedo * w;
@@ -218,7 +220,7 @@ impl<'a> Integrator<'a> {
             && texture != NO_TEXTURE
         {
             // The texel's albedo (times the object's factor, interpolated above).
-            let uv: glam::Vec2 = corners
+            let uv: glam::Vec2 = mesh.triangles[hit.triangle as usize]
                 .iter()
                 .zip(weights)
                 .map(|(i, w)| mesh.uvs[*i as usize] * w)
