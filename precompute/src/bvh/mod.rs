@@ -135,14 +135,6 @@ impl SceneBvh {
         }
     }
 
-    fn segment(origin: Vec3, direction: Vec3, tmax: f32) -> SegmentRay {
-        SegmentRay {
-            origin: origin.into(),
-            direction: direction.into(),
-            tmax,
-        }
-    }
-
     /// Closest hit along `origin + t·direction`, `t` in `[tmin, tmax]`, ignoring `skip`.
     pub fn closest_hit(
         &self,
@@ -152,7 +144,11 @@ impl SceneBvh {
         tmax: f32,
         skip: Skip,
     ) -> Option<Hit> {
-        let mut ray = Self::segment(origin, direction, tmax);
+        let mut ray = SegmentRay {
+            origin: origin.into(),
+            direction: direction.into(),
+            tmax,
+        };
         let wide = WideRay::new(ray.origin, ray.direction, tmin);
         let mut closest = None;
         let mut stack = Stack::new();
@@ -217,15 +213,14 @@ impl SceneBvh {
         tmax: f32,
         skip: Skip,
     ) -> bool {
-        let ray = Self::segment(origin, direction, tmax);
-        let wide = WideRay::new(ray.origin, ray.direction, tmin);
+        let wide = WideRay::new(origin.into(), direction.into(), tmin);
         let mut stack = Stack::new();
         let Some(mut current) = self.tree.root() else {
             return false;
         };
         loop {
             if current.is_inner() {
-                let (_, mut entered) = self.tree.enter(current.index, &wide, ray.tmax);
+                let (_, mut entered) = self.tree.enter(current.index, &wide, tmax);
                 while entered != 0 {
                     let k = entered.trailing_zeros() as usize;
                     entered &= entered - 1;

@@ -36,8 +36,13 @@ pub fn direction_of_uv(u: f32, v: f32) -> Vec3 {
 pub fn uv_of_direction(w: Vec3) -> (f32, f32) {
     let u = w.x.atan2(-w.z) / TAU;
     let u = if u < 0.0 { u + 1.0 } else { u };
-    let v = w.y.clamp(-1.0, 1.0).acos() / PI;
-    (u.min(1.0 - f32::EPSILON), v)
+    (u.min(1.0 - f32::EPSILON), v_of_direction(w))
+}
+
+/// The `v` of [`uv_of_direction`] alone (no arctangent).
+#[inline]
+fn v_of_direction(w: Vec3) -> f32 {
+    w.y.clamp(-1.0, 1.0).acos() / PI
 }
 
 /// Rotation of a direction about +Y by `angle` radians (counter-clockwise seen from above).
@@ -147,7 +152,7 @@ impl EnvMap {
     #[inline]
     pub fn texel_of(&self, w: Vec3) -> (usize, usize) {
         // As `uv_of_direction`, whose `u` takes an arctangent: `column_of` mostly does not.
-        let v = w.y.clamp(-1.0, 1.0).acos() / PI;
+        let v = v_of_direction(w);
         (
             column::column_of(w, self.width),
             ((v * self.height as f32) as usize).min(self.height - 1),

@@ -165,19 +165,8 @@ impl EnvSampler {
 
     /// A direction (in the map's own frame) drawn with density [`Self::pdf`], and that density.
     pub fn sample(&self, u: Vec2) -> (Vec3, f32) {
-        let (w, pdf, _) = self.sample_texel(u);
-        (w, pdf)
-    }
-
-    /// [`Self::sample`], with the index `j · width + i` of the texel drawn (its radiance is
-    /// the map's there, so the caller need not look the direction up again).
-    pub fn sample_texel(&self, u: Vec2) -> (Vec3, f32, usize) {
         let (w, sin_theta, texel) = self.locate(u);
-        (
-            w,
-            self.density(self.texel_probability[texel], sin_theta),
-            texel,
-        )
+        (w, self.density(self.texel_probability[texel], sin_theta))
     }
 
     /// The direction `u` maps to, the sine of its polar angle and its texel's index, without
