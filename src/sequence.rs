@@ -189,7 +189,7 @@ pub fn lighting_at_frame(
     lighting.set_rotation(rotation_deg);
     for k in 0..=last {
         if k > 0 {
-            lighting.set_map(&sequence.frame(k)?);
+            lighting.set_map(sequence.frame(k)?);
         }
         lighting.decompose();
     }

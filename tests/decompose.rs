@@ -112,14 +112,14 @@ fn every_bundled_map_decomposes_with_only_the_sanitize_warning() {
 }
 
 #[test]
-fn dwab_compression_and_bad_layouts_fail_cleanly() {
+fn undecodable_compression_and_bad_layouts_fail_cleanly() {
     let dir = tempfile::tempdir().unwrap();
-    let dwab = scene("env/venice_dwab.exr");
+    let htj2k = repo().join("tests/data/htj2k.exr");
     let out = hprt(
         dir.path(),
-        &["decompose", dwab.to_str().unwrap(), "-o", "x.json"],
+        &["decompose", htj2k.to_str().unwrap(), "-o", "x.json"],
     );
-    assert_clean_failure(&out, &["venice_dwab.exr", "DWAB", "convert"]);
+    assert_clean_failure(&out, &["htj2k.exr", "HTJ2K256", "convert"]);
     assert!(!dir.path().join("x.json").exists());
 
     let sunrise = scene("env/sunrise.exr");

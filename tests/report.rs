@@ -118,7 +118,7 @@ fn report_measures_shadows_and_survives_bad_maps() {
     let garbage = dir.join("garbage.exr");
     std::fs::write(&garbage, b"not an exr").unwrap();
     let sunrise = scene("env/sunrise.exr");
-    let venice = scene("env/venice_dwab.exr");
+    let htj2k = repo().join("tests/data/htj2k.exr");
     let report_dir = dir.join("out");
     let teapot = scene("teapot.toml");
     let args = [
@@ -128,7 +128,7 @@ fn report_measures_shadows_and_survives_bad_maps() {
         bake.to_str().unwrap(),
         "--envs",
         sunrise.to_str().unwrap(),
-        venice.to_str().unwrap(),
+        htj2k.to_str().unwrap(),
         garbage.to_str().unwrap(),
         "--width",
         "160",
@@ -159,16 +159,16 @@ fn report_measures_shadows_and_survives_bad_maps() {
     assert_eq!(maps.len(), 3);
 
     // The maps that cannot be read are reported as failed, with the reason.
-    for (map, reason) in [(&maps[1], "DWAB"), (&maps[2], "garbage.exr")] {
+    for (map, reason) in [(&maps[1], "HTJ2K256"), (&maps[2], "garbage.exr")] {
         assert_eq!(map["status"], "failed");
         let error = map["error"].as_str().unwrap();
         assert!(error.contains(reason), "{error}");
         assert!(!report_dir.join(map["name"].as_str().unwrap()).exists());
     }
     let html = std::fs::read_to_string(report_dir.join("report.html")).unwrap();
-    assert!(html.contains("venice_dwab") && html.contains("Maps that failed"));
+    assert!(html.contains("htj2k") && html.contains("Maps that failed"));
     let csv = std::fs::read_to_string(report_dir.join("stats.csv")).unwrap();
-    assert!(csv.contains("venice_dwab,failed"));
+    assert!(csv.contains("htj2k,failed"));
 
     // The working map: every statistic in stats.json is what its images give.
     let sunrise_report = &maps[0];

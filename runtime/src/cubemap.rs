@@ -205,11 +205,36 @@ impl CubeMap {
 /// texels around it), so the per-frame resampling reads little memory.
 pub struct CubeSource {
     map: EnvMap,
+    /// The size of the map as given.
+    given: (usize, usize),
     resampler: CubeResampler,
 }
 
 impl CubeSource {
     pub fn new(map: &EnvMap, face_size: usize) -> Self {
+        let given = (map.width(), map.height());
+        let map = Self::averaged(map, face_size);
+        let resampler = CubeResampler::new(face_size, map.width(), map.height());
+        Self {
+            map,
+            given,
+            resampler,
+        }
+    }
+
+    /// Replaces the map (the next frame of a changing environment); the resampler, the costly
+    /// part to set up, is kept when the new map has the old one's size.
+    pub fn set_map(&mut self, map: &EnvMap) {
+        if (map.width(), map.height()) != self.given {
+            *self = Self::new(map, self.face_size());
+            return;
+        }
+        self.map = Self::averaged(map, self.face_size());
+    }
+
+    /// `map` averaged down by the largest power of two that leaves at least `4 × face_size`
+    /// texels around the equator.
+    fn averaged(map: &EnvMap, face_size: usize) -> EnvMap {
         let mut factor = 1;
         while map.width() / (2 * factor) >= 4 * face_size
             && map.width().is_multiple_of(2 * factor)
@@ -217,13 +242,11 @@ impl CubeSource {
         {
             factor *= 2;
         }
-        let map = if factor > 1 {
+        if factor > 1 {
             map.downsampled(factor)
         } else {
             map.clone()
-        };
-        let resampler = CubeResampler::new(face_size, map.width(), map.height());
-        Self { map, resampler }
+        }
     }
 
     /// The (possibly averaged-down) map the cube maps are made from.
@@ -392,6 +415,21 @@ impl CubeResampler {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A new map of the same size reuses the resampler and gives the cube a fresh source
+    /// would; one of another size gets a resampler of its own.
+    #[test]
+    fn a_source_given_a_new_map_resamples_it_as_a_new_source_would() {
+        let first = EnvMap::from_fn(128, 64, 1, |w| Rgb::new(1.0 + w.x, 2.0, 1.0 + w.y));
+        let second = EnvMap::from_fn(128, 64, 1, |w| Rgb::new(3.0, 1.0 + w.z, 2.0 + w.y));
+        let third = EnvMap::from_fn(64, 32, 1, |w| Rgb::splat(1.5 + w.x));
+        let mut source = CubeSource::new(&first, 8);
+        for map in [&second, &third] {
+            source.set_map(map);
+            let fresh = CubeSource::new(map, 8);
+            assert_eq!(source.cube(0.4).texels(), fresh.cube(0.4).texels());
+        }
+    }
 
     #[test]
     fn cone_query_matches_brute_force() {

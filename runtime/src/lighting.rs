@@ -9,7 +9,7 @@
 //! - [`FrameLighting::for_mode`]: what each render mode draws.
 
 use crate::cubemap::{CubeGeometry, CubeMap, CubeSource};
-use crate::decompose::source_size::measure_sources;
+use crate::decompose::source_size::SourceMeter;
 use crate::decompose::{
     DecomposeError, DecomposeMode, DecomposeSettings, Decomposer, Decomposition,
 };
@@ -199,6 +199,8 @@ pub struct EnvironmentLighting {
     settings: DecomposeSettings,
     /// Built from `settings`, at the tracker's leaving threshold when tracking.
     decomposer: Decomposer,
+    /// Measures the sources behind the lights on the full-resolution map.
+    sources: SourceMeter,
     tracker: Option<LightTracker>,
     /// Map frame → world.
     orientation: Quat,
@@ -237,6 +239,7 @@ impl EnvironmentLighting {
             cube: None,
             settings,
             decomposer,
+            sources: SourceMeter::new(),
             tracker: None,
             orientation: Quat::IDENTITY,
             decomposition: None,
@@ -348,7 +351,7 @@ impl EnvironmentLighting {
             let decomposer = self.sh_sun_decomposer.as_mut().expect("made above");
             let cube = self.cube.get_or_insert_with(|| self.source.cube(0.0));
             let mut decomposition = decomposer.decompose(cube);
-            measure_sources(&self.map, &mut decomposition.lights);
+            self.sources.measure(&self.map, &mut decomposition.lights);
             self.sh_sun = Some(decomposition);
         }
         Ok(rotate_decomposition(
@@ -364,9 +367,9 @@ impl EnvironmentLighting {
 
     /// Replaces the map (the next frame of a changing environment); settings, orientation and
     /// tracked lights stay.
-    pub fn set_map(&mut self, map: &EnvMap) {
-        self.map = map.clone();
-        self.source = CubeSource::new(map, self.settings.face_size);
+    pub fn set_map(&mut self, map: EnvMap) {
+        self.source.set_map(&map);
+        self.map = map;
         self.invalidate();
     }
 
@@ -455,7 +458,7 @@ impl EnvironmentLighting {
         let cube = self.cube.get_or_insert_with(|| self.source.cube(0.0));
         self.tracked = None;
         let mut decomposition = self.decomposer.decompose(cube);
-        measure_sources(&self.map, &mut decomposition.lights);
+        self.sources.measure(&self.map, &mut decomposition.lights);
         self.decomposition.insert(decomposition)
     }
 
@@ -469,7 +472,7 @@ impl EnvironmentLighting {
         for light in &mut decomposition.lights {
             light.direction = to_map * light.direction;
         }
-        measure_sources(&self.map, &mut decomposition.lights);
+        self.sources.measure(&self.map, &mut decomposition.lights);
         for light in &mut decomposition.lights {
             light.direction = (to_map.inverse() * light.direction).normalize();
         }
@@ -775,7 +778,7 @@ mod tests {
             .unwrap()
             .decompose(&CubeSource::new(&map, 64).cube(0.0));
         // The source's size measured on the full-resolution map: a disc of acos(0.999).
-        measure_sources(&map, &mut in_map_frame.lights);
+        crate::decompose::source_size::measure_sources(&map, &mut in_map_frame.lights);
         let radius = in_map_frame.lights[0].angular_radius;
         assert!((radius - 0.999f32.acos()).abs() < 0.2 * radius, "{radius}");
         let by_hand = rotate_decomposition(&in_map_frame, Quat::from_rotation_y(FRAC_PI_2));
@@ -825,7 +828,7 @@ mod tests {
         for k in 0..frames {
             let sun = arc.at(k as f32 / (frames - 1) as f32);
             let map = sun.over(&sky);
-            lighting.set_map(&map);
+            lighting.set_map(map.clone());
             let d = lighting.decompose();
             let light = d
                 .lights

@@ -54,7 +54,9 @@ pub struct BenchTurnArgs {
         "scenes/env/forest.exr",
         "scenes/env/hall.exr",
         "scenes/env/interior.exr",
+        "scenes/env/studio.hdr",
         "scenes/env/sunrise.exr",
+        "scenes/env/venice_dwab.exr",
     ])]
     pub maps: Vec<PathBuf>,
     /// Degrees per step (a full turn is taken).

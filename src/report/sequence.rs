@@ -247,7 +247,7 @@ pub fn write_sequence_report(
         for (m, method) in SequenceMethod::ALL.iter().enumerate() {
             let lighting = &mut lightings[m];
             if k > 0 {
-                lighting.set_map(&map);
+                lighting.set_map(map.clone());
             }
             let frame = lighting.frame(method.render_mode(), None);
             renderer.set_lighting(&frame.lighting)?;

@@ -367,7 +367,7 @@ impl App {
             // Looping: start the tracking afresh, as on the first frame.
             env.enable_tracking(Some(runtime::TrackingSettings::default()))?;
         }
-        env.set_map(&sequence.frame(*frame)?);
+        env.set_map(sequence.frame(*frame)?);
         if let Some(renderer) = self.window.renderer.as_mut() {
             renderer.set_environment(env.map(), self.settings.rotation_deg);
             if let Some(gpu) = self.window.gpu.as_mut() {

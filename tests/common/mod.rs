@@ -35,6 +35,16 @@ pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
+/// The lines of `out`'s stderr that report an error (the logger's `error:` lines, a wgpu-hal
+/// complaint among them), as opposed to warnings that quote the word.
+pub fn error_lines(out: &Output) -> Vec<String> {
+    stderr(out)
+        .lines()
+        .filter(|l| l.trim_start().starts_with("error"))
+        .map(str::to_owned)
+        .collect()
+}
+
 pub fn stdout(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
@@ -92,10 +102,26 @@ pub fn bake_teapot(dir: &Path, name: &str, settings: &[&str]) -> PathBuf {
     output
 }
 
-/// The (software) GPU adapter the renderer tests draw with.
-pub fn gpu() -> runtime::render::GpuContext {
-    runtime::render::GpuContext::headless(runtime::render::Backend::Auto)
-        .expect("a (software) GPU adapter; run tests/run.sh to install one")
+/// The graphics backends every GPU test runs on: Vulkan (lavapipe on a machine without a GPU)
+/// and OpenGL (llvmpipe), which a newcomer without a Vulkan driver gets.
+pub const BACKENDS: [runtime::render::Backend; 2] = [
+    runtime::render::Backend::Vulkan,
+    runtime::render::Backend::Gl,
+];
+
+/// A device on each of [`BACKENDS`]; a missing adapter fails the test, saying how to install
+/// it. Tests draw on each and check each against the CPU's answer.
+pub fn gpus() -> Vec<runtime::render::GpuContext> {
+    BACKENDS
+        .iter()
+        .map(|&backend| {
+            let gpu = runtime::render::GpuContext::headless(backend)
+                .unwrap_or_else(|e| panic!("{e} (tests/run.sh installs both software drivers)"));
+            // Shown with a failing test's output: which adapter drew what failed.
+            eprintln!("drawing on {}", gpu.description());
+            gpu
+        })
+        .collect()
 }
 
 /// One frame of `geometry` under `lighting`, without the background.

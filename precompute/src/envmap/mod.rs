@@ -195,12 +195,11 @@ impl EnvMap {
         let mut texels = Vec::with_capacity(w * h);
         for j in 0..h {
             let rows = j * factor..(j + 1) * factor;
-            let weight: f32 =
-                rows.clone().map(|r| self.texel_solid_angle(r)).sum::<f32>() * factor as f32;
+            let d_omegas: Vec<f32> = rows.clone().map(|r| self.texel_solid_angle(r)).collect();
+            let weight: f32 = d_omegas.iter().sum::<f32>() * factor as f32;
             for i in 0..w {
                 let mut sum = Rgb::ZERO;
-                for r in rows.clone() {
-                    let d_omega = self.texel_solid_angle(r);
+                for (r, &d_omega) in rows.clone().zip(&d_omegas) {
                     let start = r * self.width + i * factor;
                     sum += self.texels[start..start + factor].iter().sum::<Rgb>() * d_omega;
                 }

@@ -540,8 +540,16 @@ impl Decomposer {
         // SH basis at the cap texels, evaluated once per frame.
         let n = self.basis.num_coeffs();
         self.member_basis.resize(members.len() * n, 0.0);
+        // At the analysis resolution the projector has the basis at every texel already.
+        let table = self
+            .downsample
+            .is_empty()
+            .then(|| self.projector.texel_basis());
         for (row, &t) in self.member_basis.chunks_exact_mut(n).zip(&members) {
-            self.basis.eval(self.geometry.directions()[t as usize], row);
+            match table {
+                Some(table) => row.copy_from_slice(table.row(t as usize)),
+                None => self.basis.eval(self.geometry.directions()[t as usize], row),
+            }
         }
         let mut sh = full.clone();
         let mut excess: Vec<Rgb> = vec![Rgb::ZERO; members.len()];

@@ -6,22 +6,32 @@ use glam::Vec3;
 use precompute::Rgb;
 use precompute::sh::{ShBasis, ShCoeffs, num_coeffs};
 
-/// SH basis values at a fixed set of directions (`values[i · n² + k] = Y_k(d_i)`).
+/// SH basis values at a fixed set of directions: row `i` holds `Y_k(d_i)` for the `n²` k,
+/// padded with zeros to a multiple of [`LANES`] so that whole rows vectorize.
 #[derive(Debug, Clone)]
 pub struct BasisTable {
     order: usize,
+    stride: usize,
     values: Vec<f32>,
 }
+
+/// The widest vector of f32 the projection loop is written for (AVX: 8).
+const LANES: usize = 8;
 
 impl BasisTable {
     pub fn new(order: usize, directions: &[Vec3]) -> Self {
         let basis = ShBasis::<f32>::new(order).expect("a supported SH order");
         let n = basis.num_coeffs();
-        let mut values = vec![0.0; directions.len() * n];
-        for (d, row) in directions.iter().zip(values.chunks_exact_mut(n)) {
-            basis.eval(*d, row);
+        let stride = n.next_multiple_of(LANES);
+        let mut values = vec![0.0; directions.len() * stride];
+        for (d, row) in directions.iter().zip(values.chunks_exact_mut(stride)) {
+            basis.eval(*d, &mut row[..n]);
         }
-        Self { order, values }
+        Self {
+            order,
+            stride,
+            values,
+        }
     }
 
     pub fn order(&self) -> usize {
@@ -30,8 +40,12 @@ impl BasisTable {
 
     #[inline]
     pub fn row(&self, i: usize) -> &[f32] {
-        let n = num_coeffs(self.order);
-        &self.values[i * n..(i + 1) * n]
+        &self.values[i * self.stride..][..num_coeffs(self.order)]
+    }
+
+    /// Every row with its padding.
+    fn padded_rows(&self) -> std::slice::ChunksExact<'_, f32> {
+        self.values.chunks_exact(self.stride)
     }
 
     /// Value of `coeffs` in direction `i` (bands beyond the table's order are ignored).
@@ -43,6 +57,20 @@ impl BasisTable {
             sum += *c * *y;
         }
         sum
+    }
+}
+
+/// `(r, g, b)[k] += l · basis[k]` for every k (each sum in the same order as a plain loop, so
+/// the same floats; over slices of one length, so that it vectorizes).
+#[inline]
+fn accumulate(sums: &mut [Vec<f32>; 3], l: Rgb, basis: &[f32]) {
+    let n = basis.len();
+    let [r, g, b] = sums;
+    let (r, g, b) = (&mut r[..n], &mut g[..n], &mut b[..n]);
+    for k in 0..n {
+        r[k] += l.x * basis[k];
+        g[k] += l.y * basis[k];
+        b[k] += l.z * basis[k];
     }
 }
 
@@ -73,15 +101,20 @@ impl ShProjector {
     /// `SH(L)_k = Σ_t L_t Y_k(ω_t) Δω_t`.
     pub fn project(&self, map: &CubeMap) -> ShCoeffs<Rgb> {
         let n = num_coeffs(self.table.order);
-        let (mut r, mut g, mut b) = (vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]);
-        for (t, (c, d_omega)) in map.texels().iter().zip(&self.solid_angles).enumerate() {
+        let stride = self.table.stride;
+        let mut sums = [
+            vec![0.0f32; stride],
+            vec![0.0f32; stride],
+            vec![0.0f32; stride],
+        ];
+        let rows = self.table.padded_rows();
+        for ((c, d_omega), y) in map.texels().iter().zip(&self.solid_angles).zip(rows) {
             let l = *c * *d_omega;
-            let y = self.table.row(t);
-            for k in 0..n {
-                r[k] += l.x * y[k];
-                g[k] += l.y * y[k];
-                b[k] += l.z * y[k];
-            }
+            accumulate(&mut sums, l, y);
+        }
+        let [mut r, mut g, mut b] = sums;
+        for channel in [&mut r, &mut g, &mut b] {
+            channel.truncate(n);
         }
         Self::collect(r, g, b)
     }
@@ -89,16 +122,13 @@ impl ShProjector {
     /// Projection of a map that is zero except at the listed texels.
     pub fn project_sparse(&self, texels: impl Iterator<Item = (u32, Rgb)>) -> ShCoeffs<Rgb> {
         let n = num_coeffs(self.table.order);
-        let (mut r, mut g, mut b) = (vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]);
+        let mut sums = [vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]];
         for (t, c) in texels {
             let l = c * self.solid_angles[t as usize];
             let y = self.table.row(t as usize);
-            for k in 0..n {
-                r[k] += l.x * y[k];
-                g[k] += l.y * y[k];
-                b[k] += l.z * y[k];
-            }
+            accumulate(&mut sums, l, y);
         }
+        let [r, g, b] = sums;
         Self::collect(r, g, b)
     }
 

@@ -29,44 +29,296 @@ const BACKGROUND_RADIUS: f32 = 30.0 * PI / 180.0;
 /// The region of a source is searched this far from its light at most.
 const MAX_SOURCE_RADIUS: f32 = 45.0 * PI / 180.0;
 
-/// Equirectangular texels `(i, j)` within `radius` of `centre` (rows by polar angle, then the
-/// columns of each row whose azimuth can be that close).
-fn texels_within(map: &EnvMap, centre: Vec3, radius: f32) -> Vec<(usize, usize)> {
-    let (w, h) = (map.width(), map.height());
-    let theta = centre.y.clamp(-1.0, 1.0).acos();
-    let row_angle = PI / h as f32;
-    let first = (((theta - radius) / row_angle).floor().max(0.0)) as usize;
-    let last = ((((theta + radius) / row_angle).ceil()) as usize).min(h);
-    let cos_radius = radius.cos();
-    let centre_u = precompute::envmap::uv_of_direction(centre).0 * w as f32;
-    let mut out = Vec::new();
-    for j in first..last {
-        // Columns to test: all of them near a pole, else an azimuth window around the centre's.
-        let sin_row = ((j as f32 + 0.5) * row_angle).sin();
-        let half_width = if sin_row * PI <= radius * 2.0 || theta < radius || PI - theta < radius {
-            w as f32
-        } else {
-            (radius / sin_row) / (2.0 * PI) * w as f32 * 1.5 + 2.0
-        };
-        let span = (2.0 * half_width).min(w as f32) as usize;
-        let start = (centre_u - half_width.min(w as f32 / 2.0)).floor() as isize;
-        for k in 0..span.max(1) {
-            let i = (start + k as isize).rem_euclid(w as isize) as usize;
-            if map.texel_direction(i, j).dot(centre) >= cos_radius {
-                out.push((i, j));
+/// The texel directions of an equirectangular map size, tabulated by row and column (the same
+/// floats as [`EnvMap::texel_direction`], without two sines per texel), and each row's texel
+/// solid angle: the measurement visits tens of thousands of texels per light every frame.
+#[derive(Debug, Clone, PartialEq)]
+struct EquirectTexels {
+    /// `(sin φ, cos φ)` of each column's centre.
+    columns: Vec<(f32, f32)>,
+    /// `(sin θ, cos θ)` of each row's centre.
+    rows: Vec<(f32, f32)>,
+    solid_angles: Vec<f32>,
+}
+
+impl EquirectTexels {
+    fn new(width: usize, height: usize) -> Self {
+        let columns = (0..width)
+            .map(|i| (std::f32::consts::TAU * ((i as f32 + 0.5) / width as f32)).sin_cos())
+            .collect();
+        let rows = (0..height)
+            .map(|j| (PI * ((j as f32 + 0.5) / height as f32)).sin_cos())
+            .collect();
+        let shape = EnvMap::uniform(width, height, precompute::Rgb::ZERO);
+        Self {
+            columns,
+            rows,
+            solid_angles: (0..height).map(|j| shape.texel_solid_angle(j)).collect(),
+        }
+    }
+}
+
+/// A map seen through its tabulated texels.
+struct TexelTable<'a> {
+    map: &'a EnvMap,
+    texels: &'a EquirectTexels,
+}
+
+impl TexelTable<'_> {
+    fn width(&self) -> usize {
+        self.map.width()
+    }
+
+    fn height(&self) -> usize {
+        self.map.height()
+    }
+
+    #[inline]
+    fn direction(&self, (i, j): (usize, usize)) -> Vec3 {
+        let ((sin_phi, cos_phi), (sin_theta, cos_theta)) =
+            (self.texels.columns[i], self.texels.rows[j]);
+        Vec3::new(sin_theta * sin_phi, cos_theta, -sin_theta * cos_phi)
+    }
+
+    #[inline]
+    fn luminance(&self, (i, j): (usize, usize)) -> f32 {
+        luminance(self.map.texel(i, j))
+    }
+
+    #[inline]
+    fn solid_angle(&self, (_, j): (usize, usize)) -> f32 {
+        self.texels.solid_angles[j]
+    }
+
+    /// Calls `visit` for each texel `(i, j)` within `radius` of `centre`: rows by polar angle,
+    /// then in each row the columns of an azimuth window around the centre's, in increasing
+    /// azimuth from the window's start (wrapping). Only the part of the window that can be
+    /// that close (with two texels' margin) is tested.
+    fn for_each_within(&self, centre: Vec3, radius: f32, mut visit: impl FnMut((usize, usize))) {
+        let (w, h) = (self.width(), self.height());
+        let theta = centre.y.clamp(-1.0, 1.0).acos();
+        let row_angle = PI / h as f32;
+        let first = (((theta - radius) / row_angle).floor().max(0.0)) as usize;
+        let last = ((((theta + radius) / row_angle).ceil()) as usize).min(h);
+        let cos_radius = radius.cos();
+        let centre_u = precompute::envmap::uv_of_direction(centre).0 * w as f32;
+        let column_angle = std::f64::consts::TAU / w as f64;
+        for j in first..last {
+            // Columns to test: all of them near a pole, else a window around the centre's.
+            let sin_row = ((j as f32 + 0.5) * row_angle).sin();
+            let half_width =
+                if sin_row * PI <= radius * 2.0 || theta < radius || PI - theta < radius {
+                    w as f32
+                } else {
+                    (radius / sin_row) / (2.0 * PI) * w as f32 * 1.5 + 2.0
+                };
+            let span = (2.0 * half_width).min(w as f32) as usize;
+            let start = (centre_u - half_width.min(w as f32 / 2.0)).floor() as isize;
+            // The columns whose azimuth is within Δφ of the centre's, where
+            // cos Δφ = (cos R − cos θ cos θ_c) / (sin θ sin θ_c), lie within `reach` columns
+            // of the centre's position in the window (exact in f64, then widened).
+            let reach = if half_width >= w as f32 {
+                w as f64
+            } else {
+                // Away from the poles: sin θ and sin θ_c are both well above zero here. The
+                // f32 test can pass a texel up to ~1e-6 below cos R (rounding in the tables
+                // and the dot product): widen the bound by that, then by two columns.
+                let (sin_theta, cos_theta) = self.texels.rows[j];
+                let (sin_c, cos_c) = (f64::from(theta).sin(), f64::from(theta).cos());
+                let across = f64::from(sin_theta) * sin_c;
+                let q = (f64::from(cos_radius) - f64::from(cos_theta) * cos_c - 1e-6) / across;
+                q.clamp(-1.0, 1.0).acos() / column_angle + 2.0
+            };
+            let centre_k = f64::from(centre_u) - start as f64;
+            let k_first = (centre_k - reach).floor().max(0.0) as usize;
+            let k_last = ((centre_k + reach).ceil().max(0.0) as usize).min(span.max(1));
+            let mut i = (start + k_first as isize).rem_euclid(w as isize) as usize;
+            for _ in k_first..k_last {
+                if self.direction((i, j)).dot(centre) >= cos_radius {
+                    visit((i, j));
+                }
+                i = if i + 1 == w { 0 } else { i + 1 };
             }
         }
     }
+}
+
+impl TexelTable<'_> {
+    /// Appends the luminance ([`order_key`]) of every texel within `radius` of `centre` to
+    /// `out` (the same texels as [`Self::for_each_within`], in no particular order). In each row, the columns
+    /// that are certainly inside (by more than the test's rounding) are read in bulk, and only
+    /// those near the cap's rim are tested.
+    fn luminances_within(&self, centre: Vec3, radius: f32, out: &mut Vec<u32>) {
+        let (w, h) = (self.width(), self.height());
+        let theta = centre.y.clamp(-1.0, 1.0).acos();
+        let row_angle = PI / h as f32;
+        let first = (((theta - radius) / row_angle).floor().max(0.0)) as usize;
+        let last = ((((theta + radius) / row_angle).ceil()) as usize).min(h);
+        let cos_radius = radius.cos();
+        let centre_u = f64::from(precompute::envmap::uv_of_direction(centre).0) * w as f64;
+        let column_angle = std::f64::consts::TAU / w as f64;
+        let (sin_c, cos_c) = (f64::from(theta).sin(), f64::from(theta).cos());
+        let texels = self.map.texels();
+        for j in first..last {
+            let (sin_theta, cos_theta) = self.texels.rows[j];
+            let across = f64::from(sin_theta) * sin_c;
+            let level = f64::from(cos_radius) - f64::from(cos_theta) * cos_c;
+            // cos Δφ ≥ level / across inside the cap; with the rounding allowance either way.
+            let half_columns = |slack: f64| -> f64 {
+                if across < 1e-9 {
+                    return if slack > 0.0 { -1.0 } else { w as f64 };
+                }
+                let q = (level + slack) / across;
+                if q > 1.0 {
+                    -1.0
+                } else {
+                    q.max(-1.0).acos() / column_angle
+                }
+            };
+            let inner = half_columns(4e-6) - 1.0;
+            let outer = half_columns(-4e-6) + 1.0;
+            let row = &texels[j * w..(j + 1) * w];
+            let (inside, near) = (
+                column_range(centre_u, inner, w),
+                column_range(centre_u, outer, w),
+            );
+            for (a, b) in inside.segments(w) {
+                out.extend(row[a..b].iter().map(|c| order_key(luminance(*c))));
+            }
+            for band in near.minus(inside, w) {
+                for (a, b) in band.segments(w) {
+                    for (i, texel) in row.iter().enumerate().take(b).skip(a) {
+                        if self.direction((i, j)).dot(centre) >= cos_radius {
+                            out.push(order_key(luminance(*texel)));
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Columns `first, first + 1, …` (`count` of them, wrapping at the map's width).
+#[derive(Debug, Clone, Copy)]
+struct ColumnRange {
+    first: usize,
+    count: usize,
+}
+
+/// The columns whose centres lie within `half` columns of position `centre` (in columns,
+/// from the map's left edge).
+fn column_range(centre: f64, half: f64, width: usize) -> ColumnRange {
+    if half < 0.0 {
+        return ColumnRange { first: 0, count: 0 };
+    }
+    // Column i's centre is at i + 0.5.
+    let first = (centre - 0.5 - half).ceil();
+    let last = (centre - 0.5 + half).floor();
+    let count = (last - first + 1.0).max(0.0);
+    if count >= width as f64 {
+        return ColumnRange {
+            first: 0,
+            count: width,
+        };
+    }
+    ColumnRange {
+        first: first.rem_euclid(width as f64) as usize % width,
+        count: count as usize,
+    }
+}
+
+impl ColumnRange {
+    /// The range as at most two index ranges of a row.
+    fn segments(self, width: usize) -> impl Iterator<Item = (usize, usize)> {
+        let end = self.first + self.count;
+        let head = (self.first, end.min(width));
+        let tail = (0, end.saturating_sub(width));
+        [head, tail].into_iter().filter(|(a, b)| a < b)
+    }
+
+    /// The columns of `self` outside `inner` (which lies within it, centred alike): a band on
+    /// each side.
+    fn minus(self, inner: ColumnRange, width: usize) -> [ColumnRange; 2] {
+        let none = ColumnRange { first: 0, count: 0 };
+        if inner.count == 0 {
+            return [self, none];
+        }
+        if self.count == width {
+            // The whole row (which starts anywhere): the rest of it after `inner`.
+            let rest = ColumnRange {
+                first: (inner.first + inner.count) % width,
+                count: width - inner.count,
+            };
+            return [rest, none];
+        }
+        let left = (inner.first + width - self.first) % width;
+        let left = left.min(self.count - inner.count);
+        [
+            ColumnRange {
+                first: self.first,
+                count: left,
+            },
+            ColumnRange {
+                first: (inner.first + inner.count) % width,
+                count: self.count - inner.count - left,
+            },
+        ]
+    }
+}
+
+/// Equirectangular texels `(i, j)` within `radius` of `centre` (rows by polar angle, then the
+/// columns of each row whose azimuth can be that close).
+#[cfg(test)]
+fn texels_within(map: &EnvMap, centre: Vec3, radius: f32) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let texels = EquirectTexels::new(map.width(), map.height());
+    TexelTable {
+        map,
+        texels: &texels,
+    }
+    .for_each_within(centre, radius, |t| out.push(t));
     out
 }
 
-/// The median of `values` (0 when empty).
-fn median(mut values: Vec<f32>) -> f32 {
-    if values.is_empty() {
+/// `total_cmp`'s order as unsigned integers: flip the sign bit of positives, every bit of
+/// negatives.
+#[inline]
+fn order_key(v: f32) -> u32 {
+    let bits = v.to_bits();
+    bits ^ (((bits as i32) >> 31) as u32 | 1 << 31)
+}
+
+/// The median of the floats whose [`order_key`]s are `keys` (0 when empty): the element at
+/// index `len / 2` in `total_cmp` order, found by radix selection (a histogram of the top
+/// bits, then of the next among the candidates left; no comparison sort). `keys` is used as
+/// scratch.
+fn median_of_keys(keys: &mut Vec<u32>) -> f32 {
+    if keys.is_empty() {
         return 0.0;
     }
-    let mid = values.len() / 2;
-    *values.select_nth_unstable_by(mid, f32::total_cmp).1
+    let mut rank = keys.len() / 2;
+    let mut shift = 32;
+    let mut prefix = 0u32;
+    for bits in [11u32, 11, 10] {
+        shift -= bits;
+        let mut counts = [0u32; 1 << 11];
+        for k in keys.iter() {
+            counts[((k >> shift) & ((1 << bits) - 1)) as usize] += 1;
+        }
+        let mut digit = 0;
+        while rank >= counts[digit] as usize {
+            rank -= counts[digit] as usize;
+            digit += 1;
+        }
+        prefix = prefix << bits | digit as u32;
+        keys.retain(|k| k >> shift == prefix);
+        if keys.len() == 1 || shift == 0 {
+            break;
+        }
+    }
+    let key = keys[rank.min(keys.len() - 1)];
+    // Undo `order_key`.
+    f32::from_bits(if key >> 31 == 1 { key ^ 1 << 31 } else { !key })
 }
 
 /// The angular radius of the disc of solid angle `omega`.
@@ -85,128 +337,240 @@ pub struct SourceShape {
     pub core_fraction: f32,
 }
 
-/// The measured shape of the source behind each light `directions[k]` (unit, in the map's
-/// frame), searched from its peak within `cap_radius`; `None` where the map has no peak above
-/// its background there.
+/// Measures the sources behind lights ([`Self::shapes`], [`Self::measure`]), keeping its
+/// tables and buffers from call to call: a changing map is measured every frame.
+#[derive(Default)]
+pub struct SourceMeter {
+    texels: Option<EquirectTexels>,
+    scratch: Scratch,
+}
+
+impl SourceMeter {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The measured shape of the source behind each light `directions[k]` (unit, in the map's
+    /// frame), searched from its peak within `cap_radius`; `None` where the map has no peak
+    /// above its background there.
+    pub fn shapes(
+        &mut self,
+        map: &EnvMap,
+        directions: &[Vec3],
+        cap_radius: f32,
+    ) -> Vec<Option<SourceShape>> {
+        let (w, h) = (map.width(), map.height());
+        let texels = match &mut self.texels {
+            Some(t) if t.columns.len() == w && t.rows.len() == h => t,
+            slot => slot.insert(EquirectTexels::new(w, h)),
+        };
+        self.scratch.core.fit(w, h);
+        let table = TexelTable { map, texels };
+        (0..directions.len())
+            .map(|k| source_shape(&table, directions, k, cap_radius, &mut self.scratch))
+            .collect()
+    }
+
+    /// Sets each light's angular radius, halo and core fraction (its directions in the map's
+    /// frame) to the measured shape of its source, where the map has one; the others keep the
+    /// decomposition's estimate.
+    pub fn measure(&mut self, map: &EnvMap, lights: &mut [crate::light::DirectionalLight]) {
+        let Some(cap_radius) = lights.iter().map(|l| l.cap_radius).reduce(f32::max) else {
+            return;
+        };
+        let directions: Vec<Vec3> = lights.iter().map(|l| l.direction).collect();
+        for (light, shape) in lights
+            .iter_mut()
+            .zip(self.shapes(map, &directions, cap_radius))
+        {
+            if let Some(shape) = shape {
+                light.angular_radius = shape.radius;
+                light.halo_radius = shape.halo_radius;
+                light.core_fraction = shape.core_fraction;
+            }
+        }
+    }
+}
+
+/// [`SourceMeter::shapes`] once.
 pub fn source_shapes(
     map: &EnvMap,
     directions: &[Vec3],
     cap_radius: f32,
 ) -> Vec<Option<SourceShape>> {
-    let nearest_light = |w: Vec3| {
-        directions
-            .iter()
-            .enumerate()
-            .max_by(|a, b| w.dot(*a.1).total_cmp(&w.dot(*b.1)))
-            .map_or(0, |(k, _)| k)
-    };
-    let lum = |(i, j): (usize, usize)| luminance(map.texel(i, j));
-    directions
-        .iter()
-        .enumerate()
-        .map(|(k, &d)| {
-            let background = median(
-                texels_within(map, d, BACKGROUND_RADIUS)
-                    .into_iter()
-                    .map(lum)
-                    .collect(),
-            );
-            let cell: Vec<(usize, usize)> = texels_within(map, d, cap_radius)
-                .into_iter()
-                .filter(|t| nearest_light(map.texel_direction(t.0, t.1)) == k)
-                .collect();
-            let (peak_texel, peak) = cell
-                .iter()
-                .map(|&t| (t, lum(t)))
-                .max_by(|a, b| a.1.total_cmp(&b.1))?;
-            if peak.partial_cmp(&background) != Some(std::cmp::Ordering::Greater) {
-                return None;
-            }
-            let half = 0.5 * (background + peak);
-            let core = half_maximum_region(map, peak_texel, d, half, |t| {
-                nearest_light(map.texel_direction(t.0, t.1)) == k
-            });
-            let omega: f32 = core.iter().map(|t| map.texel_solid_angle(t.1)).sum();
-            let radius = disc_radius(omega);
-            // The excess in the core, and the excess and its angular moment in the halo.
-            let excess =
-                |t: (usize, usize)| (lum(t) - background).max(0.0) * map.texel_solid_angle(t.1);
-            let core_excess: f32 = core.iter().map(|&t| excess(t)).sum();
-            let (mut halo_excess, mut halo_moment) = (0.0f32, 0.0f32);
-            for &t in cell.iter().filter(|t| !core.contains(t)) {
-                let e = excess(t);
-                halo_excess += e;
-                halo_moment += e * map.texel_direction(t.0, t.1).angle_between(d);
-            }
-            let halo_radius = if halo_excess > 0.0 {
-                (1.5 * halo_moment / halo_excess).clamp(radius, cap_radius.max(radius))
-            } else {
-                radius
-            };
-            Some(SourceShape {
-                radius,
-                halo_radius,
-                core_fraction: core_excess / (core_excess + halo_excess),
-            })
-        })
-        .collect()
+    SourceMeter::new().shapes(map, directions, cap_radius)
 }
 
-/// Sets each light's angular radius, halo and core fraction (its directions in the map's
-/// frame) to the measured shape of its source, where the map has one; the others keep the
-/// decomposition's estimate.
-pub fn measure_sources(map: &EnvMap, lights: &mut [crate::light::DirectionalLight]) {
-    let Some(cap_radius) = lights.iter().map(|l| l.cap_radius).reduce(f32::max) else {
-        return;
+/// Buffers reused from light to light.
+#[derive(Default)]
+struct Scratch {
+    /// Luminances of the background cap, as [`order_key`]s.
+    values: Vec<u32>,
+    cell: Vec<(usize, usize)>,
+    /// One bit per texel: in the half-maximum region of the light being measured.
+    core: TexelSet,
+}
+
+/// The shape of the source of light `k` of `directions` ([`source_shapes`]).
+fn source_shape(
+    table: &TexelTable,
+    directions: &[Vec3],
+    k: usize,
+    cap_radius: f32,
+    scratch: &mut Scratch,
+) -> Option<SourceShape> {
+    let d = directions[k];
+    let nearest_light = |w: Vec3| nearest(directions, w);
+    scratch.values.clear();
+    table.luminances_within(d, BACKGROUND_RADIUS, &mut scratch.values);
+    let background = median_of_keys(&mut scratch.values);
+    scratch.cell.clear();
+    table.for_each_within(d, cap_radius, |t| {
+        if nearest_light(table.direction(t)) == k {
+            scratch.cell.push(t);
+        }
+    });
+    let (peak_texel, peak) = scratch
+        .cell
+        .iter()
+        .map(|&t| (t, table.luminance(t)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    if peak.partial_cmp(&background) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    let half = 0.5 * (background + peak);
+    let core = half_maximum_region(table, peak_texel, d, half, &mut scratch.core, |t| {
+        nearest_light(table.direction(t)) == k
+    });
+    let omega: f32 = core.iter().map(|t| table.solid_angle(*t)).sum();
+    let radius = disc_radius(omega);
+    // The excess in the core, and the excess and its angular moment in the halo.
+    let excess =
+        |t: (usize, usize)| (table.luminance(t) - background).max(0.0) * table.solid_angle(t);
+    let core_excess: f32 = core.iter().map(|&t| excess(t)).sum();
+    let (mut halo_excess, mut halo_moment) = (0.0f32, 0.0f32);
+    for &t in scratch.cell.iter().filter(|t| !scratch.core.contains(**t)) {
+        let e = excess(t);
+        halo_excess += e;
+        halo_moment += e * table.direction(t).angle_between(d);
+    }
+    scratch.core.clear(&core);
+    let halo_radius = if halo_excess > 0.0 {
+        (1.5 * halo_moment / halo_excess).clamp(radius, cap_radius.max(radius))
+    } else {
+        radius
     };
-    let directions: Vec<Vec3> = lights.iter().map(|l| l.direction).collect();
-    for (light, shape) in lights
-        .iter_mut()
-        .zip(source_shapes(map, &directions, cap_radius))
-    {
-        if let Some(shape) = shape {
-            light.angular_radius = shape.radius;
-            light.halo_radius = shape.halo_radius;
-            light.core_fraction = shape.core_fraction;
+    Some(SourceShape {
+        radius,
+        halo_radius,
+        core_fraction: core_excess / (core_excess + halo_excess),
+    })
+}
+
+/// The index of the direction nearest to `w` (the last of equals).
+fn nearest(directions: &[Vec3], w: Vec3) -> usize {
+    let mut best = (0, f32::NEG_INFINITY);
+    for (k, d) in directions.iter().enumerate() {
+        let cos = w.dot(*d);
+        if cos >= best.1 {
+            best = (k, cos);
+        }
+    }
+    best.0
+}
+
+/// [`SourceMeter::measure`] once.
+pub fn measure_sources(map: &EnvMap, lights: &mut [crate::light::DirectionalLight]) {
+    SourceMeter::new().measure(map, lights);
+}
+
+/// A set of texels of one map, one bit each.
+#[derive(Default)]
+struct TexelSet {
+    width: usize,
+    bits: Vec<u64>,
+}
+
+impl TexelSet {
+    /// Makes the set empty and fit for a `width × height` map.
+    fn fit(&mut self, width: usize, height: usize) {
+        let words = (width * height).div_ceil(64);
+        if self.width != width || self.bits.len() != words {
+            self.width = width;
+            self.bits = vec![0; words];
+        }
+    }
+
+    fn index(&self, (i, j): (usize, usize)) -> (usize, u64) {
+        let n = j * self.width + i;
+        (n / 64, 1 << (n % 64))
+    }
+
+    fn contains(&self, t: (usize, usize)) -> bool {
+        let (word, bit) = self.index(t);
+        self.bits[word] & bit != 0
+    }
+
+    /// Adds `t`; whether it was new.
+    fn insert(&mut self, t: (usize, usize)) -> bool {
+        let (word, bit) = self.index(t);
+        let new = self.bits[word] & bit == 0;
+        self.bits[word] |= bit;
+        new
+    }
+
+    /// Removes `members` (empties the set when they are all it holds).
+    fn clear(&mut self, members: &[(usize, usize)]) {
+        for &t in members {
+            let (word, bit) = self.index(t);
+            self.bits[word] &= !bit;
         }
     }
 }
 
 /// The texels `owned` connected to `seed` (4-neighbours, wrapping in azimuth) brighter than
-/// `level`, within [`MAX_SOURCE_RADIUS`] of `centre`. A convex source cut by the
-/// convex cells of the lights nearest to its parts stays connected within each cell.
+/// `level`, within [`MAX_SOURCE_RADIUS`] of `centre`, in the order found; `seen` (empty on
+/// entry) holds them on return. A convex source cut by the convex cells of the lights nearest
+/// to its parts stays connected within each cell.
 fn half_maximum_region(
-    map: &EnvMap,
+    table: &TexelTable,
     seed: (usize, usize),
     centre: Vec3,
     level: f32,
+    seen: &mut TexelSet,
     owned: impl Fn((usize, usize)) -> bool,
-) -> std::collections::HashSet<(usize, usize)> {
-    let (w, h) = (map.width(), map.height());
+) -> Vec<(usize, usize)> {
+    let (w, h) = (table.width(), table.height());
     let cos_max = MAX_SOURCE_RADIUS.cos();
-    let mut seen = std::collections::HashSet::new();
-    let mut stack = vec![seed];
+    let mut region = vec![seed];
     seen.insert(seed);
-    while let Some((i, j)) = stack.pop() {
-        let mut neighbours = vec![((i + 1) % w, j), ((i + w - 1) % w, j)];
+    let mut next = 0;
+    while let Some(&(i, j)) = region.get(next) {
+        next += 1;
+        let mut neighbours = [
+            Some(((i + 1) % w, j)),
+            Some(((i + w - 1) % w, j)),
+            None,
+            None,
+        ];
         if j > 0 {
-            neighbours.push((i, j - 1));
+            neighbours[2] = Some((i, j - 1));
         }
         if j + 1 < h {
-            neighbours.push((i, j + 1));
+            neighbours[3] = Some((i, j + 1));
         }
-        for n in neighbours {
-            if !seen.contains(&n)
-                && luminance(map.texel(n.0, n.1)) > level
-                && map.texel_direction(n.0, n.1).dot(centre) >= cos_max
+        for n in neighbours.into_iter().flatten() {
+            if !seen.contains(n)
+                && table.luminance(n) > level
+                && table.direction(n).dot(centre) >= cos_max
                 && owned(n)
             {
                 seen.insert(n);
-                stack.push(n);
+                region.push(n);
             }
         }
     }
-    seen
+    region
 }
 
 #[cfg(test)]
@@ -339,6 +703,38 @@ mod tests {
     }
 
     #[test]
+    fn the_median_is_the_middle_element_in_total_order() {
+        let mut state = 12345u32;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state
+        };
+        for len in [1usize, 2, 3, 10, 1000, 30_001] {
+            // Wide exponents, many ties, zeros of both signs and a few negatives.
+            let values: Vec<f32> = (0..len)
+                .map(|_| match next() % 5 {
+                    0 => 0.0,
+                    1 => -0.0,
+                    2 => (next() % 7) as f32,
+                    3 => -((next() % 1000) as f32) * 1e-3,
+                    _ => f32::from_bits(next() % 0x7f00_0000),
+                })
+                .collect();
+            let mut sorted = values.clone();
+            sorted.sort_by(f32::total_cmp);
+            let mut keys: Vec<u32> = values.iter().map(|v| order_key(*v)).collect();
+            assert_eq!(
+                median_of_keys(&mut keys).to_bits(),
+                sorted[len / 2].to_bits(),
+                "{len} values"
+            );
+        }
+        assert_eq!(median_of_keys(&mut Vec::new()), 0.0);
+    }
+
+    #[test]
     fn a_map_without_a_peak_has_no_source() {
         let map = EnvMap::uniform(128, 64, Rgb::splat(2.0));
         assert_eq!(source_shapes(&map, &[Vec3::Y], 0.1), [None]);
@@ -346,18 +742,64 @@ mod tests {
 
     #[test]
     fn texels_within_a_cap_across_the_seam_and_the_pole() {
-        let map = EnvMap::uniform(256, 128, Rgb::ONE);
-        for centre in [Vec3::new(0.0, 0.2, 1.0).normalize(), Vec3::Y, Vec3::NEG_Z] {
-            let radius = 12f32.to_radians();
-            let mut found = texels_within(&map, centre, radius);
-            found.sort_unstable();
-            let brute: Vec<(usize, usize)> = (0..128)
-                .flat_map(|j| (0..256).map(move |i| (i, j)))
-                .filter(|&(i, j)| map.texel_direction(i, j).dot(centre) >= radius.cos())
-                .collect();
-            let mut brute = brute;
-            brute.sort_unstable();
-            assert_eq!(found, brute, "{centre}");
+        // Centres at the seam, the poles, next to a pole and at random; radii from under a
+        // texel to the background's 30°: exactly the texels a brute-force scan finds.
+        let mut centres = vec![
+            Vec3::new(0.0, 0.2, 1.0).normalize(),
+            Vec3::Y,
+            Vec3::NEG_Y,
+            Vec3::NEG_Z,
+            Vec3::new(0.01, 0.9999, 0.0).normalize(),
+        ];
+        let mut state = 7u32;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as f32 / u32::MAX as f32 * 2.0 - 1.0
+        };
+        for _ in 0..12 {
+            centres.push(Vec3::new(next(), next(), next()).normalize());
+        }
+        for (width, height) in [(256, 128), (96, 48)] {
+            let map = EnvMap::uniform(width, height, Rgb::ONE);
+            let indexed = EnvMap::new(
+                width,
+                height,
+                (0..width * height).map(|n| Rgb::splat(n as f32)).collect(),
+            );
+            for &centre in &centres {
+                for radius_deg in [0.3f32, 2.0, 12.0, 30.0] {
+                    let radius = radius_deg.to_radians();
+                    let mut found = texels_within(&map, centre, radius);
+                    found.sort_unstable();
+                    let mut brute: Vec<(usize, usize)> = (0..height)
+                        .flat_map(|j| (0..width).map(move |i| (i, j)))
+                        .filter(|&(i, j)| map.texel_direction(i, j).dot(centre) >= radius.cos())
+                        .collect();
+                    brute.sort_unstable();
+                    assert_eq!(found, brute, "{centre} {radius_deg}° on {width}x{height}");
+                    // The bulk reading finds the same texels (each map texel's luminance is
+                    // its index here, so the values name the texels).
+                    let mut values = Vec::new();
+                    let texels = EquirectTexels::new(width, height);
+                    TexelTable {
+                        map: &indexed,
+                        texels: &texels,
+                    }
+                    .luminances_within(centre, radius, &mut values);
+                    values.sort_unstable();
+                    let mut expected: Vec<u32> = brute
+                        .iter()
+                        .map(|&(i, j)| order_key(luminance(indexed.texel(i, j))))
+                        .collect();
+                    expected.sort_unstable();
+                    assert_eq!(
+                        values, expected,
+                        "{centre} {radius_deg}° on {width}x{height}"
+                    );
+                }
+            }
         }
     }
 }

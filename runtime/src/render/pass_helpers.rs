@@ -3,7 +3,23 @@
 
 use super::shaders::Shader;
 
-/// A 2D texture (or array of `size.2` layers) with one mip level.
+/// The layer count to give a 2D texture of `width × height` meant to hold `layers` layers and
+/// be bound as a 2D array. wgpu's OpenGL backend fixes each texture's GL target when the
+/// texture is made, guessing from its shape: a square one whose layer count is a multiple of 6
+/// becomes a cube map (or cube-map array), and views of it as a 2D array then read the wrong
+/// texels (glossy reflections came out bluish and misplaced on llvmpipe). hprt binds every
+/// layered texture as a 2D array, so such a texture gets one spare layer that is never read or
+/// written; Vulkan and the other backends draw the same image with or without it.
+pub fn array_layer_count(width: u32, height: u32, layers: u32) -> u32 {
+    if layers > 1 && width == height && layers.is_multiple_of(6) {
+        layers + 1
+    } else {
+        layers
+    }
+}
+
+/// A 2D texture (or array of at least `size.2` layers, [`array_layer_count`]) with one mip
+/// level.
 pub fn texture(
     device: &wgpu::Device,
     label: &str,
@@ -16,7 +32,7 @@ pub fn texture(
         size: wgpu::Extent3d {
             width: size.0,
             height: size.1,
-            depth_or_array_layers: size.2,
+            depth_or_array_layers: array_layer_count(size.0, size.1, size.2),
         },
         mip_level_count: 1,
         sample_count: 1,
@@ -150,5 +166,33 @@ impl FullscreenPass<'_> {
             multiview_mask: None,
             cache: None,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::array_layer_count;
+
+    /// wgpu-hal's OpenGL rule (`gles::Texture::get_info_from_desc`): a square 2D texture whose
+    /// layer count is a multiple of 6 is made a cube map or cube-map array.
+    fn gl_takes_for_a_cube(width: u32, height: u32, layers: u32) -> bool {
+        width == height && layers.is_multiple_of(6)
+    }
+
+    #[test]
+    fn no_array_texture_looks_like_a_cube_to_opengl() {
+        for layers in 1..=64 {
+            for (w, h) in [(64, 64), (128, 64), (1, 1)] {
+                let count = array_layer_count(w, h, layers);
+                assert!(count >= layers && count <= layers + 1);
+                assert!(
+                    layers == 1 || !gl_takes_for_a_cube(w, h, count),
+                    "{w}x{h}, {layers} layers"
+                );
+            }
+        }
+        // Shapes OpenGL cannot mistake keep their count.
+        assert_eq!(array_layer_count(64, 64, 4), 4);
+        assert_eq!(array_layer_count(64, 32, 6), 6);
     }
 }

@@ -7,7 +7,7 @@
 //! its zonal factors and uploaded.
 
 use super::environment::{mip_chain_of, rgba16f_texels};
-use super::pass_helpers::{FullscreenPass, begin_pass, color_attachment};
+use super::pass_helpers::{FullscreenPass, array_layer_count, begin_pass, color_attachment};
 use super::shaders::Shader;
 use crate::cubemap::{CubeGeometry, CubeMap};
 use crate::reflection::{ReflectedEnvironment, sh_reflection_map};
@@ -180,7 +180,7 @@ impl ReflectionMaps {
             size: wgpu::Extent3d {
                 width: n as u32,
                 height: n as u32,
-                depth_or_array_layers: 6,
+                depth_or_array_layers: array_layer_count(n as u32, n as u32, 6),
             },
             mip_level_count: levels as u32,
             sample_count: 1,
@@ -273,7 +273,11 @@ fn maps_texture(device: &wgpu::Device, face_size: usize, slots: usize) -> wgpu::
         size: wgpu::Extent3d {
             width: face_size as u32,
             height: face_size as u32,
-            depth_or_array_layers: 6 * slots as u32,
+            depth_or_array_layers: array_layer_count(
+                face_size as u32,
+                face_size as u32,
+                6 * slots as u32,
+            ),
         },
         mip_level_count: 1,
         sample_count: 1,
