@@ -198,6 +198,10 @@ fn report_measures_shadows_and_survives_bad_maps() {
     let mut shadow_errors = Vec::new();
     for m in methods {
         let name = m["method"].as_str().unwrap();
+        // Each method's lighting cost, on the first frame and on a later one of a changing map.
+        for cost in ["decomposition_ms", "warm_decomposition_ms"] {
+            assert!(m[cost].as_f64().unwrap() > 0.0, "{name} {cost}");
+        }
         let r = recompute(
             &map_dir,
             &name.replace('/', "-"),

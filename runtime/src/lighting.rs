@@ -422,6 +422,13 @@ impl EnvironmentLighting {
         }
     }
 
+    /// Drops everything made from the map (cube, decompositions, projection, the peers'
+    /// lighting, the reflection remainder), keeping settings, orientation, tracker and
+    /// buffers: the next frame costs what a new frame of a changing map costs.
+    pub fn forget_derived(&mut self) {
+        self.invalidate();
+    }
+
     fn invalidate(&mut self) {
         self.cube = None;
         self.decomposition = None;

@@ -75,7 +75,7 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
         .any(|m| m.methods.iter().any(|x| x.stats.highlight_pixels > 0));
     html.push_str(
         "<table><tr><th>map</th><th>method</th><th>rank</th><th>mean ± std</th><th>shadow mean ± std</th>\
-         <th>penumbra mean ± std</th><th>relative RMSE</th><th>relative RMSE, noise-corrected</th><th>lights</th><th>decomposition (ms)</th><th>frame (ms)</th>",
+         <th>penumbra mean ± std</th><th>relative RMSE</th><th>relative RMSE, noise-corrected</th><th>lights</th><th>decomposition (ms): first frame / warm</th><th>frame (ms)</th>",
     );
     html.push_str(if glossy {
         "<th>highlight mean ± std</th></tr>"
@@ -113,7 +113,7 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
             };
             let _ = write!(
                 html,
-                "<tr>{name}<td class=\"name\">{}</td><td>{}</td>{}{}{}{}<td>{:.4}</td><td>{}</td><td>{:.2}</td><td>{:.1}</td>{}</tr>",
+                "<tr>{name}<td class=\"name\">{}</td><td>{}</td>{}{}{}{}<td>{:.4}</td><td>{}</td><td>{:.2} / {:.2}</td><td>{:.1}</td>{}</tr>",
                 escape(&m.method),
                 ranks[k],
                 cell(s.mean, best_mean, mean_std(s.mean, s.std)),
@@ -135,6 +135,7 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
                 m.relative_rmse_corrected,
                 m.lights,
                 m.decomposition_ms,
+                m.warm_decomposition_ms,
                 m.frame_ms,
                 if glossy {
                     cell(
@@ -361,6 +362,7 @@ mod tests {
             relative_rmse_corrected: 0.0,
             lights: 0,
             decomposition_ms: 0.0,
+            warm_decomposition_ms: 0.0,
             frame_ms: 0.0,
         };
         let methods = [result(0.3), result(0.1), result(0.2), result(0.1)];
