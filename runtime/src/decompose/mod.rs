@@ -27,7 +27,7 @@ use icosphere::Icosphere;
 use precompute::settings::InvalidSettings;
 use precompute::sh::{ShCoeffs, clamped_cosine_bands};
 use precompute::{Rgb, luminance};
-use projection::{BasisTable, ShProjector};
+use projection::{BasisColumns, ShProjector};
 use smoothing::GaussianSmoothing;
 use std::f32::consts::PI;
 pub use window::Window;
@@ -231,7 +231,7 @@ pub struct Decomposer {
     ico: Icosphere,
     smoothing: GaussianSmoothing,
     projector: ShProjector,
-    ico_basis: BasisTable,
+    ico_basis: BasisColumns,
     detection_window: Vec<f32>,
     sh_window: Vec<f32>,
     // Per-frame scratch buffers.
@@ -265,7 +265,7 @@ impl Decomposer {
             settings.smoothing_deg.to_radians(),
         );
         let projector = ShProjector::new(&analysis, settings.order);
-        let ico_basis = BasisTable::new(settings.order, &ico.vertices);
+        let ico_basis = BasisColumns::new(settings.order, &ico.vertices);
         let texels = geometry.texel_count();
         Ok(Self {
             analysis_map: CubeMap::uniform(a, Rgb::ZERO),
@@ -405,13 +405,14 @@ impl Decomposer {
             &self.analysis_map
         };
         self.smoothing.apply(analysis, &mut self.smoothed);
-        let residual_rgb: Vec<Rgb> = self
+        let mut expansion = Vec::new();
+        self.ico_basis.eval_all(detection, &mut expansion);
+        let residual: Vec<f32> = self
             .smoothed
             .iter()
-            .enumerate()
-            .map(|(v, s)| *s - self.ico_basis.eval(detection, v))
+            .zip(&expansion)
+            .map(|(s, p)| luminance(*s - *p))
             .collect();
-        let residual: Vec<f32> = residual_rgb.iter().map(|r| luminance(*r)).collect();
         let floor = self.settings.min_contrast * mean_luminance;
         let mut maxima: Vec<u32> = self
             .ico

@@ -60,6 +60,59 @@ impl BasisTable {
     }
 }
 
+/// SH basis values at a fixed set of directions, coefficient-major (`values[k · count + i] =
+/// Y_k(d_i)`): evaluating an expansion at every direction then runs over the directions in
+/// step, each direction's sum still taken coefficient after coefficient.
+#[derive(Debug, Clone)]
+pub struct BasisColumns {
+    order: usize,
+    count: usize,
+    values: Vec<f32>,
+}
+
+impl BasisColumns {
+    pub fn new(order: usize, directions: &[Vec3]) -> Self {
+        let rows = BasisTable::new(order, directions);
+        let n = num_coeffs(order);
+        let count = directions.len();
+        let mut values = vec![0.0; n * count];
+        for i in 0..count {
+            for (k, y) in rows.row(i).iter().enumerate() {
+                values[k * count + i] = *y;
+            }
+        }
+        Self {
+            order,
+            count,
+            values,
+        }
+    }
+
+    /// The value of `coeffs` at every direction (bands beyond the table's order ignored):
+    /// the same floats as [`BasisTable::eval`] direction by direction.
+    pub fn eval_all(&self, coeffs: &ShCoeffs<Rgb>, out: &mut Vec<Rgb>) {
+        let n = num_coeffs(self.order.min(coeffs.order()));
+        let [mut r, mut g, mut b] = [0, 1, 2].map(|_| vec![0.0f32; self.count]);
+        for (c, column) in coeffs.as_slice()[..n]
+            .iter()
+            .zip(self.values.chunks_exact(self.count))
+        {
+            for (((r, g), b), y) in r.iter_mut().zip(&mut g).zip(&mut b).zip(column) {
+                *r += c.x * *y;
+                *g += c.y * *y;
+                *b += c.z * *y;
+            }
+        }
+        out.clear();
+        out.extend(
+            r.iter()
+                .zip(&g)
+                .zip(&b)
+                .map(|((r, g), b)| Rgb::new(*r, *g, *b)),
+        );
+    }
+}
+
 /// `(r, g, b)[k] += l · basis[k]` for every k (each sum in the same order as a plain loop, so
 /// the same floats; over slices of one length, so that it vectorizes).
 #[inline]
@@ -146,6 +199,31 @@ impl ShProjector {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Coefficient-major evaluation gives each direction the same floats as row by row.
+    #[test]
+    fn columns_evaluate_as_rows_do() {
+        let directions: Vec<Vec3> = (0..37)
+            .map(|i| Vec3::new((i as f32).sin(), (0.7 * i as f32).cos(), 0.3).normalize())
+            .collect();
+        let mut sh = ShCoeffs::zeros(5);
+        for (k, c) in sh.as_mut_slice().iter_mut().enumerate() {
+            *c = Rgb::new(1.0 / (1.0 + k as f32), (k as f32).sin(), 0.1 * k as f32);
+        }
+        let (rows, columns) = (
+            BasisTable::new(5, &directions),
+            BasisColumns::new(5, &directions),
+        );
+        let mut all = Vec::new();
+        columns.eval_all(&sh, &mut all);
+        for (i, value) in all.iter().enumerate() {
+            assert_eq!(
+                value.to_array(),
+                rows.eval(&sh, i).to_array(),
+                "direction {i}"
+            );
+        }
+    }
 
     #[test]
     fn projects_spherical_polynomials_accurately() {
