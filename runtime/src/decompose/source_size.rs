@@ -95,15 +95,13 @@ impl TexelTable<'_> {
     /// azimuth from the window's start (wrapping). Only the part of the window that can be
     /// that close (with two texels' margin) is tested.
     fn for_each_within(&self, centre: Vec3, radius: f32, mut visit: impl FnMut((usize, usize))) {
-        let (w, h) = (self.width(), self.height());
-        let theta = centre.y.clamp(-1.0, 1.0).acos();
-        let row_angle = PI / h as f32;
-        let first = (((theta - radius) / row_angle).floor().max(0.0)) as usize;
-        let last = ((((theta + radius) / row_angle).ceil()) as usize).min(h);
+        let w = self.width();
+        let (theta, rows) = self.cap_rows(centre, radius);
+        let row_angle = PI / self.height() as f32;
         let cos_radius = radius.cos();
         let centre_u = precompute::envmap::uv_of_direction(centre).0 * w as f32;
         let column_angle = std::f64::consts::TAU / w as f64;
-        for j in first..last {
+        for j in rows {
             // Columns to test: all of them near a pole, else a window around the centre's.
             let sin_row = ((j as f32 + 0.5) * row_angle).sin();
             let half_width =
@@ -144,22 +142,29 @@ impl TexelTable<'_> {
 }
 
 impl TexelTable<'_> {
-    /// Appends the luminance ([`order_key`]) of every texel within `radius` of `centre` to
-    /// `out` (the same texels as [`Self::for_each_within`], in no particular order). In each row, the columns
-    /// that are certainly inside (by more than the test's rounding) are read in bulk, and only
-    /// those near the cap's rim are tested.
-    fn luminances_within(&self, centre: Vec3, radius: f32, out: &mut Vec<u32>) {
-        let (w, h) = (self.width(), self.height());
+    /// The polar angle of `centre` and the rows a cap of `radius` around it reaches.
+    fn cap_rows(&self, centre: Vec3, radius: f32) -> (f32, std::ops::Range<usize>) {
+        let h = self.height();
         let theta = centre.y.clamp(-1.0, 1.0).acos();
         let row_angle = PI / h as f32;
         let first = (((theta - radius) / row_angle).floor().max(0.0)) as usize;
         let last = ((((theta + radius) / row_angle).ceil()) as usize).min(h);
+        (theta, first..last)
+    }
+
+    /// Appends the luminance ([`order_key`]) of every texel within `radius` of `centre` to
+    /// `out` (the same texels as [`Self::for_each_within`], in no particular order). In each
+    /// row, the columns certainly inside (by more than the test's rounding) are read in bulk,
+    /// and only those near the cap's rim are tested.
+    fn luminances_within(&self, centre: Vec3, radius: f32, out: &mut Vec<u32>) {
+        let w = self.width();
+        let (theta, rows) = self.cap_rows(centre, radius);
         let cos_radius = radius.cos();
         let centre_u = f64::from(precompute::envmap::uv_of_direction(centre).0) * w as f64;
         let column_angle = std::f64::consts::TAU / w as f64;
         let (sin_c, cos_c) = (f64::from(theta).sin(), f64::from(theta).cos());
         let texels = self.map.texels();
-        for j in first..last {
+        for j in rows {
             let (sin_theta, cos_theta) = self.texels.rows[j];
             let across = f64::from(sin_theta) * sin_c;
             let level = f64::from(cos_radius) - f64::from(cos_theta) * cos_c;
@@ -289,14 +294,53 @@ fn order_key(v: f32) -> u32 {
 }
 
 /// The median of the floats whose [`order_key`]s are `keys` (0 when empty): the element at
-/// index `len / 2` in `total_cmp` order, found by radix selection (a histogram of the top
-/// bits, then of the next among the candidates left; no comparison sort). `keys` is used as
-/// scratch.
-fn median_of_keys(keys: &mut Vec<u32>) -> f32 {
+/// index `len / 2` in `total_cmp` order. A sorted sample of every 32nd key brackets it; one
+/// pass counts the keys below the bracket and gathers those inside, and the median is
+/// selected among these few ([`radix_select`] over all of them if the bracket missed).
+/// `keys` and `inside` are used as scratch.
+fn median_of_keys(keys: &mut Vec<u32>, inside: &mut Vec<u32>) -> f32 {
     if keys.is_empty() {
         return 0.0;
     }
-    let mut rank = keys.len() / 2;
+    let rank = keys.len() / 2;
+    let key = bracketed_select(keys, rank, inside).unwrap_or_else(|| radix_select(keys, rank));
+    // Undo `order_key`.
+    f32::from_bits(if key >> 31 == 1 { key ^ 1 << 31 } else { !key })
+}
+
+/// The key of `rank` in `keys` if a sample's bracket around it holds it.
+fn bracketed_select(keys: &[u32], rank: usize, inside: &mut Vec<u32>) -> Option<u32> {
+    const STRIDE: usize = 32;
+    if keys.len() < 16 * STRIDE {
+        return None;
+    }
+    let mut sample: Vec<u32> = keys.iter().step_by(STRIDE).copied().collect();
+    sample.sort_unstable();
+    // The rank's place in the sample, widened by three standard deviations of a sample
+    // quantile's rank (√(n p (1 − p)) ≤ √n / 2) and a few more.
+    let n = sample.len();
+    let centre = rank * n / keys.len();
+    let margin = (1.5 * (n as f64).sqrt()) as usize + 4;
+    let lo = sample[centre.saturating_sub(margin)];
+    let hi = sample[(centre + margin).min(n - 1)];
+    inside.clear();
+    let mut below = 0;
+    for &k in keys {
+        below += usize::from(k < lo);
+        if (lo..=hi).contains(&k) {
+            inside.push(k);
+        }
+    }
+    let within = rank.checked_sub(below)?;
+    if within >= inside.len() {
+        return None;
+    }
+    Some(*inside.select_nth_unstable(within).1)
+}
+
+/// The key of `rank` in `keys` by radix selection (a histogram of the top bits, then of the
+/// next among the keys left; no comparison sort). `keys` is used as scratch.
+fn radix_select(keys: &mut Vec<u32>, mut rank: usize) -> u32 {
     let mut shift = 32;
     let mut prefix = 0u32;
     for bits in [11u32, 11, 10] {
@@ -316,9 +360,7 @@ fn median_of_keys(keys: &mut Vec<u32>) -> f32 {
             break;
         }
     }
-    let key = keys[rank.min(keys.len() - 1)];
-    // Undo `order_key`.
-    f32::from_bits(if key >> 31 == 1 { key ^ 1 << 31 } else { !key })
+    keys[rank.min(keys.len() - 1)]
 }
 
 /// The angular radius of the disc of solid angle `omega`.
@@ -406,6 +448,8 @@ pub fn source_shapes(
 struct Scratch {
     /// Luminances of the background cap, as [`order_key`]s.
     values: Vec<u32>,
+    /// Those near their median.
+    inside: Vec<u32>,
     cell: Vec<(usize, usize)>,
     /// One bit per texel: in the half-maximum region of the light being measured.
     core: TexelSet,
@@ -422,7 +466,7 @@ fn source_shape(
     let d = directions[k];
     scratch.values.clear();
     table.luminances_within(d, BACKGROUND_RADIUS, &mut scratch.values);
-    let background = median_of_keys(&mut scratch.values);
+    let background = median_of_keys(&mut scratch.values, &mut scratch.inside);
     scratch.cell.clear();
     let cell_rivals = Rivals::of(directions, k, cap_radius);
     table.for_each_within(d, cap_radius, |t| {
@@ -756,14 +800,31 @@ mod tests {
                 .collect();
             let mut sorted = values.clone();
             sorted.sort_by(f32::total_cmp);
-            let mut keys: Vec<u32> = values.iter().map(|v| order_key(*v)).collect();
+            let keys: Vec<u32> = values.iter().map(|v| order_key(*v)).collect();
+            // Both ways of selecting it.
             assert_eq!(
-                median_of_keys(&mut keys).to_bits(),
+                order_key(sorted[len / 2]),
+                radix_select(&mut keys.clone(), len / 2),
+                "{len} values"
+            );
+            assert_eq!(
+                median_of_keys(&mut keys.clone(), &mut Vec::new()).to_bits(),
                 sorted[len / 2].to_bits(),
                 "{len} values"
             );
         }
-        assert_eq!(median_of_keys(&mut Vec::new()), 0.0);
+        assert_eq!(median_of_keys(&mut Vec::new(), &mut Vec::new()), 0.0);
+        // A bracket that misses (every sampled key equal, the median elsewhere) falls back.
+        let mut skewed: Vec<u32> = (0..4096u32)
+            .map(|i| if i % 32 == 0 { 7 } else { i })
+            .collect();
+        let mut sorted = skewed.clone();
+        sorted.sort_unstable();
+        assert_eq!(bracketed_select(&skewed, 2048, &mut Vec::new()), None);
+        assert_eq!(median_of_keys(&mut skewed, &mut Vec::new()).to_bits(), {
+            let key = sorted[2048];
+            if key >> 31 == 1 { key ^ 1 << 31 } else { !key }
+        });
     }
 
     /// The measurement as first written, by brute force: every texel tested with its own
