@@ -510,6 +510,35 @@ impl Decomposer {
         (sh, lights)
     }
 
+    /// `P = SH(map) − SH(excess)`: `full` less the projection of `excess` at the texels
+    /// `members` (their basis values in `member_basis`). Channel by channel over the
+    /// coefficients, each coefficient's sum in member order: the same floats as subtracting
+    /// member after member from the expansion.
+    fn without_excess(
+        &self,
+        full: &ShCoeffs<Rgb>,
+        excess: &[Rgb],
+        members: &[u32],
+    ) -> ShCoeffs<Rgb> {
+        let n = full.as_slice().len();
+        let channel = |c: fn(&Rgb) -> f32| full.as_slice().iter().map(c).collect::<Vec<f32>>();
+        let mut sums = [channel(|c| c.x), channel(|c| c.y), channel(|c| c.z)];
+        for ((e, &t), y) in excess
+            .iter()
+            .zip(members)
+            .zip(self.member_basis.chunks_exact(n))
+        {
+            // Adding −(e Δω) Y subtracts e Δω Y exactly.
+            projection::accumulate(
+                &mut sums,
+                -(*e * self.geometry.solid_angles()[t as usize]),
+                y,
+            );
+        }
+        let [r, g, b] = sums;
+        ShProjector::collect(r, g, b)
+    }
+
     /// For caps of radius R around `centres`: the excess `max(0, L − P)` of the map over the SH
     /// part `P`, where `P` is refitted to the map minus that excess (a few fixed-point steps).
     /// Texels in several caps belong to the nearest centre. Returns the final `P` and one light
@@ -562,18 +591,7 @@ impl Decomposer {
             {
                 *e = (texels[t as usize] - sh.dot_basis(y)).max(Rgb::ZERO);
             }
-            // P = SH(map) − SH(excess).
-            sh = full.clone();
-            for ((e, &t), y) in excess
-                .iter()
-                .zip(&members)
-                .zip(self.member_basis.chunks_exact(n))
-            {
-                let weighted = *e * self.geometry.solid_angles()[t as usize];
-                for (c, yk) in sh.as_mut_slice().iter_mut().zip(y) {
-                    *c -= weighted * *yk;
-                }
-            }
+            sh = self.without_excess(full, &excess, &members);
         }
         // Each light: power, luminance-weighted centroid and spread of its excess.
         let mut power = vec![Rgb::ZERO; centres.len()];

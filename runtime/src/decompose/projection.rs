@@ -116,7 +116,7 @@ impl BasisColumns {
 /// `(r, g, b)[k] += l · basis[k]` for every k (each sum in the same order as a plain loop, so
 /// the same floats; over slices of one length, so that it vectorizes).
 #[inline]
-fn accumulate(sums: &mut [Vec<f32>; 3], l: Rgb, basis: &[f32]) {
+pub(super) fn accumulate(sums: &mut [Vec<f32>; 3], l: Rgb, basis: &[f32]) {
     let n = basis.len();
     let [r, g, b] = sums;
     let (r, g, b) = (&mut r[..n], &mut g[..n], &mut b[..n]);
@@ -185,7 +185,7 @@ impl ShProjector {
         Self::collect(r, g, b)
     }
 
-    fn collect(r: Vec<f32>, g: Vec<f32>, b: Vec<f32>) -> ShCoeffs<Rgb> {
+    pub(super) fn collect(r: Vec<f32>, g: Vec<f32>, b: Vec<f32>) -> ShCoeffs<Rgb> {
         let coeffs = r
             .iter()
             .zip(&g)

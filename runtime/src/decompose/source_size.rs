@@ -156,7 +156,7 @@ impl TexelTable<'_> {
     /// `out` (the same texels as [`Self::for_each_within`], in no particular order). In each
     /// row, the columns certainly inside (by more than the test's rounding) are read in bulk,
     /// and only those near the cap's rim are tested.
-    fn luminances_within(&self, centre: Vec3, radius: f32, out: &mut Vec<u32>) {
+    fn luminances_within(&self, centre: Vec3, radius: f32, out: &mut Vec<u32>, top: &mut TopBits) {
         let w = self.width();
         let (theta, rows) = self.cap_rows(centre, radius);
         let cos_radius = radius.cos();
@@ -188,13 +188,17 @@ impl TexelTable<'_> {
                 column_range(centre_u, outer, w),
             );
             for (a, b) in inside.segments(w) {
-                out.extend(row[a..b].iter().map(|c| order_key(luminance(*c))));
+                out.extend(
+                    row[a..b]
+                        .iter()
+                        .map(|c| top.count(order_key(luminance(*c)))),
+                );
             }
             for band in near.minus(inside, w) {
                 for (a, b) in band.segments(w) {
                     for (i, texel) in row.iter().enumerate().take(b).skip(a) {
                         if self.direction((i, j)).dot(centre) >= cos_radius {
-                            out.push(order_key(luminance(*texel)));
+                            out.push(top.count(order_key(luminance(*texel))));
                         }
                     }
                 }
@@ -293,61 +297,45 @@ fn order_key(v: f32) -> u32 {
     bits ^ (((bits as i32) >> 31) as u32 | 1 << 31)
 }
 
+/// Bits of an [`order_key`] counted by each level of [`median_of_keys`]' radix selection.
+const RADIX_LEVELS: [u32; 3] = [11, 11, 10];
+
+/// The counts of the keys' top [`RADIX_LEVELS`]`[0]` bits: the selection's first histogram,
+/// taken while the keys are gathered.
+struct TopBits([u32; 1 << 11]);
+
+impl TopBits {
+    fn new() -> Self {
+        Self([0; 1 << 11])
+    }
+
+    #[inline]
+    fn count(&mut self, key: u32) -> u32 {
+        self.0[(key >> (32 - RADIX_LEVELS[0])) as usize] += 1;
+        key
+    }
+}
+
 /// The median of the floats whose [`order_key`]s are `keys` (0 when empty): the element at
-/// index `len / 2` in `total_cmp` order. A sorted sample of every 32nd key brackets it; one
-/// pass counts the keys below the bracket and gathers those inside, and the median is
-/// selected among these few ([`radix_select`] over all of them if the bracket missed).
-/// `keys` and `inside` are used as scratch.
-fn median_of_keys(keys: &mut Vec<u32>, inside: &mut Vec<u32>) -> f32 {
+/// index `len / 2` in `total_cmp` order, found by radix selection (`top` counts the top bits;
+/// then a histogram of the next bits among the keys left, and so on: no comparison sort).
+/// `keys` is used as scratch.
+fn median_of_keys(keys: &mut Vec<u32>, top: &TopBits) -> f32 {
     if keys.is_empty() {
         return 0.0;
     }
-    let rank = keys.len() / 2;
-    let key = bracketed_select(keys, rank, inside).unwrap_or_else(|| radix_select(keys, rank));
-    // Undo `order_key`.
-    f32::from_bits(if key >> 31 == 1 { key ^ 1 << 31 } else { !key })
-}
-
-/// The key of `rank` in `keys` if a sample's bracket around it holds it.
-fn bracketed_select(keys: &[u32], rank: usize, inside: &mut Vec<u32>) -> Option<u32> {
-    const STRIDE: usize = 32;
-    if keys.len() < 16 * STRIDE {
-        return None;
-    }
-    let mut sample: Vec<u32> = keys.iter().step_by(STRIDE).copied().collect();
-    sample.sort_unstable();
-    // The rank's place in the sample, widened by three standard deviations of a sample
-    // quantile's rank (√(n p (1 − p)) ≤ √n / 2) and a few more.
-    let n = sample.len();
-    let centre = rank * n / keys.len();
-    let margin = (1.5 * (n as f64).sqrt()) as usize + 4;
-    let lo = sample[centre.saturating_sub(margin)];
-    let hi = sample[(centre + margin).min(n - 1)];
-    inside.clear();
-    let mut below = 0;
-    for &k in keys {
-        below += usize::from(k < lo);
-        if (lo..=hi).contains(&k) {
-            inside.push(k);
-        }
-    }
-    let within = rank.checked_sub(below)?;
-    if within >= inside.len() {
-        return None;
-    }
-    Some(*inside.select_nth_unstable(within).1)
-}
-
-/// The key of `rank` in `keys` by radix selection (a histogram of the top bits, then of the
-/// next among the keys left; no comparison sort). `keys` is used as scratch.
-fn radix_select(keys: &mut Vec<u32>, mut rank: usize) -> u32 {
+    let mut rank = keys.len() / 2;
     let mut shift = 32;
     let mut prefix = 0u32;
-    for bits in [11u32, 11, 10] {
+    for (level, bits) in RADIX_LEVELS.into_iter().enumerate() {
         shift -= bits;
         let mut counts = [0u32; 1 << 11];
-        for k in keys.iter() {
-            counts[((k >> shift) & ((1 << bits) - 1)) as usize] += 1;
+        if level == 0 {
+            counts = top.0;
+        } else {
+            for k in keys.iter() {
+                counts[((k >> shift) & ((1 << bits) - 1)) as usize] += 1;
+            }
         }
         let mut digit = 0;
         while rank >= counts[digit] as usize {
@@ -360,7 +348,19 @@ fn radix_select(keys: &mut Vec<u32>, mut rank: usize) -> u32 {
             break;
         }
     }
-    keys[rank.min(keys.len() - 1)]
+    let key = keys[rank.min(keys.len() - 1)];
+    // Undo `order_key`.
+    f32::from_bits(if key >> 31 == 1 { key ^ 1 << 31 } else { !key })
+}
+
+/// [`median_of_keys`] of keys not counted while gathered.
+#[cfg(test)]
+fn median_of(keys: &mut Vec<u32>) -> f32 {
+    let mut top = TopBits::new();
+    keys.iter().for_each(|k| {
+        top.count(*k);
+    });
+    median_of_keys(keys, &top)
 }
 
 /// The angular radius of the disc of solid angle `omega`.
@@ -448,8 +448,6 @@ pub fn source_shapes(
 struct Scratch {
     /// Luminances of the background cap, as [`order_key`]s.
     values: Vec<u32>,
-    /// Those near their median.
-    inside: Vec<u32>,
     cell: Vec<(usize, usize)>,
     /// One bit per texel: in the half-maximum region of the light being measured.
     core: TexelSet,
@@ -465,8 +463,9 @@ fn source_shape(
 ) -> Option<SourceShape> {
     let d = directions[k];
     scratch.values.clear();
-    table.luminances_within(d, BACKGROUND_RADIUS, &mut scratch.values);
-    let background = median_of_keys(&mut scratch.values, &mut scratch.inside);
+    let mut top = TopBits::new();
+    table.luminances_within(d, BACKGROUND_RADIUS, &mut scratch.values, &mut top);
+    let background = median_of_keys(&mut scratch.values, &top);
     scratch.cell.clear();
     let cell_rivals = Rivals::of(directions, k, cap_radius);
     table.for_each_within(d, cap_radius, |t| {
@@ -801,30 +800,13 @@ mod tests {
             let mut sorted = values.clone();
             sorted.sort_by(f32::total_cmp);
             let keys: Vec<u32> = values.iter().map(|v| order_key(*v)).collect();
-            // Both ways of selecting it.
             assert_eq!(
-                order_key(sorted[len / 2]),
-                radix_select(&mut keys.clone(), len / 2),
-                "{len} values"
-            );
-            assert_eq!(
-                median_of_keys(&mut keys.clone(), &mut Vec::new()).to_bits(),
+                median_of(&mut keys.clone()).to_bits(),
                 sorted[len / 2].to_bits(),
                 "{len} values"
             );
         }
-        assert_eq!(median_of_keys(&mut Vec::new(), &mut Vec::new()), 0.0);
-        // A bracket that misses (every sampled key equal, the median elsewhere) falls back.
-        let mut skewed: Vec<u32> = (0..4096u32)
-            .map(|i| if i % 32 == 0 { 7 } else { i })
-            .collect();
-        let mut sorted = skewed.clone();
-        sorted.sort_unstable();
-        assert_eq!(bracketed_select(&skewed, 2048, &mut Vec::new()), None);
-        assert_eq!(median_of_keys(&mut skewed, &mut Vec::new()).to_bits(), {
-            let key = sorted[2048];
-            if key >> 31 == 1 { key ^ 1 << 31 } else { !key }
-        });
+        assert_eq!(median_of(&mut Vec::new()), 0.0);
     }
 
     /// The measurement as first written, by brute force: every texel tested with its own
@@ -1021,7 +1003,12 @@ mod tests {
                         map: &indexed,
                         texels: &texels,
                     }
-                    .luminances_within(centre, radius, &mut values);
+                    .luminances_within(
+                        centre,
+                        radius,
+                        &mut values,
+                        &mut TopBits::new(),
+                    );
                     values.sort_unstable();
                     let mut expected: Vec<u32> = brute
                         .iter()
