@@ -370,7 +370,7 @@ impl EnvironmentLighting {
     pub fn set_map(&mut self, map: EnvMap) {
         self.source.set_map(&map);
         self.map = map;
-        self.invalidate();
+        self.forget_derived();
     }
 
     pub fn settings(&self) -> &DecomposeSettings {
@@ -387,7 +387,7 @@ impl EnvironmentLighting {
             self.source = CubeSource::new(&self.map, settings.face_size);
         }
         self.settings = settings;
-        self.invalidate();
+        self.forget_derived();
         Ok(())
     }
 
@@ -399,7 +399,7 @@ impl EnvironmentLighting {
     ) -> Result<(), DecomposeError> {
         self.tracker = tracking.map(LightTracker::new);
         self.decomposer = Decomposer::new(self.decomposer_settings(&self.settings))?;
-        self.invalidate();
+        self.forget_derived();
         Ok(())
     }
 
@@ -426,10 +426,6 @@ impl EnvironmentLighting {
     /// lighting, the reflection remainder), keeping settings, orientation, tracker and
     /// buffers: the next frame costs what a new frame of a changing map costs.
     pub fn forget_derived(&mut self) {
-        self.invalidate();
-    }
-
-    fn invalidate(&mut self) {
         self.cube = None;
         self.decomposition = None;
         self.projection = None;
