@@ -781,7 +781,7 @@ mod tests {
             .unwrap()
             .decompose(&CubeSource::new(&map, 64).cube(0.0));
         // The source's size measured on the full-resolution map: a disc of acos(0.999).
-        crate::decompose::source_size::measure_sources(&map, &mut in_map_frame.lights);
+        SourceMeter::new().measure(&map, &mut in_map_frame.lights);
         let radius = in_map_frame.lights[0].angular_radius;
         assert!((radius - 0.999f32.acos()).abs() < 0.2 * radius, "{radius}");
         let by_hand = rotate_decomposition(&in_map_frame, Quat::from_rotation_y(FRAC_PI_2));

@@ -34,10 +34,6 @@ impl BasisTable {
         }
     }
 
-    pub fn order(&self) -> usize {
-        self.order
-    }
-
     #[inline]
     pub fn row(&self, i: usize) -> &[f32] {
         &self.values[i * self.stride..][..num_coeffs(self.order)]
@@ -46,17 +42,6 @@ impl BasisTable {
     /// Every row with its padding.
     fn padded_rows(&self) -> std::slice::ChunksExact<'_, f32> {
         self.values.chunks_exact(self.stride)
-    }
-
-    /// Value of `coeffs` in direction `i` (bands beyond the table's order are ignored).
-    #[inline]
-    pub fn eval(&self, coeffs: &ShCoeffs<Rgb>, i: usize) -> Rgb {
-        let n = num_coeffs(self.order.min(coeffs.order()));
-        let mut sum = Rgb::ZERO;
-        for (c, y) in coeffs.as_slice()[..n].iter().zip(&self.row(i)[..n]) {
-            sum += *c * *y;
-        }
-        sum
     }
 }
 
@@ -89,7 +74,7 @@ impl BasisColumns {
     }
 
     /// The value of `coeffs` at every direction (bands beyond the table's order ignored):
-    /// the same floats as [`BasisTable::eval`] direction by direction.
+    /// the same floats as [`ShCoeffs::eval`] direction by direction.
     pub fn eval_all(&self, coeffs: &ShCoeffs<Rgb>, out: &mut Vec<Rgb>) {
         let n = num_coeffs(self.order.min(coeffs.order()));
         let [mut r, mut g, mut b] = [0, 1, 2].map(|_| vec![0.0f32; self.count]);
@@ -200,7 +185,8 @@ impl ShProjector {
 mod tests {
     use super::*;
 
-    /// Coefficient-major evaluation gives each direction the same floats as row by row.
+    /// Coefficient-major evaluation gives each direction the same floats as the expansion
+    /// evaluated there.
     #[test]
     fn columns_evaluate_as_rows_do() {
         let directions: Vec<Vec3> = (0..37)
@@ -210,18 +196,10 @@ mod tests {
         for (k, c) in sh.as_mut_slice().iter_mut().enumerate() {
             *c = Rgb::new(1.0 / (1.0 + k as f32), (k as f32).sin(), 0.1 * k as f32);
         }
-        let (rows, columns) = (
-            BasisTable::new(5, &directions),
-            BasisColumns::new(5, &directions),
-        );
         let mut all = Vec::new();
-        columns.eval_all(&sh, &mut all);
-        for (i, value) in all.iter().enumerate() {
-            assert_eq!(
-                value.to_array(),
-                rows.eval(&sh, i).to_array(),
-                "direction {i}"
-            );
+        BasisColumns::new(5, &directions).eval_all(&sh, &mut all);
+        for (value, d) in all.iter().zip(&directions) {
+            assert_eq!(value.to_array(), sh.eval(*d).to_array(), "direction {d}");
         }
     }
 

@@ -434,15 +434,6 @@ impl SourceMeter {
     }
 }
 
-/// [`SourceMeter::shapes`] once.
-pub fn source_shapes(
-    map: &EnvMap,
-    directions: &[Vec3],
-    cap_radius: f32,
-) -> Vec<Option<SourceShape>> {
-    SourceMeter::new().shapes(map, directions, cap_radius)
-}
-
 /// Buffers reused from light to light.
 #[derive(Default)]
 struct Scratch {
@@ -453,7 +444,7 @@ struct Scratch {
     core: TexelSet,
 }
 
-/// The shape of the source of light `k` of `directions` ([`source_shapes`]).
+/// The shape of the source of light `k` of `directions` ([`SourceMeter::shapes`]).
 fn source_shape(
     table: &TexelTable,
     directions: &[Vec3],
@@ -554,11 +545,6 @@ impl Rivals {
     }
 }
 
-/// [`SourceMeter::measure`] once.
-pub fn measure_sources(map: &EnvMap, lights: &mut [crate::light::DirectionalLight]) {
-    SourceMeter::new().measure(map, lights);
-}
-
 /// A set of texels of one map, one bit each.
 #[derive(Default)]
 struct TexelSet {
@@ -651,6 +637,15 @@ fn half_maximum_region(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`SourceMeter::shapes`] once.
+    fn source_shapes(
+        map: &EnvMap,
+        directions: &[Vec3],
+        cap_radius: f32,
+    ) -> Vec<Option<SourceShape>> {
+        SourceMeter::new().shapes(map, directions, cap_radius)
+    }
     use precompute::Rgb;
 
     /// A map of `width × width/2` with a uniform disc of angular radius `radius` and radiance
