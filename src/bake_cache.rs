@@ -3,11 +3,11 @@
 
 use crate::support::TerminalProgress;
 use anyhow::Context;
+use foundation::bvh::SceneBvh;
+use foundation::infra::progress::Progress;
+use foundation::scene::Scene;
 use precompute::bake::{BakeSettings, BakeStats, Transfer};
 use precompute::bakefile;
-use precompute::bvh::SceneBvh;
-use precompute::progress::Progress;
-use precompute::scene::Scene;
 use std::path::{Path, PathBuf};
 
 /// The cache folder: `$HPRT_CACHE`, else `$XDG_CACHE_HOME/hprt`, else `~/.cache/hprt`.

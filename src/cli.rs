@@ -3,8 +3,8 @@
 
 use crate::environment::{self, ChosenEnvironment};
 use clap::{Args, ValueEnum};
-use precompute::envmap::Layout;
-use precompute::scene::Scene;
+use foundation::envmap::Layout;
+use foundation::scene::Scene;
 use runtime::render::{Backend, RenderMode, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings, Window};
 use std::path::PathBuf;
@@ -43,7 +43,7 @@ pub struct ImageSizeArgs {
 
 impl ImageSizeArgs {
     /// The scene's camera at this size.
-    pub fn camera(&self, scene: &Scene) -> anyhow::Result<precompute::camera::Camera> {
+    pub fn camera(&self, scene: &Scene) -> anyhow::Result<foundation::camera::Camera> {
         let camera = scene.camera.with_size(
             self.width.unwrap_or(scene.camera.width),
             self.height.unwrap_or(scene.camera.height),
@@ -199,8 +199,8 @@ pub struct ReportOptions {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Random numbers of the reference's light paths: sobol or independent.
-    #[arg(long, default_value_t = precompute::reference::SamplerKind::default())]
-    pub sampler: precompute::reference::SamplerKind,
+    #[arg(long, default_value_t = reference::SamplerKind::default())]
+    pub sampler: reference::SamplerKind,
     /// Render the reference progressively (doubling its samples, continuing the cached ones)
     /// until its noise floor, in the mean error's units, is at most this: a number (0.001) or
     /// a share of the best method's mean error (20%).

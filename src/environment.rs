@@ -1,8 +1,8 @@
 //! Which environment map lights a scene, loaded with context, and what follows from the map
 //! (its default exposure, the maps beside it).
 
-use precompute::envmap::{self, EnvMap, Layout, LoadedEnvMap};
-use precompute::scene::Scene;
+use foundation::envmap::{self, EnvMap, Layout, LoadedEnvMap};
+use foundation::scene::Scene;
 use std::path::{Path, PathBuf};
 
 /// Loads a map with the file named in any error (and the option that names a layout, when

@@ -60,7 +60,7 @@ fn main() {
         .init();
     // Ctrl-C or SIGTERM: remove the outputs' temporary files, as a failed run does.
     let _ = ctrlc::set_handler(|| {
-        precompute::atomic_file::remove_partials();
+        foundation::infra::atomic_file::remove_partials();
         eprintln!("interrupted");
         std::process::exit(130);
     });

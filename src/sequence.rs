@@ -5,7 +5,7 @@
 
 use crate::environment::load_map;
 use anyhow::Context;
-use precompute::envmap::EnvMap;
+use foundation::envmap::EnvMap;
 use runtime::sequence::{SunArc, SunDisc, crossfade, direction_of};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};

@@ -2,9 +2,9 @@
 //! the terminal progress bar.
 
 use anyhow::Context;
+use foundation::infra::progress::Progress;
+use foundation::scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
-use precompute::progress::Progress;
-use precompute::scene::Scene;
 use std::path::Path;
 
 /// Loads a scene file, or a bare model placed in a default scene, with the path in any error.

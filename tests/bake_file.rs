@@ -4,10 +4,10 @@
 mod common;
 
 use common::*;
+use foundation::bvh::SceneBvh;
+use foundation::scene::Scene;
 use precompute::bake::BakeSettings;
 use precompute::bakefile;
-use precompute::bvh::SceneBvh;
-use precompute::scene::Scene;
 use std::process::Command;
 
 /// A Python 3 interpreter that has numpy (the test suite's runner installs python3-numpy).

@@ -6,22 +6,22 @@
 
 mod common;
 
+use foundation::bvh::SceneBvh;
+use foundation::envmap::{EnvMap, rotate_y};
+use foundation::infra::progress::NoProgress;
+use foundation::scene::Scene;
+use foundation::sh::{ShBasis, ShCoeffs};
+use foundation::{Rgb, luminance};
 use glam::Vec3;
 use precompute::bake::{self, BakeSettings, TransferVectors};
-use precompute::bvh::SceneBvh;
-use precompute::envmap::{EnvMap, rotate_y};
-use precompute::progress::NoProgress;
-use precompute::reference::{EnvironmentLight, Integrator, estimate_vertex};
-use precompute::scene::Scene;
-use precompute::sh::{ShBasis, ShCoeffs};
-use precompute::{Rgb, luminance};
+use reference::{EnvironmentLight, Integrator, estimate_vertex};
 
 const ORDER: usize = 8;
 
 /// A smooth, positive environment: the Hann-windowed order-8 projection of a real map, raised
 /// so it is positive everywhere (adding a constant keeps it order 8).
 fn smooth_environment() -> EnvMap {
-    let real = precompute::envmap::load(&common::scene("env/city.exr"), None)
+    let real = foundation::envmap::load(&common::scene("env/city.exr"), None)
         .unwrap()
         .map;
     let mut sh = real.downsampled(4).sh_projection(ORDER);

@@ -3,9 +3,9 @@
 mod common;
 
 use common::*;
+use foundation::envmap;
+use foundation::luminance;
 use glam::Vec3;
-use precompute::envmap;
-use precompute::luminance;
 use runtime::{CubeSource, DecomposeSettings, Decomposer};
 
 const MAPS: [&str; 5] = ["sunrise", "interior", "city", "forest", "hall"];
@@ -26,7 +26,7 @@ fn normals() -> Vec<Vec3> {
 
 /// The map's luminous power `∫ L dω`, summed here in f64 over its texels: row j of an
 /// equirectangular map spans `cos θ_j − cos θ_{j+1}` in `cos θ` and `2π / width` in azimuth.
-fn luminous_power(map: &precompute::envmap::EnvMap) -> f64 {
+fn luminous_power(map: &foundation::envmap::EnvMap) -> f64 {
     let (w, h) = (map.width(), map.height());
     (0..h)
         .map(|j| {

@@ -138,8 +138,8 @@ fn mesh_scene(dir: &Path, ext: &str) -> Vec<String> {
 
 #[test]
 fn mutated_maps_never_crash_the_program() {
-    let image = precompute::image_io::RgbImageF32::filled(64, 32, precompute::Rgb::splat(0.5));
-    let exr = precompute::image_io::exr_bytes(&image).unwrap();
+    let image = foundation::image_io::RgbImageF32::filled(64, 32, foundation::Rgb::splat(0.5));
+    let exr = foundation::image_io::exr_bytes(&image).unwrap();
     let decompose = |_: &Path| {
         ["decompose", "input.exr", "-o", "out.json"]
             .map(String::from)

@@ -3,18 +3,18 @@
 mod common;
 
 use common::*;
+use foundation::bvh::SceneBvh;
+use foundation::camera::Camera;
+use foundation::envmap::EnvMap;
+use foundation::infra::progress::NoProgress;
+use foundation::material::{Material, mirror, phong_zonal};
+use foundation::mesh::{box_mesh, sphere_mesh};
+use foundation::scene::SceneMesh;
+use foundation::sh::ShCoeffs;
+use foundation::{Rgb, luminance};
 use glam::{Quat, Vec3};
 use precompute::bake::{BakeSettings, Transfer};
-use precompute::bvh::SceneBvh;
-use precompute::camera::Camera;
-use precompute::envmap::EnvMap;
-use precompute::material::{Material, mirror, phong_zonal};
-use precompute::mesh::{box_mesh, sphere_mesh};
-use precompute::progress::NoProgress;
-use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
-use precompute::scene::SceneMesh;
-use precompute::sh::ShCoeffs;
-use precompute::{Rgb, luminance};
+use reference::{self, EnvironmentLight, ReferenceSettings};
 use runtime::reflection::{ReflectedEnvironment, SharedCube, convolve_exact};
 use runtime::render::{FrameLighting, RenderMode};
 use runtime::{CubeGeometry, CubeMap, DecomposeSettings, EnvironmentLighting};
@@ -344,7 +344,7 @@ fn glossy_frames_agree_between_opengl_and_vulkan() {
         ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    let frames: Vec<precompute::image_io::RgbImageF32> = ["vulkan", "gl"]
+    let frames: Vec<foundation::image_io::RgbImageF32> = ["vulkan", "gl"]
         .iter()
         .map(|backend| {
             let exr = format!("{backend}.exr");
@@ -369,7 +369,7 @@ fn glossy_frames_agree_between_opengl_and_vulkan() {
             );
             assert!(out.status.success(), "{backend}: {}", stderr(&out));
             assert!(error_lines(&out).is_empty(), "{backend}: {}", stderr(&out));
-            precompute::image_io::read_exr(&d.join(&exr)).unwrap()
+            foundation::image_io::read_exr(&d.join(&exr)).unwrap()
         })
         .collect();
     let differences: Vec<f32> = frames[0]

@@ -9,7 +9,7 @@
 mod common;
 
 use common::*;
-use precompute::image_io::read_exr;
+use foundation::image_io::read_exr;
 use std::path::PathBuf;
 
 fn golden_dir() -> PathBuf {
@@ -71,7 +71,7 @@ fn teapot_renders_match_the_committed_images_in_every_mode() {
             if bless {
                 if backend == "vulkan" {
                     std::fs::create_dir_all(golden_dir()).unwrap();
-                    precompute::image_io::write_exr(&golden, &actual).unwrap();
+                    foundation::image_io::write_exr(&golden, &actual).unwrap();
                 }
                 continue;
             }
@@ -96,7 +96,7 @@ fn render_case(
     stem: &str,
     extra: &[&str],
     backend: &str,
-) -> precompute::image_io::RgbImageF32 {
+) -> foundation::image_io::RgbImageF32 {
     let scene = scene("teapot.toml");
     let hall = repo().join("scenes/env/hall.exr");
     let exr = dir.join(format!("{stem}-{backend}.exr"));
@@ -142,8 +142,8 @@ fn render_case(
 /// What differs between `actual` and `expected`, if more than allowed: nothing at all when
 /// `exact`, else the OpenGL tolerance.
 fn compare(
-    actual: &precompute::image_io::RgbImageF32,
-    expected: &precompute::image_io::RgbImageF32,
+    actual: &foundation::image_io::RgbImageF32,
+    expected: &foundation::image_io::RgbImageF32,
     exact: bool,
 ) -> Option<String> {
     let pairs = || actual.pixels.iter().zip(&expected.pixels);

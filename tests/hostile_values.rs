@@ -164,8 +164,8 @@ fn declared_sizes_are_checked_before_allocating() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     // A valid 64x32 EXR whose data window is then made to claim 100000 x 100000 texels.
-    let image = precompute::image_io::RgbImageF32::filled(64, 32, precompute::Rgb::ONE);
-    let mut exr = precompute::image_io::exr_bytes(&image).unwrap();
+    let image = foundation::image_io::RgbImageF32::filled(64, 32, foundation::Rgb::ONE);
+    let mut exr = foundation::image_io::exr_bytes(&image).unwrap();
     let tag = b"dataWindow\0box2i\0";
     let at = exr.windows(tag.len()).position(|w| w == tag).unwrap() + tag.len() + 4;
     exr[at + 8..at + 12].copy_from_slice(&99_999i32.to_le_bytes());
@@ -361,7 +361,7 @@ fn outputs_keep_links_refuse_collisions_and_clean_up_on_signals() {
         assert!(out.status.success(), "{}", stderr(&out));
         let link = std::fs::symlink_metadata(d.join("link.exr")).unwrap();
         assert!(link.file_type().is_symlink());
-        assert!(precompute::image_io::read_exr(&d.join("real.exr")).is_ok());
+        assert!(foundation::image_io::read_exr(&d.join("real.exr")).is_ok());
     }
 
     // SIGTERM in the middle of a long reference render: no partial file remains.

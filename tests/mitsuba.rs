@@ -18,9 +18,9 @@
 mod common;
 
 use common::*;
+use foundation::color::Rgb;
+use foundation::image_io::{RgbImageF32, read_exr, write_exr};
 use glam::Vec3;
-use precompute::color::Rgb;
-use precompute::image_io::{RgbImageF32, read_exr, write_exr};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -67,7 +67,7 @@ fn write_map(path: &Path) {
             let (x, y) = (i % w, i / w);
             let u = (x as f32 + 0.5) / w as f32;
             let v = (y as f32 + 0.5) / h as f32;
-            sky(precompute::envmap::direction_of_uv(u, v))
+            sky(foundation::envmap::direction_of_uv(u, v))
         })
         .collect();
     write_exr(path, &RgbImageF32::new(w, h, pixels)).unwrap();
@@ -214,8 +214,8 @@ fn masked_statistics(a: &RgbImageF32, b: &RgbImageF32, mask: &[bool]) -> (f32, f
         .filter(|(_, m)| **m)
     {
         {
-            let la = precompute::luminance(*pa);
-            let lb = precompute::luminance(*pb);
+            let la = foundation::luminance(*pa);
+            let lb = foundation::luminance(*pb);
             sum += f64::from(0.5 * (la + lb));
             var += f64::from((la - lb) * (la - lb) / 4.0);
             n += 1;

@@ -6,9 +6,9 @@
 mod common;
 
 use common::*;
+use foundation::mesh::{LoadOptions, ModelPart, read_model};
+use foundation::scene::Scene;
 use glam::{Mat4, Quat, Vec3};
-use precompute::mesh::{LoadOptions, ModelPart, read_model};
-use precompute::scene::Scene;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 

@@ -3,7 +3,7 @@
 mod common;
 
 use common::*;
-use precompute::image_io::read_exr;
+use foundation::image_io::read_exr;
 
 #[test]
 fn renders_with_auxiliary_images_and_is_thread_count_independent() {
@@ -135,11 +135,11 @@ fn export_writes_a_mitsuba_scene_with_every_object() {
     let xml = std::fs::read_to_string(d.join("mts/scene.xml")).unwrap();
     assert!(xml.contains("<integer name=\"max_depth\" value=\"4\"/>"));
     assert!(xml.contains("<rotate y=\"1\" angle=\"-100\"/>"));
-    let scene = precompute::scene::Scene::load(&teapot).unwrap();
+    let scene = foundation::scene::Scene::load(&teapot).unwrap();
     let mut triangles = 0;
     for entry in std::fs::read_dir(d.join("mts/meshes")).unwrap() {
         let path = entry.unwrap().path();
-        let mesh = precompute::mesh::read_mesh(&path, &Default::default()).unwrap();
+        let mesh = foundation::mesh::read_mesh(&path, &Default::default()).unwrap();
         assert!(mesh.normals.is_some());
         triangles += mesh.triangles.len();
     }

@@ -3,18 +3,18 @@
 mod common;
 
 use common::*;
+use foundation::bvh::{Hit, SceneBvh, Skip};
+use foundation::camera::Camera;
+use foundation::envmap::EnvMap;
+use foundation::image_io::RgbImageF32;
+use foundation::infra::progress::NoProgress;
+use foundation::mesh::{box_mesh, sphere_mesh};
+use foundation::scene::{Scene, SceneMesh};
+use foundation::sh::ShCoeffs;
+use foundation::{Rgb, luminance};
 use glam::Vec3;
 use precompute::bake::{BakeSettings, Transfer};
-use precompute::bvh::{Hit, SceneBvh, Skip};
-use precompute::camera::Camera;
-use precompute::envmap::EnvMap;
-use precompute::image_io::RgbImageF32;
-use precompute::mesh::{box_mesh, sphere_mesh};
-use precompute::progress::NoProgress;
-use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
-use precompute::scene::{Scene, SceneMesh};
-use precompute::sh::ShCoeffs;
-use precompute::{Rgb, luminance};
+use reference::{self, EnvironmentLight, ReferenceSettings};
 use runtime::lighting::ShTransfer;
 use runtime::render::{FrameLighting, RenderMode, Renderer, ShadowSettings};
 use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer, DirectionalLight};
@@ -220,9 +220,9 @@ fn gpu_prt_matches_the_transfer_at_every_order() {
 }
 
 /// A square of side 2 centred on `centre`, facing `normal`.
-fn plane_facing(centre: Vec3, normal: Vec3) -> precompute::mesh::TriangleMesh {
+fn plane_facing(centre: Vec3, normal: Vec3) -> foundation::mesh::TriangleMesh {
     let (u, v) = normal.any_orthonormal_pair();
-    precompute::mesh::TriangleMesh {
+    foundation::mesh::TriangleMesh {
         positions: [-u - v, u - v, u + v, -u + v].map(|c| centre + c).to_vec(),
         normals: vec![normal; 4],
         triangles: vec![[0, 1, 2], [0, 2, 3]],
@@ -250,7 +250,7 @@ fn gpu_prt_of_single_sh_bands_on_open_surfaces_is_funk_hecke() {
             camera(2.5 * normal + Vec3::new(0.7, 0.3, 0.2), Vec3::ZERO, 64, 64),
         ),
     ];
-    let basis = precompute::sh::ShBasis::new(5).unwrap();
+    let basis = foundation::sh::ShBasis::new(5).unwrap();
     let gpus = gpus();
     for (mesh, cam) in scenes {
         let mut geometry = SceneMesh::default();
@@ -260,7 +260,7 @@ fn gpu_prt_of_single_sh_bands_on_open_surfaces_is_funk_hecke() {
             let mut sh = ShCoeffs::zeros(5);
             sh.as_mut_slice()[0] = Rgb::splat(3.0);
             let weights: Vec<(usize, f32)> = (-(l as isize)..=l as isize)
-                .map(|m| (precompute::sh::index(l, m), 0.6 + 0.25 * m as f32))
+                .map(|m| (foundation::sh::index(l, m), 0.6 + 0.25 * m as f32))
                 .collect();
             if l > 0 {
                 for &(k, a) in &weights {
@@ -752,7 +752,7 @@ fn a_source_with_a_halo_casts_its_wide_penumbra() {
 #[test]
 fn hybrid_beats_prt_in_the_shadows_against_the_reference() {
     let teapot = Scene::load(&scene("teapot.toml")).unwrap();
-    let map = precompute::envmap::load(&scene("env/sunrise.exr"), None)
+    let map = foundation::envmap::load(&scene("env/sunrise.exr"), None)
         .unwrap()
         .map;
     let rotation = teapot.environment.as_ref().unwrap().rotation_deg;
@@ -1029,7 +1029,7 @@ fn background_shows_the_map_filtered() {
                     let ray = cam.pixel_direction(&basis, i, j);
                     // The map is turned 30° about +Y: look up R_y(−30°) ray.
                     let expected = if name == "smooth" {
-                        map.radiance(precompute::envmap::rotate_y(ray, -30f32.to_radians()))
+                        map.radiance(foundation::envmap::rotate_y(ray, -30f32.to_radians()))
                     } else {
                         Rgb::ONE
                     };
@@ -1051,8 +1051,8 @@ fn background_shows_the_map_filtered() {
 /// bilinear filtering blends) are left out.
 #[test]
 fn a_textured_quad_shows_its_texture_per_pixel_on_the_gpu_and_in_the_reference() {
-    use precompute::image_io::srgb_decode;
-    use precompute::texture::AlbedoTexture;
+    use foundation::image_io::srgb_decode;
+    use foundation::texture::AlbedoTexture;
     use std::sync::Arc;
     const SIDE: usize = 16;
     const CELL: usize = 4;

@@ -5,7 +5,7 @@
 mod common;
 
 use common::*;
-use precompute::image_io::read_exr;
+use foundation::image_io::read_exr;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 

@@ -5,11 +5,11 @@
 mod common;
 
 use common::bake_quietly;
+use foundation::bvh::SceneBvh;
+use foundation::color::Rgb;
+use foundation::scene::Scene;
+use foundation::sh::ShCoeffs;
 use precompute::bake::BakeSettings;
-use precompute::bvh::SceneBvh;
-use precompute::color::Rgb;
-use precompute::scene::Scene;
-use precompute::sh::ShCoeffs;
 
 #[test]
 fn teapot_scene_deficit_shrinks_with_every_bounce() {

@@ -22,9 +22,9 @@
 //!    end    4  u32 CRC-32 (IEEE, zlib's crc32) of every preceding byte
 //! ```
 
-use crate::atomic_file::AtomicOutput;
 use crate::bake::{BakeSettings, RAY_OFFSET_FRACTION, Transfer, TransferVectors};
-use crate::sh::{self, num_coeffs};
+use foundation::infra::atomic_file::AtomicOutput;
+use foundation::sh::{self, num_coeffs};
 use std::path::{Path, PathBuf};
 
 pub const MAGIC: &[u8; 8] = b"HPRTBAKE";

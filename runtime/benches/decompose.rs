@@ -18,7 +18,7 @@ fn bench(c: &mut Criterion) {
         ("hall", 256),
     ] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../scenes/env/{name}.exr"));
-        let map = precompute::envmap::load(&path, None)
+        let map = foundation::envmap::load(&path, None)
             .expect("the bundled map")
             .map;
         for mode in [DecomposeMode::Consistent, DecomposeMode::Thesis] {
@@ -53,7 +53,7 @@ fn bench(c: &mut Criterion) {
     for name in ["sunrise", "hall"] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../scenes/env/{name}.exr"));
         let map = analysis_map(
-            &precompute::envmap::load(&path, None)
+            &foundation::envmap::load(&path, None)
                 .expect("the bundled map")
                 .map,
         );

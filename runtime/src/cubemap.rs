@@ -1,10 +1,10 @@
 //! The cube map the decomposition works on (thesis 4.3.3), its fixed geometry, and the
 //! per-frame resampling from an equirectangular map with a supersampling box filter.
 
+use foundation::Rgb;
+use foundation::envmap::EnvMap;
+use foundation::envmap::cube::{ALL_FACES, CubeFace, texel_solid_angle};
 use glam::Vec3;
-use precompute::Rgb;
-use precompute::envmap::EnvMap;
-use precompute::envmap::cube::{ALL_FACES, CubeFace, texel_solid_angle};
 
 /// Direction and solid angle of every texel of a `6 × size × size` cube map; texel index
 /// `face · size² + y · size + x` (faces in the order of [`CubeFace`]).
@@ -73,7 +73,7 @@ impl CubeGeometry {
         }
         let n = self.size as f32;
         for face in ALL_FACES {
-            let [forward, right, down] = precompute::envmap::cube::FACE_FRAMES[face as usize];
+            let [forward, right, down] = foundation::envmap::cube::FACE_FRAMES[face as usize];
             // Skip faces the cone cannot touch: every face point is within 54.74° of its
             // centre direction.
             if axis.dot(forward) < (angle + 0.9553).min(std::f32::consts::PI).cos() {
@@ -314,7 +314,7 @@ impl CubeResampler {
                             let u = (i as f32 + (b as f32 + 0.5) / s as f32) / map_width as f32;
                             let v = (j as f32 + (a as f32 + 0.5) / s as f32) / map_height as f32;
                             let t =
-                                geometry.texel_of(precompute::envmap::direction_of_uv(u, v)) as u32;
+                                geometry.texel_of(foundation::envmap::direction_of_uv(u, v)) as u32;
                             match cell.iter_mut().find(|(target, _)| *target == t) {
                                 Some(entry) => entry.1 += 1.0,
                                 None => cell.push((t, 1.0)),

@@ -1,7 +1,7 @@
 //! Directional lights: what the decomposition hands the shadow-mapped passes.
 
+use foundation::Rgb;
 use glam::Vec3;
-use precompute::Rgb;
 
 /// A distant light standing for a concentrated source of the environment map.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]

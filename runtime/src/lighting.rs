@@ -18,14 +18,14 @@ use crate::peers::median_cut::{MedianCutError, analysis_map, median_cut};
 use crate::peers::sh_sun;
 use crate::reflection::{ReflectedEnvironment, SharedCube, remainder_cube};
 use crate::tracking::{LightTracker, TrackedLight, TrackingSettings};
+use foundation::Rgb;
+use foundation::envmap::EnvMap;
+use foundation::sh::ShCoeffs;
+use foundation::sh::rotation::ShRotation;
 use glam::{Mat3, Quat, Vec3};
-use precompute::Rgb;
-use precompute::envmap::EnvMap;
-use precompute::sh::ShCoeffs;
-use precompute::sh_rotation::ShRotation;
 use std::time::Instant;
 
-precompute::named_enum! {
+foundation::named_enum! {
     /// What to draw.
     #[derive(Default, serde::Serialize, serde::Deserialize)]
     #[serde(rename_all = "lowercase")]
@@ -596,8 +596,8 @@ pub fn rotate_decomposition(base: &Decomposition, orientation: Quat) -> Decompos
 #[cfg(test)]
 mod tests {
     use super::*;
+    use foundation::luminance;
     use glam::Vec3;
-    use precompute::luminance;
     use std::f32::consts::FRAC_PI_2;
 
     /// A sky with three suns of different widths and brightness, as a function of direction.
@@ -788,7 +788,7 @@ mod tests {
         assert_eq!(frame.decomposition.as_ref(), Some(&by_hand));
         assert!(frame.lighting.lights_indirect);
         let light = frame.lighting.lights[0].direction;
-        let rotated = precompute::envmap::rotate_y(sun, 90f32.to_radians());
+        let rotated = foundation::envmap::rotate_y(sun, 90f32.to_radians());
         assert!(light.dot(rotated) > 0.999, "{light} vs {rotated}");
 
         let thesis = DecomposeSettings::for_mode(DecomposeMode::Thesis, 3);

@@ -11,10 +11,10 @@
 
 use crate::cubemap::{CubeGeometry, CubeMap};
 use crate::light::DirectionalLight;
+use foundation::Rgb;
+use foundation::material::phong_zonal;
+use foundation::sh::ShCoeffs;
 use glam::Quat;
-use precompute::Rgb;
-use precompute::material::phong_zonal;
-use precompute::sh::ShCoeffs;
 use std::sync::Arc;
 
 /// A cube map shared between frames; frames compare it by identity (it is rebuilt, not
@@ -92,7 +92,7 @@ pub fn convolve_exact(
         .zip(geometry.directions())
         .zip(geometry.solid_angles())
     {
-        let w = precompute::material::phong_lobe(r.dot(*d), shininess) * a;
+        let w = foundation::material::phong_lobe(r.dot(*d), shininess) * a;
         sum += *l * w;
         weight += w;
     }

@@ -13,7 +13,7 @@
 use crate::decompose::Decomposition;
 use crate::decompose::weber::weber_elbow;
 use crate::light::DirectionalLight;
-use precompute::luminance;
+use foundation::luminance;
 
 /// How lights are followed.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -187,9 +187,9 @@ impl LightTracker {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use foundation::Rgb;
+    use foundation::sh::ShCoeffs;
     use glam::Vec3;
-    use precompute::Rgb;
-    use precompute::sh::ShCoeffs;
     use std::f32::consts::PI;
 
     fn light(direction: Vec3, power: f32) -> DirectionalLight {

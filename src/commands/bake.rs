@@ -4,11 +4,11 @@ use crate::bake_cache::print_bake_stats;
 use crate::support::{TerminalProgress, load_scene, with_threads};
 use anyhow::Context;
 use clap::Args;
-use precompute::atomic_file::AtomicOutput;
+use foundation::bvh::SceneBvh;
+use foundation::infra::atomic_file::AtomicOutput;
+use foundation::scene::Scene;
 use precompute::bake::{self, BakeSettings};
 use precompute::bakefile;
-use precompute::bvh::SceneBvh;
-use precompute::scene::Scene;
 use std::path::PathBuf;
 use std::time::Instant;
 

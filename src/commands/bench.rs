@@ -4,9 +4,9 @@ use crate::cli::Switch;
 use crate::environment::{self, load_map};
 use crate::support::{load_scene, median, with_threads};
 use clap::{Args, Subcommand};
+use foundation::bvh::SceneBvh;
+use foundation::infra::progress::NoProgress;
 use precompute::bake::{self, BakeSettings};
-use precompute::bvh::SceneBvh;
-use precompute::progress::NoProgress;
 use runtime::render::ShadowSettings;
 use std::path::PathBuf;
 
@@ -206,7 +206,7 @@ fn bench_bake(args: BenchBakeArgs) -> anyhow::Result<()> {
 }
 
 fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
-    use precompute::reference::{self, EnvironmentLight, ReferenceSettings};
+    use reference::{self, EnvironmentLight, ReferenceSettings};
     let scene = load_scene(&args.scene)?;
     let env = environment::choose(&scene, None, None, None)?;
     let camera = scene.camera.with_size(args.width, args.height);
@@ -257,7 +257,7 @@ fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
         return Ok(());
     };
     let dir = tempfile::tempdir()?;
-    let export = precompute::export::ExportSettings {
+    let export = reference::export::ExportSettings {
         camera,
         rotation_deg: env.rotation_deg,
         spp: args.spp,
@@ -563,7 +563,7 @@ fn turn_stats(
         powers.push(
             d.lights
                 .iter()
-                .map(|l| precompute::luminance(l.power) as f64)
+                .map(|l| foundation::luminance(l.power) as f64)
                 .sum::<f64>(),
         );
         if let Some(strongest) = d.lights.first() {

@@ -5,9 +5,9 @@ use crate::environment::load_map;
 use crate::support::median;
 use anyhow::Context;
 use clap::Args;
-use precompute::envmap::Layout;
-use precompute::image_io::write_png_rgb8;
-use precompute::{Rgb, luminance};
+use foundation::envmap::Layout;
+use foundation::image_io::write_png_rgb8;
+use foundation::{Rgb, luminance};
 use runtime::decompose::visualize::{decomposition_picture, describe};
 use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
 use std::path::PathBuf;
@@ -124,7 +124,7 @@ pub fn run(args: DecomposeArgs) -> anyhow::Result<()> {
         decomposition_ms_all: times,
     };
     let text = serde_json::to_string_pretty(&json)?;
-    precompute::atomic_file::write_atomic(&args.output, text.as_bytes())
+    foundation::infra::atomic_file::write_atomic(&args.output, text.as_bytes())
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     if let Some(png) = &args.png {
         let picture = decomposition_picture(&loaded.map, args.rotate.to_radians(), &result, 1024);

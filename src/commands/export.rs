@@ -4,7 +4,7 @@ use crate::cli::{EnvironmentArgs, ImageSizeArgs};
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
-use precompute::export::{ExportSettings, export_mitsuba, mitsuba_max_depth};
+use reference::export::{ExportSettings, export_mitsuba, mitsuba_max_depth};
 use std::path::PathBuf;
 
 #[derive(Args)]

@@ -2,9 +2,9 @@
 //! with `hprt export`, rendered and timed by Mitsuba, so both renderers are measured in one run.
 
 use anyhow::Context;
-use precompute::export::{ExportSettings, export_mitsuba};
-use precompute::image_io::{RgbImageF32, read_exr};
-use precompute::scene::SceneMesh;
+use foundation::image_io::{RgbImageF32, read_exr};
+use foundation::scene::SceneMesh;
+use reference::export::{ExportSettings, export_mitsuba};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -79,7 +79,7 @@ impl Mitsuba {
         &self,
         dir: &Path,
         geometry: &SceneMesh,
-        map: &precompute::envmap::EnvMap,
+        map: &foundation::envmap::EnvMap,
         settings: &ExportSettings,
         repeat: usize,
     ) -> anyhow::Result<(Vec<f64>, RgbImageF32)> {
@@ -138,7 +138,7 @@ pub fn covered_mean_difference(ours: &RgbImageF32, theirs: &RgbImageF32, covered
             .zip(covered)
             .filter(|(_, c)| **c > 0.5)
             .fold((0.0f64, 0usize), |(s, n), (p, _)| {
-                (s + f64::from(precompute::luminance(*p)), n + 1)
+                (s + f64::from(foundation::luminance(*p)), n + 1)
             });
         sum / n.max(1) as f64
     };

@@ -5,12 +5,10 @@ use crate::environment::default_exposure;
 use crate::support::{TerminalProgress, load_scene, with_threads};
 use anyhow::Context;
 use clap::Args;
-use precompute::atomic_file::AtomicOutput;
-use precompute::bvh::SceneBvh;
-use precompute::image_io::{RgbImageF32, exr_bytes, write_exr, write_png};
-use precompute::reference::{
-    self, EnvironmentLight, ReferenceImage, ReferenceSettings, SamplerKind,
-};
+use foundation::bvh::SceneBvh;
+use foundation::image_io::{RgbImageF32, exr_bytes, write_exr, write_png};
+use foundation::infra::atomic_file::AtomicOutput;
+use reference::{self, EnvironmentLight, ReferenceImage, ReferenceSettings, SamplerKind};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -66,7 +64,7 @@ pub fn write_grey(
         .iter()
         .flat_map(|v| [(v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8; 3])
         .collect();
-    precompute::image_io::write_png_rgb8(&dir.join(format!("{name}.png")), width, height, &rgb)?;
+    foundation::image_io::write_png_rgb8(&dir.join(format!("{name}.png")), width, height, &rgb)?;
     Ok(())
 }
 

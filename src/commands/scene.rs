@@ -3,10 +3,10 @@
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use precompute::atomic_file::write_atomic;
-use precompute::mesh::is_mesh_file;
-use precompute::model_scene::scene_file_for_model;
-use precompute::scene::{EnvironmentSpec, Scene};
+use foundation::infra::atomic_file::write_atomic;
+use foundation::mesh::is_mesh_file;
+use foundation::scene::model::scene_file_for_model;
+use foundation::scene::{EnvironmentSpec, Scene};
 use std::path::{Path, PathBuf};
 
 #[derive(Subcommand)]

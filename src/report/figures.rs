@@ -74,7 +74,7 @@ pub fn heat_map(
         bar.draw(&Text::new(title.to_owned(), (0, 4), style))?;
         root.present()?;
     }
-    Ok(precompute::image_io::png_bytes(
+    Ok(foundation::image_io::png_bytes(
         &rgb, w as usize, h as usize,
     )?)
 }

@@ -5,28 +5,28 @@
 
 pub mod figures;
 mod html;
-mod reference;
 pub mod sequence;
 pub mod stats;
+mod truth;
 
 use crate::bake_cache;
 use crate::cli::ReportOptions;
 use crate::environment::{default_exposure, load_map, scene_rotation};
 use crate::support::median;
 use figures::Curve;
-use precompute::atomic_file::write_atomic;
+use foundation::camera::Camera;
+use foundation::image_io::{RgbImageF32, write_exr, write_png};
+use foundation::infra::atomic_file::write_atomic;
+use foundation::scene::Scene;
 use precompute::bake::Transfer;
-use precompute::camera::Camera;
-use precompute::image_io::{RgbImageF32, write_exr, write_png};
-use precompute::reference::SamplerKind;
-use precompute::scene::Scene;
-pub use reference::NoiseTarget;
-pub(crate) use reference::{ReferenceImages, ReferenceRequest, reference_images};
+use reference::SamplerKind;
 use runtime::render::{Backend, FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
 use stats::{ErrorStats, Masks, NoiseFloor, error_stats};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+pub use truth::NoiseTarget;
+pub(crate) use truth::{ReferenceImages, ReferenceRequest, reference_images};
 
 /// What a report renders.
 #[derive(Debug, Clone, serde::Serialize)]

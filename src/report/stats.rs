@@ -2,8 +2,8 @@
 //! statistics"): `|Y(tonemap(test)) − Y(tonemap(reference))|` over covered pixels and over the
 //! shadow region, the penumbra region and (glossy scenes) the highlight region, and the RMSE of linear luminance relative to the reference's mean.
 
-use precompute::image_io::{RgbImageF32, tonemap};
-use precompute::luminance;
+use foundation::image_io::{RgbImageF32, tonemap};
+use foundation::luminance;
 
 /// Pixels whose reference direct visibility is below this belong to the shadow region.
 pub const SHADOW_VISIBILITY: f32 = 0.5;
@@ -245,7 +245,7 @@ pub const NOISE_WARNING: f64 = 0.2;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use precompute::Rgb;
+    use foundation::Rgb;
 
     /// Halves that differ by known amounts: the floor is half their tone-mapped difference,
     /// and the corrected RMSE removes exactly the variance `(a − b)² / 4`.

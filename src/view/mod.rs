@@ -18,10 +18,10 @@ use crate::sequence::Sequence;
 use crate::support::{load_scene, median};
 use anyhow::Context;
 use clap::Args;
+use foundation::infra::progress::SharedProgress;
+use foundation::scene::Scene;
 use orbit::Orbit;
 use precompute::bake::Transfer;
-use precompute::progress::SharedProgress;
-use precompute::scene::Scene;
 use runtime::lighting::lights_indirect_default;
 use runtime::render::{Backend, RenderMode, Renderer, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings, Decomposition, EnvironmentLighting};
@@ -403,8 +403,8 @@ impl App {
             {
                 m.specular = m
                     .specular
-                    .min(precompute::Rgb::ONE - o.albedo)
-                    .max(precompute::Rgb::ZERO);
+                    .min(foundation::Rgb::ONE - o.albedo)
+                    .max(foundation::Rgb::ZERO);
             }
             renderer.set_materials(&self.settings.materials)?;
             if renderer.is_glossy() {
@@ -509,11 +509,14 @@ impl App {
                 C::WindowScreenshot(path) => self.save_window_screenshot(&path)?,
                 C::SaveRenderLine(path) => {
                     let line = self.command_line(&PathBuf::from("render.png"));
-                    precompute::atomic_file::write_atomic(&path, format!("{line}\n").as_bytes())?;
+                    foundation::infra::atomic_file::write_atomic(
+                        &path,
+                        format!("{line}\n").as_bytes(),
+                    )?;
                 }
                 C::State(path) => {
                     let json = serde_json::to_string_pretty(&self.state_json())?;
-                    precompute::atomic_file::write_atomic(&path, json.as_bytes())?;
+                    foundation::infra::atomic_file::write_atomic(&path, json.as_bytes())?;
                 }
                 C::Quit => {
                     event_loop.exit();
@@ -524,7 +527,7 @@ impl App {
         Ok(())
     }
 
-    fn current_camera(&self) -> precompute::camera::Camera {
+    fn current_camera(&self) -> foundation::camera::Camera {
         let (w, h) = self
             .window
             .gpu
@@ -556,8 +559,8 @@ impl App {
             .as_ref()
             .context("nothing rendered yet (no bake)")?;
         let image = renderer.read_back()?;
-        let rgb = precompute::image_io::to_display_rgb8(&image, self.settings.exposure);
-        precompute::image_io::write_png_rgb8(path, image.width, image.height, &rgb)?;
+        let rgb = foundation::image_io::to_display_rgb8(&image, self.settings.exposure);
+        foundation::image_io::write_png_rgb8(path, image.width, image.height, &rgb)?;
         self.stats.message = format!("saved {}", path.display());
         Ok(())
     }
@@ -572,7 +575,7 @@ impl App {
             &paint,
             &screen,
         )?;
-        precompute::image_io::write_png_rgb8(path, w as usize, h as usize, &rgb)?;
+        foundation::image_io::write_png_rgb8(path, w as usize, h as usize, &rgb)?;
         Ok(())
     }
 

@@ -1,7 +1,7 @@
 //! An orbiting camera: yaw and pitch around a target, a distance, and panning of the target.
 
+use foundation::camera::Camera;
 use glam::Vec3;
-use precompute::camera::Camera;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Orbit {

@@ -1,8 +1,8 @@
 //! What the viewer's panel controls, and the `hprt render` command line that reproduces it.
 
-use precompute::Rgb;
-use precompute::camera::Camera;
-use precompute::material::{MAX_SHININESS, Material};
+use foundation::Rgb;
+use foundation::camera::Camera;
+use foundation::material::{MAX_SHININESS, Material};
 use runtime::lighting::lights_indirect_default;
 use runtime::render::{RenderMode, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings};

@@ -3,9 +3,9 @@
 //! returns what the user asked for as [`PanelAction`]s.
 
 use super::settings::ViewSettings;
+use foundation::envmap::{EnvMap, direction_of_uv, rotate_y, uv_of_direction};
+use foundation::image_io::{srgb_encode, tonemap};
 use precompute::bake::BakeSettings;
-use precompute::envmap::{EnvMap, direction_of_uv, rotate_y, uv_of_direction};
-use precompute::image_io::{srgb_encode, tonemap};
 use runtime::render::RenderMode;
 use runtime::{DecomposeMode, Decomposition, TrackedLight};
 use std::path::{Path, PathBuf};
@@ -43,7 +43,7 @@ pub struct PanelInfo<'a> {
     /// The `hprt render` command line of the current view.
     pub command_line: String,
     /// Each object's name and diffuse albedo (the bound on its specular).
-    pub objects: Vec<(&'a str, precompute::Rgb)>,
+    pub objects: Vec<(&'a str, foundation::Rgb)>,
 }
 
 /// What the user asked for in the panel.
@@ -331,7 +331,7 @@ impl Panel<'_> {
         ui.add(
             egui::Slider::new(
                 &mut material.shininess,
-                1.0..=precompute::material::MAX_SHININESS,
+                1.0..=foundation::material::MAX_SHININESS,
             )
             .logarithmic(true)
             .text("shininess"),

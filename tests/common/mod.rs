@@ -82,11 +82,11 @@ pub fn write_scene(dir: &Path, name: &str, object: &str) -> PathBuf {
 
 /// Bakes `geometry` without a progress bar.
 pub fn bake_quietly(
-    geometry: &precompute::scene::SceneMesh,
-    bvh: &precompute::bvh::SceneBvh,
+    geometry: &foundation::scene::SceneMesh,
+    bvh: &foundation::bvh::SceneBvh,
     settings: &precompute::bake::BakeSettings,
 ) -> precompute::bake::Transfer {
-    let progress = precompute::progress::NoProgress;
+    let progress = foundation::infra::progress::NoProgress;
     precompute::bake::bake(geometry, bvh, settings, &progress)
         .expect("valid bake settings")
         .0
@@ -130,11 +130,11 @@ pub fn gpus() -> Vec<runtime::render::GpuContext> {
 /// One frame of `geometry` under `lighting`, without the background.
 pub fn render(
     gpu: &runtime::render::GpuContext,
-    geometry: &precompute::scene::SceneMesh,
+    geometry: &foundation::scene::SceneMesh,
     transfer: &precompute::bake::Transfer,
-    camera: &precompute::camera::Camera,
+    camera: &foundation::camera::Camera,
     lighting: &runtime::render::FrameLighting,
-) -> precompute::image_io::RgbImageF32 {
+) -> foundation::image_io::RgbImageF32 {
     let mut renderer = runtime::render::Renderer::new(
         gpu,
         geometry,
@@ -151,13 +151,13 @@ pub fn render(
 
 /// Mean `|Y(tonemap(a)) − Y(tonemap(b))|` over `mask` (the reports' mean error).
 pub fn tone_mapped_error(
-    a: &precompute::image_io::RgbImageF32,
-    b: &precompute::image_io::RgbImageF32,
+    a: &foundation::image_io::RgbImageF32,
+    b: &foundation::image_io::RgbImageF32,
     mask: &[bool],
     exposure: f32,
 ) -> f32 {
-    use precompute::image_io::tonemap;
-    use precompute::luminance;
+    use foundation::image_io::tonemap;
+    use foundation::luminance;
     let (sum, n) = a
         .pixels
         .iter()

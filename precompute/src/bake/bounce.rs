@@ -1,7 +1,7 @@
 //! The interreflection operator and one Neumann-series bounce.
 
 use super::TransferVectors;
-use crate::color::Rgb;
+use foundation::color::Rgb;
 use rayon::prelude::*;
 
 /// Sparse vertex-to-vertex operator `W`: `W[v][j]` is the fraction of vertex `v`'s

@@ -5,7 +5,7 @@
 //! neighbours outside, growing inward ring by ring.
 
 use super::TransferVectors;
-use crate::mesh::TriangleMesh;
+use foundation::mesh::TriangleMesh;
 
 /// Each vertex's neighbours through shared triangles (compressed rows).
 #[derive(Debug, Clone, Default)]

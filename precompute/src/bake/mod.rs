@@ -17,11 +17,11 @@ pub use inside::{VertexNeighbours, fill_inside};
 pub use transfer::TransferVectors;
 pub use visibility::INSIDE_BACKFACE_FRACTION;
 
-pub use crate::bake_settings::{BakeSettings, MAX_BOUNCES, MAX_SAMPLES};
-use crate::bvh::SceneBvh;
-use crate::progress::Progress;
-use crate::scene::SceneMesh;
-use crate::settings::InvalidSettings;
+pub use foundation::bake_settings::{BakeSettings, MAX_BOUNCES, MAX_SAMPLES};
+use foundation::bvh::SceneBvh;
+use foundation::infra::progress::Progress;
+use foundation::scene::SceneMesh;
+use foundation::settings::InvalidSettings;
 use std::time::Instant;
 
 /// Direct and interreflected transfer of every vertex.
@@ -62,8 +62,7 @@ impl BakeStats {
     }
 }
 
-/// Where the ray-epsilon scale of a scene comes from: a fraction of its bounding-box diagonal.
-pub const RAY_OFFSET_FRACTION: f32 = 1e-5;
+pub use foundation::bvh::RAY_OFFSET_FRACTION;
 
 /// The result of the tracing pass: the direct transfer and the interreflection operator, from
 /// which any number of bounces follows without tracing again.
@@ -73,10 +72,10 @@ pub struct TracedScene {
     pub direct: TransferVectors,
     pub operator: InterreflectionOperator,
     /// The albedo each vertex reflects toward the others ([`SceneMesh::reflected_albedo`]).
-    reflected_albedo: Vec<crate::color::Rgb>,
+    reflected_albedo: Vec<foundation::color::Rgb>,
     /// For a textured scene: the direct transfer with the reflected albedo (what the next
     /// bounce sees) and the stored vertices' albedo; `None` where the two albedos agree.
-    textured: Option<(TransferVectors, Vec<crate::color::Rgb>)>,
+    textured: Option<(TransferVectors, Vec<foundation::color::Rgb>)>,
     /// Vertices inside solids (see [`fill_inside`]); their transfer is their neighbours'.
     pub inside: Vec<bool>,
     neighbours: VertexNeighbours,
@@ -99,7 +98,7 @@ impl TracedScene {
         let ones = self
             .textured
             .as_ref()
-            .map(|_| vec![crate::color::Rgb::ONE; self.direct.vertex_count()]);
+            .map(|_| vec![foundation::color::Rgb::ONE; self.direct.vertex_count()]);
         (0..bounces).map(move |_| {
             let add = |sum: &mut TransferVectors, x: &TransferVectors| {
                 for (acc, x) in sum.as_mut_slice().iter_mut().zip(x.as_slice()) {
@@ -164,7 +163,7 @@ pub fn trace(
 }
 
 /// Bakes the transfer of every vertex of `geometry`. `progress` counts vertices of the
-/// tracing pass (pass [`crate::progress::NoProgress`] for none).
+/// tracing pass (pass [`foundation::infra::progress::NoProgress`] for none).
 pub fn bake(
     geometry: &SceneMesh,
     bvh: &SceneBvh,

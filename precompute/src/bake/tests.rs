@@ -1,9 +1,9 @@
 //! Furnace tests and properties of the bake.
 
 use super::*;
-use crate::color::Rgb;
-use crate::mesh::{TriangleMesh, box_mesh, sphere_mesh};
-use crate::sh::ShCoeffs;
+use foundation::color::Rgb;
+use foundation::mesh::{TriangleMesh, box_mesh, sphere_mesh};
+use foundation::sh::ShCoeffs;
 use glam::Vec3;
 
 /// SH coefficients of a uniform environment of radiance `value`.
@@ -21,7 +21,13 @@ fn scene_of(mesh: &TriangleMesh, albedo: Rgb) -> SceneMesh {
 
 fn run(geometry: &SceneMesh, settings: BakeSettings) -> (Transfer, BakeStats) {
     let bvh = SceneBvh::build(&geometry.mesh);
-    bake(geometry, &bvh, &settings, &crate::progress::NoProgress).unwrap()
+    bake(
+        geometry,
+        &bvh,
+        &settings,
+        &foundation::infra::progress::NoProgress,
+    )
+    .unwrap()
 }
 
 /// An open box (five inward-facing walls, no lid): a concave mesh where every vertex is
@@ -243,7 +249,7 @@ fn plane_facing(normal: Vec3) -> TriangleMesh {
 #[test]
 fn each_sh_basis_function_lights_open_surfaces_by_funk_hecke() {
     let albedo = Rgb::new(0.9, 0.6, 0.3);
-    let basis = crate::sh::ShBasis::new(5).unwrap();
+    let basis = foundation::sh::ShBasis::new(5).unwrap();
     for (name, mesh) in [
         ("sphere", sphere_mesh(Vec3::ZERO, 1.0, 2)),
         ("plane", plane_facing(Vec3::new(0.4, 0.8, -0.45))),
@@ -260,7 +266,7 @@ fn each_sh_basis_function_lights_open_surfaces_by_funk_hecke() {
         let mut worst = 0.0f32;
         for (l, clamped_cosine) in CLAMPED_COSINE.iter().enumerate() {
             for m in -(l as isize)..=l as isize {
-                let k = crate::sh::index(l, m);
+                let k = foundation::sh::index(l, m);
                 let mut light = ShCoeffs::zeros(5);
                 light.as_mut_slice()[k] = Rgb::ONE;
                 for v in 0..geometry.mesh.vertex_count() {
@@ -291,10 +297,18 @@ fn rejects_bad_settings() {
             ..Default::default()
         },
         BakeSettings {
-            order: crate::sh::MAX_ORDER + 1,
+            order: foundation::sh::MAX_ORDER + 1,
             ..Default::default()
         },
     ] {
-        assert!(bake(&geometry, &bvh, &settings, &crate::progress::NoProgress).is_err());
+        assert!(
+            bake(
+                &geometry,
+                &bvh,
+                &settings,
+                &foundation::infra::progress::NoProgress
+            )
+            .is_err()
+        );
     }
 }

@@ -1,7 +1,7 @@
 //! Per-vertex transfer vectors: what a bake produces.
 
-use crate::color::Rgb;
-use crate::sh::{ShCoeffs, num_coeffs};
+use foundation::color::Rgb;
+use foundation::sh::{ShCoeffs, num_coeffs};
 
 /// For each vertex and colour channel, `order²` SH coefficients `t_c` such that the vertex's
 /// outgoing radiance under lighting `l_c` is `dot(t_c, l_c)`. Albedo and cosine are inside.

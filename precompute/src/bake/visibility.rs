@@ -2,14 +2,14 @@
 
 use super::bounce::OperatorBlock;
 use super::{BakeSettings, InterreflectionOperator, RAY_OFFSET_FRACTION, TransferVectors};
-use crate::bvh::{SceneBvh, Skip};
-use crate::color::Rgb;
-use crate::progress::Progress;
-use crate::sampling::{
+use foundation::bvh::{SceneBvh, Skip};
+use foundation::color::Rgb;
+use foundation::infra::progress::Progress;
+use foundation::sampling::{
     Frame, cosine_hemisphere, cranley_patterson, hammersley, hash_to_unit2, mix64,
 };
-use crate::scene::SceneMesh;
-use crate::sh::{ShBasis, num_coeffs};
+use foundation::scene::SceneMesh;
+use foundation::sh::{ShBasis, num_coeffs};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 

@@ -1,7 +1,7 @@
 //! The subdivided icosahedron the decomposition samples the sphere on (thesis 4.3.3).
 
+use foundation::mesh::{icosahedron, subdivide};
 use glam::Vec3;
-use precompute::mesh::{icosahedron, subdivide};
 
 /// Unit vertices of a subdivided icosahedron with their one-ring neighbours.
 #[derive(Debug, Clone)]

@@ -22,17 +22,17 @@ pub mod window;
 
 use crate::cubemap::{CubeGeometry, CubeMap};
 use crate::light::DirectionalLight;
+use foundation::settings::InvalidSettings;
+use foundation::sh::{ShCoeffs, clamped_cosine_bands};
+use foundation::{Rgb, luminance};
 use glam::Vec3;
 use icosphere::Icosphere;
-use precompute::settings::InvalidSettings;
-use precompute::sh::{ShCoeffs, clamped_cosine_bands};
-use precompute::{Rgb, luminance};
 use projection::{BasisColumns, ShProjector};
 use smoothing::GaussianSmoothing;
 use std::f32::consts::PI;
 pub use window::Window;
 
-precompute::named_enum! {
+foundation::named_enum! {
     /// How light power and the SH part are formed from the peaks.
     #[derive(serde::Serialize, serde::Deserialize)]
     #[serde(rename_all = "lowercase")]
@@ -117,7 +117,7 @@ impl DecomposeSettings {
                 reason,
             )))
         };
-        if let Err(e) = precompute::sh::check_order(self.order) {
+        if let Err(e) = foundation::sh::check_order(self.order) {
             return invalid(e.to_string());
         }
         if !(4..=1024).contains(&self.face_size) {
@@ -227,7 +227,7 @@ pub struct Decomposer {
     /// For each analysis texel, the input texels it averages (empty when not downsampling).
     downsample: Vec<(Vec<u32>, Vec<f32>)>,
     analysis_map: CubeMap,
-    basis: precompute::sh::ShBasis<f32>,
+    basis: foundation::sh::ShBasis<f32>,
     ico: Icosphere,
     smoothing: GaussianSmoothing,
     projector: ShProjector,
@@ -270,7 +270,7 @@ impl Decomposer {
         Ok(Self {
             analysis_map: CubeMap::uniform(a, Rgb::ZERO),
             downsample,
-            basis: precompute::sh::ShBasis::new(settings.order).map_err(|e| {
+            basis: foundation::sh::ShBasis::new(settings.order).map_err(|e| {
                 DecomposeError(InvalidSettings::new(
                     "decomposition settings",
                     e.to_string(),

@@ -2,9 +2,9 @@
 //! and evaluation of expansions at fixed directions, with every basis value tabulated once.
 
 use crate::cubemap::{CubeGeometry, CubeMap};
+use foundation::Rgb;
+use foundation::sh::{ShBasis, ShCoeffs, num_coeffs};
 use glam::Vec3;
-use precompute::Rgb;
-use precompute::sh::{ShBasis, ShCoeffs, num_coeffs};
 
 /// SH basis values at a fixed set of directions: row `i` holds `Y_k(d_i)` for the `n²` k,
 /// padded with zeros to a multiple of [`LANES`] so that whole rows vectorize.

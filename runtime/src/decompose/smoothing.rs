@@ -4,8 +4,8 @@
 //! is computed once; smoothing a map is then a sparse weighted sum.
 
 use crate::cubemap::{CubeGeometry, CubeMap};
+use foundation::Rgb;
 use glam::Vec3;
-use precompute::Rgb;
 
 #[derive(Debug, Clone)]
 pub struct GaussianSmoothing {

@@ -18,9 +18,9 @@
 //! distance from the light, `E[θ] = 2ρ/3` for a uniform disc); the shadow filter spreads its
 //! samples over both discs in proportion (CONVENTIONS.md, "Shadows and background on the GPU").
 
+use foundation::envmap::EnvMap;
+use foundation::luminance;
 use glam::Vec3;
-use precompute::envmap::EnvMap;
-use precompute::luminance;
 use std::f32::consts::PI;
 
 /// Texels within this angle of a light give its local background (their median luminance);
@@ -49,7 +49,7 @@ impl EquirectTexels {
         let rows = (0..height)
             .map(|j| (PI * ((j as f32 + 0.5) / height as f32)).sin_cos())
             .collect();
-        let shape = EnvMap::uniform(width, height, precompute::Rgb::ZERO);
+        let shape = EnvMap::uniform(width, height, foundation::Rgb::ZERO);
         Self {
             columns,
             rows,
@@ -99,7 +99,7 @@ impl TexelTable<'_> {
         let (theta, rows) = self.cap_rows(centre, radius);
         let row_angle = PI / self.height() as f32;
         let cos_radius = radius.cos();
-        let centre_u = precompute::envmap::uv_of_direction(centre).0 * w as f32;
+        let centre_u = foundation::envmap::uv_of_direction(centre).0 * w as f32;
         let column_angle = std::f64::consts::TAU / w as f64;
         for j in rows {
             // Columns to test: all of them near a pole, else a window around the centre's.
@@ -160,7 +160,7 @@ impl TexelTable<'_> {
         let w = self.width();
         let (theta, rows) = self.cap_rows(centre, radius);
         let cos_radius = radius.cos();
-        let centre_u = f64::from(precompute::envmap::uv_of_direction(centre).0) * w as f64;
+        let centre_u = f64::from(foundation::envmap::uv_of_direction(centre).0) * w as f64;
         let column_angle = std::f64::consts::TAU / w as f64;
         let (sin_c, cos_c) = (f64::from(theta).sin(), f64::from(theta).cos());
         let texels = self.map.texels();
@@ -646,7 +646,7 @@ mod tests {
     ) -> Vec<Option<SourceShape>> {
         SourceMeter::new().shapes(map, directions, cap_radius)
     }
-    use precompute::Rgb;
+    use foundation::Rgb;
 
     /// A map of `width × width/2` with a uniform disc of angular radius `radius` and radiance
     /// 100 at `centre` over a sky of 1, plus a glow of 5 falling off over 3 radii around it.
@@ -672,7 +672,7 @@ mod tests {
                 for s in 0..n * n {
                     let u = (i as f32 + ((s % n) as f32 + 0.5) / n as f32) / width as f32;
                     let v = (j as f32 + ((s / n) as f32 + 0.5) / n as f32) / height as f32;
-                    let angle = precompute::envmap::direction_of_uv(u, v)
+                    let angle = foundation::envmap::direction_of_uv(u, v)
                         .dot(centre)
                         .clamp(-1.0, 1.0)
                         .acos();

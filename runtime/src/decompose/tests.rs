@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::cubemap::CubeSource;
-use precompute::envmap::EnvMap;
+use foundation::envmap::EnvMap;
 
 /// A smooth sky-like background plus discs of uniform radiance.
 struct Synthetic {
@@ -312,7 +312,7 @@ fn every_sh_window_scales_the_sh_part_band_by_band_in_both_modes() {
             }
             for (l, factor) in factors.iter().enumerate().take(5) {
                 for m in -(l as isize)..=l as isize {
-                    let k = precompute::sh::index(l, m);
+                    let k = foundation::sh::index(l, m);
                     let want = plain.sh.as_slice()[k] * *factor;
                     let got = windowed.sh.as_slice()[k];
                     assert!(
@@ -352,7 +352,7 @@ fn rotating_the_map_rotates_lights_and_irradiance() {
     let turned = decompose(&map, angle, settings);
     assert_eq!(base.lights.len(), turned.lights.len());
     for (i, (a, b)) in base.lights.iter().zip(&turned.lights).enumerate() {
-        let expected = precompute::envmap::rotate_y(a.direction, angle);
+        let expected = foundation::envmap::rotate_y(a.direction, angle);
         assert!(expected.angle_between(b.direction).to_degrees() < 0.5);
         // Both stay within the accuracy bound of the true source power.
         let source = (0..3)
@@ -370,7 +370,7 @@ fn rotating_the_map_rotates_lights_and_irradiance() {
         );
     }
     for n in [Vec3::Y, Vec3::new(0.5, 0.2, -0.84).normalize(), Vec3::NEG_X] {
-        let expected = base.irradiance(precompute::envmap::rotate_y(n, -angle));
+        let expected = base.irradiance(foundation::envmap::rotate_y(n, -angle));
         let got = turned.irradiance(n);
         assert!(
             ((got - expected) / expected).abs().max_element() < 0.02,
@@ -461,11 +461,11 @@ fn more_lights_than_peaks_considered_is_an_error() {
     assert!(message.contains("at most 24 lights"), "{message}");
 }
 
-/// The smallest maps hprt reads (`precompute::envmap::MIN_MAP_WIDTH`) decompose like large
+/// The smallest maps hprt reads (`foundation::envmap::MIN_MAP_WIDTH`) decompose like large
 /// ones: a uniform map has no light and its SH part holds exactly its power, 4π.
 #[test]
 fn the_smallest_uniform_maps_have_no_lights() {
-    let min = precompute::envmap::MIN_MAP_WIDTH;
+    let min = foundation::envmap::MIN_MAP_WIDTH;
     for (w, h) in [(min, min / 2), (100, 50), (128, 64)] {
         let map = EnvMap::uniform(w, h, Rgb::ONE);
         for mode in [DecomposeMode::Consistent, DecomposeMode::Thesis] {

@@ -2,11 +2,11 @@
 //! equirectangular panels.
 
 use super::Decomposition;
+use foundation::envmap::{EnvMap, direction_of_uv, uv_of_direction};
+use foundation::image_io::{srgb_encode, tonemap};
+use foundation::sh::ShBasis;
+use foundation::{Rgb, luminance};
 use glam::Vec3;
-use precompute::envmap::{EnvMap, direction_of_uv, uv_of_direction};
-use precompute::image_io::{srgb_encode, tonemap};
-use precompute::sh::ShBasis;
-use precompute::{Rgb, luminance};
 
 /// An 8-bit RGB picture.
 pub struct Picture {
@@ -96,7 +96,7 @@ fn map_average(map: &EnvMap, rotation: f32, i: usize, j: usize, w: usize, h: usi
             let u = (i as f32 + (b as f32 + 0.5) / sx as f32) / w as f32;
             let v = (j as f32 + (a as f32 + 0.5) / sy as f32) / h as f32;
             let dir = direction_of_uv(u, v);
-            sum += map.radiance(precompute::envmap::rotate_y(dir, -rotation));
+            sum += map.radiance(foundation::envmap::rotate_y(dir, -rotation));
         }
     }
     sum / (sx * sy) as f32

@@ -1,6 +1,6 @@
 //! Windows that damp the ringing of a truncated SH expansion (thesis 4.3.3, "windowing").
 
-precompute::named_enum! {
+foundation::named_enum! {
     /// A band-wise window `w_l` applied to SH coefficients.
     #[derive(serde::Serialize, serde::Deserialize)]
     #[serde(rename_all = "lowercase")]
@@ -39,8 +39,8 @@ impl Window {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use foundation::sh::{ShBasis, ShCoeffs};
     use glam::Vec3;
-    use precompute::sh::{ShBasis, ShCoeffs};
 
     /// Most negative value of an expansion over a fine set of directions, relative to its peak.
     fn negative_lobe(c: &ShCoeffs<f32>) -> f32 {

@@ -10,9 +10,9 @@
 //! O(log n) whatever the region's size.
 
 use crate::light::DirectionalLight;
+use foundation::envmap::EnvMap;
+use foundation::{Rgb, luminance};
 use glam::Vec3;
-use precompute::envmap::EnvMap;
-use precompute::{Rgb, luminance};
 use std::f32::consts::PI;
 use thiserror::Error;
 

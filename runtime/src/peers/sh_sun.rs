@@ -43,9 +43,9 @@ pub fn lighting(decomposition: &Decomposition) -> FrameLighting {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use foundation::envmap::EnvMap;
+    use foundation::{Rgb, luminance};
     use glam::Vec3;
-    use precompute::envmap::EnvMap;
-    use precompute::{Rgb, luminance};
     use std::f32::consts::PI;
 
     /// Under a sky `L(ω) = 1 + ω_y` (exactly bands 0 and 1), a surface of normal n receives

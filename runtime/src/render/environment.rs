@@ -1,8 +1,8 @@
 //! The environment map shown behind the scene: the full-resolution map with its mipmaps,
 //! sampled with trilinear filtering at the level whose texels match the screen's pixels.
 
-use precompute::Rgb;
-use precompute::envmap::EnvMap;
+use foundation::Rgb;
+use foundation::envmap::EnvMap;
 
 /// The largest finite half float: brighter texels (a sun's core) are clamped to it, which the
 /// tone-mapped background cannot show anyway.

@@ -2,7 +2,7 @@
 
 use std::fmt;
 
-precompute::named_enum! {
+foundation::named_enum! {
     /// Which graphics API to use.
     #[derive(Default)]
     pub enum Backend ("graphics backend") {

@@ -7,12 +7,12 @@ use super::materials::GpuMaterials;
 use super::shaders::{MAX_GPU_COEFFS, MAX_GPU_ORDER, Shader, TRANSFER_WORKGROUP};
 use crate::lighting::{FrameLighting, ShTransfer};
 use bytemuck::{Pod, Zeroable};
+use foundation::color::Rgb;
+use foundation::scene::SceneMesh;
+use foundation::sh::num_coeffs;
+use foundation::texture::AlbedoTexture;
 use glam::Vec3;
 use precompute::bake::Transfer;
-use precompute::color::Rgb;
-use precompute::scene::SceneMesh;
-use precompute::sh::num_coeffs;
-use precompute::texture::AlbedoTexture;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
 

@@ -6,9 +6,9 @@ use super::RenderError;
 use super::pass_helpers::writable_buffer;
 use super::shaders::MAX_MATERIALS;
 use bytemuck::{Pod, Zeroable};
-use precompute::material::Material;
-use precompute::scene::SceneMesh;
-use precompute::settings::InvalidSettings;
+use foundation::material::Material;
+use foundation::scene::SceneMesh;
+use foundation::settings::InvalidSettings;
 use wgpu::util::DeviceExt;
 
 /// Matches `Material` in `shaders/glossy.wgsl`.
@@ -190,7 +190,7 @@ fn vertices(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use precompute::Rgb;
+    use foundation::Rgb;
 
     #[test]
     fn distinct_materials_share_entries_and_slots() {

@@ -12,7 +12,7 @@ use super::shaders::Shader;
 use crate::cubemap::{CubeGeometry, CubeMap};
 use crate::reflection::{ReflectedEnvironment, sh_reflection_map};
 use bytemuck::{Pod, Zeroable};
-use precompute::Rgb;
+use foundation::Rgb;
 
 pub const REFLECTION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Uniform offsets must be multiples of the adapter's alignment, at most 256 bytes.

@@ -2,7 +2,7 @@
 //! Rust side sizes its buffers by, as WGSL constants, so the two cannot disagree; the render
 //! passes' modules also get `shaders/common.wgsl` (the uniform structs they share).
 
-use precompute::sh::num_coeffs;
+use foundation::sh::num_coeffs;
 
 /// Most lights drawn per frame (the light pass's uniform array).
 pub const MAX_LIGHTS: usize = 32;

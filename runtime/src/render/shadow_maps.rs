@@ -43,7 +43,7 @@ impl ShadowSettings {
     pub fn validate(&self) -> Result<(), RenderError> {
         let invalid = |reason: String| {
             Err(RenderError::Settings(
-                precompute::settings::InvalidSettings::new("shadow settings", reason),
+                foundation::settings::InvalidSettings::new("shadow settings", reason),
             ))
         };
         if !(16..=8192).contains(&self.resolution) {
@@ -518,7 +518,7 @@ mod tests {
     }
 
     fn view_proj(position: Vec3, target: Vec3, fov_y_deg: f32) -> Mat4 {
-        let camera = precompute::camera::Camera {
+        let camera = foundation::camera::Camera {
             position,
             target,
             up: Vec3::Y,

@@ -6,10 +6,10 @@ use super::shaders::MAX_LIGHTS;
 use super::shadow_maps::{BoundingSphere, ShadowFit};
 use crate::light::DirectionalLight;
 use bytemuck::{Pod, Zeroable};
+use foundation::Rgb;
+use foundation::camera::Camera;
+use foundation::sh::{ShCoeffs, clamped_cosine_bands};
 use glam::Mat4;
-use precompute::Rgb;
-use precompute::camera::Camera;
-use precompute::sh::{ShCoeffs, clamped_cosine_bands};
 
 /// Matches `Frame` in `shaders/common.wgsl`.
 #[repr(C)]

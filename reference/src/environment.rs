@@ -1,10 +1,10 @@
 //! The environment as a light source for the path tracer: radiance lookup and importance
 //! sampling in world space, with the map's rotation about +Y.
 
-use crate::color::Rgb;
-use crate::envmap::sampling::EnvSampler;
-use crate::envmap::{EnvMap, YRotation};
-use crate::huge_pages::HugePageTable;
+use foundation::color::Rgb;
+use foundation::envmap::sampling::EnvSampler;
+use foundation::envmap::{EnvMap, YRotation};
+use foundation::infra::huge_pages::HugePageTable;
 use glam::{Vec2, Vec3, Vec4};
 
 /// Distant lighting `L(ω) = map(R_y(−rotation) ω)` (CONVENTIONS.md, "Rotating an environment").
@@ -92,7 +92,7 @@ impl<'a> EnvironmentLight<'a> {
 
     #[inline]
     fn pending(&self, index: usize, sin_theta: f32) -> PendingTexel {
-        crate::prefetch::prefetch(self.texels.as_ptr().wrapping_add(index));
+        foundation::infra::prefetch::prefetch(self.texels.as_ptr().wrapping_add(index));
         PendingTexel { index, sin_theta }
     }
 

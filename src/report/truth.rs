@@ -1,19 +1,20 @@
 //! The reports' reference: two independent halves, whose difference measures its own noise
 //! (CONVENTIONS.md, "The reference's noise"), cached with their sample counts so that a later,
-//! stricter request continues them instead of starting over.
+//! stricter request continues them instead of starting over. (The path tracer itself is the
+//! `reference` crate; this module is the report's use of it.)
 
 use super::stats::{Masks, NoiseFloor, noise_floor};
 use crate::bake_cache::{self, cache_dir};
 use crate::support::TerminalProgress;
-use precompute::bvh::SceneBvh;
-use precompute::camera::Camera;
-use precompute::envmap::EnvMap;
-use precompute::image_io::{RgbImageF32, read_exr, write_exr};
-use precompute::progress::Progress;
-use precompute::reference::{
+use foundation::bvh::SceneBvh;
+use foundation::camera::Camera;
+use foundation::envmap::EnvMap;
+use foundation::image_io::{RgbImageF32, read_exr, write_exr};
+use foundation::infra::progress::Progress;
+use foundation::scene::Scene;
+use reference::{
     self, EnvironmentLight, MAX_SOBOL_SAMPLES, ReferenceImage, ReferenceSettings, SamplerKind,
 };
-use precompute::scene::Scene;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -202,7 +203,7 @@ impl CachePaths {
         let meta = CacheMeta {
             samples_per_half: images.samples_per_half,
         };
-        precompute::atomic_file::write_atomic(&self.meta, &serde_json::to_vec(&meta)?)?;
+        foundation::infra::atomic_file::write_atomic(&self.meta, &serde_json::to_vec(&meta)?)?;
         Ok(())
     }
 }

@@ -16,7 +16,7 @@ pub struct UnknownName {
 /// a variant's name, and `FromStr` / `Display` parse and print it.
 ///
 /// ```
-/// precompute::named_enum! {
+/// crate::named_enum! {
 ///     /// A colour.
 ///     pub enum Colour ("colour") {
 ///         Red = "red",
@@ -54,13 +54,13 @@ macro_rules! named_enum {
         }
 
         impl ::std::str::FromStr for $name {
-            type Err = $crate::named_enum::UnknownName;
+            type Err = $crate::infra::named_enum::UnknownName;
             fn from_str(s: &str) -> ::std::result::Result<Self, Self::Err> {
                 $name::ALL
                     .iter()
                     .copied()
                     .find(|v| v.name() == s)
-                    .ok_or_else(|| $crate::named_enum::UnknownName {
+                    .ok_or_else(|| $crate::infra::named_enum::UnknownName {
                         what: $what,
                         given: s.to_owned(),
                         choices: &[$($text),+],

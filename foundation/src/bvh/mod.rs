@@ -1,7 +1,7 @@
 //! Ray casting against the scene: obvhs builds the tree, [`wide`] lays it out four-wide for
 //! the CPU, and the traversals here visit it.
 
-use crate::huge_pages::HugePageTable;
+use crate::infra::huge_pages::HugePageTable;
 use crate::mesh::TriangleMesh;
 use glam::{Vec3, Vec3A};
 use obvhs::bvh2::builder::build_bvh2_from_tris;
@@ -10,6 +10,10 @@ use std::mem::MaybeUninit;
 use wide::{Bvh4, ChildRef, NO_TRIANGLE, TrianglePacket, WideRay, moller_trumbore};
 
 mod wide;
+
+/// Where the ray-epsilon scale of a scene comes from: a fraction of its bounding-box diagonal.
+/// The bake and the reference offset every ray by it, so both see the same geometry.
+pub const RAY_OFFSET_FRACTION: f32 = 1e-5;
 
 /// The closest intersection of a ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -267,7 +271,7 @@ impl SceneBvh {
             self.tree.prefetch(child.index);
         } else {
             let packets = Self::packets_of(child);
-            crate::prefetch::prefetch_range(
+            crate::infra::prefetch::prefetch_range(
                 self.packets.as_ptr().wrapping_add(packets.start),
                 packets.len(),
             );
@@ -347,7 +351,7 @@ mod tests {
     #[test]
     fn traversals_agree_with_testing_every_triangle() {
         use rand_core::Rng;
-        let mut rng = crate::reference::stream(7, 0);
+        let mut rng = rand_pcg::Pcg32::new(7, 0);
         let mut uniform = move || (rng.next_u32() >> 8) as f32 / (1u32 << 24) as f32;
         let mut point = |scale: f32| {
             Vec3::new(uniform(), uniform(), uniform()) * 2.0 * scale - Vec3::splat(scale)

@@ -12,6 +12,10 @@
 //! `sin^m θ` factor carried by `(x + i y)^m`, so no factorial is ever formed and no
 //! trigonometric function is called.
 
+#[cfg(test)]
+pub(crate) mod quadrature;
+pub mod rotation;
+
 use glam::Vec3;
 use num_traits::Float;
 use std::ops::{Add, AddAssign, Mul};
@@ -309,7 +313,7 @@ pub fn clamped_cosine_bands(order: usize) -> Vec<f32> {
 #[cfg(test)]
 pub(crate) mod test_support {
     use super::*;
-    use crate::quadrature::SphereQuadrature;
+    use crate::sh::quadrature::SphereQuadrature;
     use glam::DVec3;
 
     /// The basis at `w` in double precision.
@@ -352,7 +356,7 @@ pub(crate) mod test_support {
 mod tests {
     use super::test_support::{eval64, project64, random_coeffs};
     use super::*;
-    use crate::quadrature::SphereQuadrature;
+    use crate::sh::quadrature::SphereQuadrature;
     use glam::DVec3;
 
     #[test]

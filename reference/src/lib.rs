@@ -8,6 +8,7 @@
 //! does not depend on the number of threads.
 
 mod environment;
+pub mod export;
 mod integrator;
 mod sampler;
 
@@ -15,13 +16,13 @@ pub use environment::EnvironmentLight;
 pub use integrator::{DirectVisibility, Integrator, PathEstimate, SurfacePoint};
 pub use sampler::{MAX_SOBOL_SAMPLES, PathSampler, PixelSampler, SamplerKind, SobolSampler};
 
-use crate::bvh::SceneBvh;
-use crate::camera::Camera;
-use crate::color::Rgb;
-use crate::image_io::RgbImageF32;
-use crate::progress::Progress;
-use crate::sampling::mix64;
-use crate::scene::SceneMesh;
+use foundation::bvh::SceneBvh;
+use foundation::camera::Camera;
+use foundation::color::Rgb;
+use foundation::image_io::RgbImageF32;
+use foundation::infra::progress::Progress;
+use foundation::sampling::mix64;
+use foundation::scene::SceneMesh;
 use rand_pcg::Pcg32;
 use rayon::prelude::*;
 use std::time::Instant;

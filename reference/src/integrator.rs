@@ -1,18 +1,18 @@
 //! The path tracer: next-event estimation with environment importance sampling, combined by
 //! multiple importance sampling (power heuristic) with sampling of the surface's BRDF:
-//! cosine-weighted for a Lambertian surface; for a glossy one ([`crate::material`]) the
+//! cosine-weighted for a Lambertian surface; for a glossy one ([`foundation::material`]) the
 //! diffuse part or the Phong lobe, chosen by their reflectances' luminance (one-sample MIS
 //! over the two: the pdf is their mixture).
 
 use super::environment::EnvironmentLight;
 use super::sampler::PathSampler;
-use crate::bake::RAY_OFFSET_FRACTION;
-use crate::bvh::{Hit, SceneBvh, Skip};
-use crate::color::{Rgb, luminance};
-use crate::huge_pages::HugePageTable;
-use crate::material::{Material, front_view, mirror, phong_lobe, sample_phong_lobe};
-use crate::sampling::{Frame, cosine_hemisphere};
-use crate::scene::{NO_TEXTURE, SceneMesh};
+use foundation::bvh::RAY_OFFSET_FRACTION;
+use foundation::bvh::{Hit, SceneBvh, Skip};
+use foundation::color::{Rgb, luminance};
+use foundation::infra::huge_pages::HugePageTable;
+use foundation::material::{Material, front_view, mirror, phong_lobe, sample_phong_lobe};
+use foundation::sampling::{Frame, cosine_hemisphere};
+use foundation::scene::{NO_TEXTURE, SceneMesh};
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
 
@@ -421,7 +421,7 @@ impl<'a> Integrator<'a> {
                     // The next vertex's light sample does not depend on where it is: drawn
                     // first (the sampler's order is unchanged), its table reads overlap the
                     // reads of the hit's shading data, asked of the cache before it.
-                    crate::prefetch::prefetch(
+                    foundation::infra::prefetch::prefetch(
                         self.triangles.as_ptr().wrapping_add(hit.triangle as usize),
                     );
                     light_sample = self.light.sample_texel(sampler.next_2d());

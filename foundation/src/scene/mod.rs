@@ -1,6 +1,8 @@
 //! Scene files (TOML): objects with transforms and albedos, the camera, the default
 //! environment map and the default bake settings. The format is described in `scenes/README.md`.
 
+pub mod model;
+
 use crate::bake_settings::BakeSettings;
 use crate::camera::Camera;
 use crate::color::Rgb;

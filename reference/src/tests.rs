@@ -1,8 +1,8 @@
 //! Furnace tests, convergence and determinism of the reference renderer.
 
 use super::*;
-use crate::envmap::EnvMap;
-use crate::mesh::{TriangleMesh, box_mesh, sphere_mesh};
+use foundation::envmap::EnvMap;
+use foundation::mesh::{TriangleMesh, box_mesh, sphere_mesh};
 use glam::Vec3;
 
 fn scene_of(objects: &[(&TriangleMesh, Rgb)]) -> SceneMesh {
@@ -50,7 +50,7 @@ fn render_with(
         &light,
         cam,
         settings,
-        &crate::progress::NoProgress,
+        &foundation::infra::progress::NoProgress,
     )
 }
 
@@ -276,7 +276,7 @@ fn shadows_show_in_the_visibility_image() {
 }
 
 fn glossy(mut geometry: SceneMesh, object: usize, specular: Rgb, shininess: f32) -> SceneMesh {
-    geometry.objects[object].material = crate::material::Material {
+    geometry.objects[object].material = foundation::material::Material {
         specular,
         shininess,
     };
@@ -322,7 +322,7 @@ fn glossy_white_furnace_returns_the_sky() {
     let image = render_simple(&geometry, &map, &cam, 64, 3, 1);
     let pixels = sphere_pixels_facing(&cam, 0.5);
     assert!(pixels.len() > 200);
-    let mean = |img: &crate::image_io::RgbImageF32| {
+    let mean = |img: &foundation::image_io::RgbImageF32| {
         pixels.iter().map(|&p| img.pixels[p]).sum::<Rgb>() / pixels.len() as f32
     };
     let total = mean(&image.radiance);
@@ -362,7 +362,7 @@ fn glossy_plane_reflects_the_lobe_convolved_sky() {
     };
     let image = render_simple(&geometry, &map, &cam, 4096, 0, 7);
     let v = -cam.pixel_direction(&cam.basis(), 0, 0);
-    let r = crate::material::mirror(v, Vec3::Y);
+    let r = foundation::material::mirror(v, Vec3::Y);
     let (nt, np) = (600, 600);
     let mut expected = 0.0f64;
     for i in 0..nt {
@@ -374,7 +374,7 @@ fn glossy_plane_reflects_the_lobe_convolved_sky() {
                 theta.cos() as f32,
                 (theta.sin() * phi.sin()) as f32,
             );
-            let lobe = crate::material::phong_lobe(r.dot(w), s);
+            let lobe = foundation::material::phong_lobe(r.dot(w), s);
             expected += f64::from(lobe * map.radiance(w).x) * theta.sin();
         }
     }

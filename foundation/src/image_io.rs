@@ -1,8 +1,8 @@
 //! Image files: linear OpenEXR for radiance, tone-mapped sRGB PNG for display
 //! (CONVENTIONS.md, "Cameras and images"). Every file is written atomically.
 
-use crate::atomic_file::write_atomic;
 use crate::color::Rgb;
+use crate::infra::atomic_file::write_atomic;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]

@@ -2,12 +2,12 @@
 //! reference renderer against an independent one. See the README's "Cross-checking with
 //! Mitsuba 3" for the mapping.
 
-use crate::atomic_file::write_atomic;
-use crate::camera::Camera;
-use crate::envmap::EnvMap;
-use crate::image_io::{RgbImageF32, write_exr};
-use crate::mesh::TriangleMesh;
-use crate::scene::SceneMesh;
+use foundation::camera::Camera;
+use foundation::envmap::EnvMap;
+use foundation::image_io::{RgbImageF32, write_exr};
+use foundation::infra::atomic_file::write_atomic;
+use foundation::mesh::TriangleMesh;
+use foundation::scene::SceneMesh;
 use ply_rs_bw::ply::{
     Addable, DefaultElement, ElementDef, Encoding, Ply, Property, PropertyDef, PropertyType,
     ScalarType,
@@ -303,8 +303,8 @@ pub fn export_mitsuba(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::color::Rgb;
-    use crate::mesh::{LoadOptions, box_mesh, read_mesh};
+    use foundation::color::Rgb;
+    use foundation::mesh::{LoadOptions, box_mesh, read_mesh};
     use glam::Vec3;
 
     #[test]

@@ -6,7 +6,7 @@
 //! obvhs's own compressed wide BVH is designed for GPUs: on a CPU its quantised boxes must be
 //! decoded at every node, and its children come in a fixed order per ray octant.
 
-use crate::huge_pages::HugePageTable;
+use crate::infra::huge_pages::HugePageTable;
 use glam::{Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
 
@@ -163,7 +163,7 @@ impl Builder<'_> {
 impl Bvh4 {
     #[inline(always)]
     pub fn prefetch(&self, node: u32) {
-        crate::prefetch::prefetch(self.nodes.as_ptr().wrapping_add(node as usize));
+        crate::infra::prefetch::prefetch(self.nodes.as_ptr().wrapping_add(node as usize));
     }
 
     pub fn root(&self) -> Option<ChildRef> {

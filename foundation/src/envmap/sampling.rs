@@ -3,7 +3,7 @@
 
 use super::{EnvMap, direction_of_uv, uv_of_direction};
 use crate::color::luminance;
-use crate::huge_pages::HugePageTable;
+use crate::infra::huge_pages::HugePageTable;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 

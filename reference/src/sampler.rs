@@ -7,12 +7,12 @@
 //! deterministic functions of the seed, the pixel and the sample index: the image does not
 //! depend on the number of threads, and samples `[a, b)` rendered later continue `[0, a)`.
 
-use crate::sampling::mix64;
+use foundation::sampling::mix64;
 use glam::Vec2;
 use rand_core::Rng;
 use rand_pcg::Pcg32;
 
-crate::named_enum! {
+foundation::named_enum! {
     /// Which numbers drive the reference's light paths.
     #[derive(Default, serde::Serialize, serde::Deserialize)]
     #[serde(rename_all = "lowercase")]
