@@ -2,6 +2,7 @@
 //! settings. Each command's own arguments live with the command.
 
 use crate::environment::{self, ChosenEnvironment};
+use crate::report::{NoiseTarget, ReportSettings};
 use clap::{Args, ValueEnum};
 use foundation::envmap::Layout;
 use foundation::scene::Scene;
@@ -205,7 +206,7 @@ pub struct ReportOptions {
     /// until its noise floor, in the mean error's units, is at most this: a number (0.001) or
     /// a share of the best method's mean error (20%).
     #[arg(long)]
-    pub target_noise: Option<crate::report::NoiseTarget>,
+    pub target_noise: Option<NoiseTarget>,
     /// With --target-noise: stop before a pass that would end after this many seconds of
     /// rendering one map's reference.
     #[arg(long, value_parser = parse_positive_f64)]
@@ -219,6 +220,30 @@ pub struct ReportOptions {
     /// Graphics backend: auto, vulkan or gl.
     #[arg(long, default_value = "auto")]
     pub backend: Backend,
+}
+
+impl ReportOptions {
+    /// The settings `options` ask for at `camera`'s size; the reference's bounces default to
+    /// the bake's, so both see the same light.
+    pub fn report_settings(
+        &self,
+        camera: &foundation::camera::Camera,
+        transfer: &precompute::bake::Transfer,
+    ) -> ReportSettings {
+        ReportSettings {
+            width: camera.width,
+            height: camera.height,
+            spp: self.spp,
+            bounces: self.bounces.unwrap_or(transfer.settings.bounces),
+            seed: self.seed,
+            sampler: self.sampler,
+            target_noise: self.target_noise,
+            reference_time_limit: self.reference_time_limit,
+            thresholds: self.thresholds.clone(),
+            frames: self.frames as usize,
+            backend: self.backend,
+        }
+    }
 }
 
 /// A vector written "x,y,z" of finite numbers.

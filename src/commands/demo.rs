@@ -3,8 +3,8 @@
 //! minutes on two CPU cores without a GPU; a second run reuses bake and references.
 
 use crate::cli::{ImageSizeArgs, ReportOptions};
+use crate::commands::report::write_report;
 use crate::environment::maps_beside;
-use crate::report::write_report;
 use crate::support::load_scene;
 use clap::Args;
 use std::path::{Path, PathBuf};

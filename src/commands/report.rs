@@ -1,12 +1,15 @@
 //! `hprt report`: error statistics of plain PRT and the hybrid against the path-traced
 //! reference, for one scene under several environment maps (thesis chapter 5).
 
+use crate::bake_cache;
 use crate::cli::ReportOptions;
 use crate::environment::maps_beside;
 use crate::report;
+use crate::sequence::Sequence;
 use crate::support::load_scene;
 use clap::Args;
-use std::path::PathBuf;
+use foundation::scene::Scene;
+use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub struct ReportArgs {
@@ -30,12 +33,7 @@ pub struct ReportArgs {
 pub fn run(args: ReportArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     if let Some(sequence) = &args.env_sequence {
-        return report::sequence::write_sequence_report(
-            &scene,
-            sequence,
-            &args.options,
-            &args.output,
-        );
+        return write_sequence_report(&scene, sequence, &args.options, &args.output);
     }
     let envs = if args.envs.is_empty() {
         let Some(environment) = &scene.environment else {
@@ -48,5 +46,61 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
     } else {
         args.envs.clone()
     };
-    report::write_report(&scene, &envs, &args.options, &args.output)
+    write_report(&scene, &envs, &args.options, &args.output)
+}
+
+/// Checks the options, bakes (or reuses) the transfer, writes the report and prints a summary.
+pub(crate) fn write_report(
+    scene: &Scene,
+    envs: &[PathBuf],
+    options: &ReportOptions,
+    output: &Path,
+) -> anyhow::Result<()> {
+    for t in &options.thresholds {
+        anyhow::ensure!(
+            (0.0..=1.0).contains(t),
+            "--thresholds: {t} is outside [0, 1]"
+        );
+    }
+    anyhow::ensure!(!envs.is_empty(), "no environment maps to report on");
+    let (bake_path, transfer) = bake_cache::bake_for(scene, options.bake.as_deref())?;
+    let camera = options.size.camera(scene)?;
+    let settings = options.report_settings(&camera, &transfer);
+    let report = report::run_report(scene, &transfer, &bake_path, envs, &settings, output)?;
+    report::print_summary(&report, scene.geometry.is_glossy());
+    println!("\nwrote {}", output.join("report.html").display());
+    let failed = report
+        .maps
+        .iter()
+        .filter(|m| m.status == report::MapStatus::Failed)
+        .count();
+    if failed == report.maps.len() {
+        anyhow::bail!("every map failed; see the messages above");
+    }
+    Ok(())
+}
+
+/// Loads the sequence, bakes (or reuses) the transfer and writes the sequence report.
+fn write_sequence_report(
+    scene: &Scene,
+    sequence_path: &Path,
+    options: &ReportOptions,
+    out: &Path,
+) -> anyhow::Result<()> {
+    let sequence = Sequence::load(sequence_path)?;
+    let (_, transfer) = bake_cache::bake_for(scene, options.bake.as_deref())?;
+    let camera = options.size.camera(scene)?;
+    let settings = report::ReportSettings {
+        thresholds: Vec::new(),
+        ..options.report_settings(&camera, &transfer)
+    };
+    report::sequence::write_sequence_report(
+        scene,
+        &sequence,
+        sequence_path,
+        &transfer,
+        camera,
+        &settings,
+        out,
+    )
 }

@@ -6,7 +6,7 @@
 //! that error from a column edge; within it (about 0.15% of directions on a 1024-wide
 //! map) the exact formula decides. The answer is always the exact formula's, bit for bit.
 
-use super::uv_of_direction;
+use super::mapping::uv_of_direction;
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
 
 /// Bound on `|atan2_approx(y, x) − atan2(y, x)|` in radians: the polynomial's own error

@@ -1,7 +1,8 @@
 //! Bicubic Bézier patches in the `.bpt` text format (Newell's teapot): first line the number of
 //! patches; each patch a line `3 3` followed by 16 control points `x y z`, row-major.
 
-use super::{MeshError, RawMesh};
+use super::error::MeshError;
+use super::triangle_mesh::RawMesh;
 use glam::Vec3;
 use std::path::Path;
 

@@ -1,6 +1,7 @@
 //! Validation and preparation of a freshly read mesh.
 
-use super::{MeshError, RawMesh, TriangleMesh};
+use super::error::MeshError;
+use super::triangle_mesh::{RawMesh, TriangleMesh};
 use glam::{IVec3, Vec3};
 use std::collections::HashMap;
 use std::path::Path;

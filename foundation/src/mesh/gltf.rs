@@ -3,7 +3,8 @@
 //! coordinates and the material's base colour (factor and texture). Everything else a material
 //! says is ignored, with one note per material.
 
-use super::{MeshError, RawMesh};
+use super::error::MeshError;
+use super::triangle_mesh::RawMesh;
 use crate::color::Rgb;
 use crate::texture::AlbedoTexture;
 use glam::{Mat3, Mat4, Vec2, Vec3};

@@ -4,128 +4,22 @@
 
 mod bpt;
 mod cleanup;
+mod error;
 mod gltf;
 mod obj;
 mod ply;
 mod shapes;
+mod triangle_mesh;
 
 pub use bpt::{BezierPatch, read_bpt, tessellate_patches};
 pub use cleanup::{CleanupReport, MeshCleanup};
+pub use error::MeshError;
 pub use gltf::{ModelPart, PartMaterial};
 pub use shapes::{annulus_mesh, box_mesh, icosahedron, sphere_mesh, subdivide};
+pub use triangle_mesh::{RawMesh, TriangleMesh};
 
-use glam::{Vec2, Vec3};
-use std::path::{Path, PathBuf};
-
-/// An indexed triangle mesh with one unit normal per vertex and, for a textured mesh, one
-/// texture coordinate per vertex (glTF's convention: origin at the image's top left).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct TriangleMesh {
-    pub positions: Vec<Vec3>,
-    pub normals: Vec<Vec3>,
-    pub triangles: Vec<[u32; 3]>,
-    /// Empty, or one per vertex.
-    pub uvs: Vec<Vec2>,
-}
-
-impl TriangleMesh {
-    pub fn vertex_count(&self) -> usize {
-        self.positions.len()
-    }
-
-    pub fn triangle_count(&self) -> usize {
-        self.triangles.len()
-    }
-
-    /// Corner positions of triangle `t`.
-    #[inline]
-    pub fn corners(&self, t: usize) -> [Vec3; 3] {
-        let [a, b, c] = self.triangles[t];
-        [
-            self.positions[a as usize],
-            self.positions[b as usize],
-            self.positions[c as usize],
-        ]
-    }
-
-    /// Unit geometric normal of triangle `t`, flipped to the side its vertex normals point to
-    /// (the "front" side; a back face shows its front's radiance and occludes: CONVENTIONS.md,
-    /// "Surfaces").
-    pub fn front_normal(&self, t: usize) -> Vec3 {
-        let [a, b, c] = self.corners(t);
-        let n = (b - a).cross(c - a).normalize_or_zero();
-        let shading: Vec3 = self.triangles[t]
-            .iter()
-            .map(|&i| self.normals[i as usize])
-            .sum();
-        if n.dot(shading) < 0.0 { -n } else { n }
-    }
-
-    /// Axis-aligned bounds `(min, max)`; `None` for an empty mesh.
-    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let first = *self.positions.first()?;
-        Some(
-            self.positions
-                .iter()
-                .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))),
-        )
-    }
-
-    /// Appends `other`, offsetting its indices. Texture coordinates stay one per vertex where
-    /// either mesh has them (zero for the other's vertices).
-    pub fn append(&mut self, other: &TriangleMesh) {
-        let base = self.positions.len() as u32;
-        if !self.uvs.is_empty() || !other.uvs.is_empty() {
-            self.uvs.resize(self.positions.len(), Vec2::ZERO);
-            match other.uvs.is_empty() {
-                true => self
-                    .uvs
-                    .extend(std::iter::repeat_n(Vec2::ZERO, other.positions.len())),
-                false => self.uvs.extend_from_slice(&other.uvs),
-            }
-        }
-        self.positions.extend_from_slice(&other.positions);
-        self.normals.extend_from_slice(&other.normals);
-        self.triangles
-            .extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
-    }
-}
-
-/// A mesh as read from a file: positions, triangles and, if the file has them, normals and
-/// texture coordinates.
-#[derive(Debug, Clone, Default)]
-pub struct RawMesh {
-    pub positions: Vec<Vec3>,
-    pub normals: Option<Vec<Vec3>>,
-    pub triangles: Vec<[u32; 3]>,
-    pub uvs: Option<Vec<Vec2>>,
-}
-
-/// Why a mesh could not be loaded. Every variant names the file.
-#[derive(Debug, thiserror::Error)]
-pub enum MeshError {
-    #[error("{}: {cause}", path.display())]
-    Io {
-        path: PathBuf,
-        cause: std::io::Error,
-    },
-    #[error("{}: line {line}: {message}", path.display())]
-    Syntax {
-        path: PathBuf,
-        line: usize,
-        message: String,
-    },
-    #[error("{}: {message}", path.display())]
-    Invalid { path: PathBuf, message: String },
-    #[error("{}: the mesh has no triangles{detail}", path.display())]
-    Empty { path: PathBuf, detail: String },
-    #[error(
-        "{}: unsupported mesh format (expected .obj, .ply, .bpt, optionally gzipped as .gz, or \
-         glTF 2.0: .gltf, .glb)",
-        path.display()
-    )]
-    UnsupportedFormat { path: PathBuf },
-}
+use std::path::Path;
+use triangle_mesh::merge_meshes;
 
 /// Reads a file, transparently decompressing `.gz`.
 /// Largest decompressed mesh file (a gzip file is read only this far).
@@ -268,42 +162,6 @@ pub fn read_mesh(path: &Path, options: &LoadOptions) -> Result<RawMesh, MeshErro
     }
 }
 
-/// Reads and cleans a mesh file: validation, zero-area triangles dropped (counted in the
-/// report), coincident vertices welded where the file has no normals, smooth normals.
-pub fn load_mesh(
-    path: &Path,
-    options: &LoadOptions,
-) -> Result<(TriangleMesh, CleanupReport), MeshError> {
-    let raw = read_mesh(path, options)?;
-    MeshCleanup::default().run(path, raw)
-}
-
-/// One mesh of all `meshes`; normals only if every one has them (and there are vertices).
-fn merge_meshes(meshes: impl IntoIterator<Item = RawMesh>) -> RawMesh {
-    let mut merged = RawMesh {
-        normals: Some(Vec::new()),
-        ..Default::default()
-    };
-    for mesh in meshes {
-        let base = merged.positions.len() as u32;
-        merged.positions.extend(&mesh.positions);
-        merged.normals = match (merged.normals, &mesh.normals) {
-            (Some(mut all), Some(n)) => {
-                all.extend(n);
-                Some(all)
-            }
-            _ => None,
-        };
-        merged
-            .triangles
-            .extend(mesh.triangles.iter().map(|t| t.map(|i| i + base)));
-    }
-    if merged.positions.is_empty() {
-        merged.normals = None;
-    }
-    merged
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -314,19 +172,5 @@ mod tests {
         assert_eq!(format_of(Path::new("teapot.bpt")), Some("bpt"));
         assert_eq!(format_of(Path::new("x.obj")), Some("obj"));
         assert_eq!(format_of(Path::new("x.stl")), None);
-    }
-
-    #[test]
-    fn append_offsets_indices() {
-        let tri = TriangleMesh {
-            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
-            normals: vec![Vec3::Z; 3],
-            triangles: vec![[0, 1, 2]],
-            uvs: Vec::new(),
-        };
-        let mut m = tri.clone();
-        m.append(&tri);
-        assert_eq!(m.triangles, vec![[0, 1, 2], [3, 4, 5]]);
-        assert_eq!(m.bounds(), Some((Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0))));
     }
 }

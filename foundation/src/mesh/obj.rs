@@ -1,6 +1,8 @@
 //! Wavefront OBJ through `tobj`, with the offending line located for error messages.
 
-use super::{MeshError, ModelPart, PartMaterial, RawMesh};
+use super::error::MeshError;
+use super::gltf::{ModelPart, PartMaterial};
+use super::triangle_mesh::{RawMesh, merge_meshes};
 use crate::color::Rgb;
 use crate::texture::AlbedoTexture;
 use glam::{Vec2, Vec3};
@@ -41,9 +43,7 @@ pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     })
     .map_err(|e| syntax_error(path, bytes, e))?;
 
-    Ok(super::merge_meshes(
-        models.iter().map(|m| model_mesh(&m.mesh)),
-    ))
+    Ok(merge_meshes(models.iter().map(|m| model_mesh(&m.mesh))))
 }
 
 /// One tobj model's geometry: normals where every vertex has one, texture coordinates (`vt`

@@ -1,6 +1,7 @@
 //! Stanford PLY (ASCII and binary) through `ply-rs-bw`.
 
-use super::{MeshError, RawMesh};
+use super::error::MeshError;
+use super::triangle_mesh::RawMesh;
 use glam::Vec3;
 use ply_rs_bw::parser::{Parser, Reader};
 use ply_rs_bw::ply::{DefaultElement, PropertyAccess, PropertyAccessResult};

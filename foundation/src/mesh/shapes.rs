@@ -1,6 +1,6 @@
 //! Procedural shapes used by scene files.
 
-use super::TriangleMesh;
+use super::triangle_mesh::TriangleMesh;
 use glam::Vec3;
 
 /// An axis-aligned box with outward-facing flat faces, each face a grid of

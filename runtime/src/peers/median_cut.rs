@@ -153,6 +153,12 @@ pub fn median_cut(map: &EnvMap, count: usize) -> Result<Vec<DirectionalLight>, M
     if !count.is_power_of_two() {
         return Err(MedianCutError::NotAPowerOfTwo(count));
     }
+    Ok(median_cut_in_levels(map, count.trailing_zeros()))
+}
+
+/// The `2^levels` median-cut lights of `map` (see [`median_cut`]).
+pub fn median_cut_in_levels(map: &EnvMap, levels: u32) -> Vec<DirectionalLight> {
+    let count = 1usize << levels.min(usize::BITS - 1);
     let table = EnergyTable::new(map);
     let mut regions = vec![Region {
         x0: 0,
@@ -186,7 +192,7 @@ pub fn median_cut(map: &EnvMap, count: usize) -> Result<Vec<DirectionalLight>, M
         .map(|r| region_light(map, r, total))
         .collect();
     lights.sort_by(|a, b| luminance(b.power).total_cmp(&luminance(a.power)));
-    Ok(lights)
+    lights
 }
 
 /// `map` averaged down to about [`ANALYSIS_WIDTH`] texels wide (by the largest whole factor

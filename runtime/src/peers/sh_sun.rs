@@ -7,8 +7,7 @@
 //! (the brightest peak, whatever its Weber ratio), so the light's power and the SH part add up
 //! to the map; the SH part is then cut to order 3.
 
-use crate::decompose::{DecomposeMode, DecomposeSettings, Decomposition};
-use crate::lighting::{FrameLighting, ShTransfer};
+use crate::decompose::{DecomposeMode, DecomposeSettings};
 
 /// Order of the SH irradiance (bands 0–2).
 pub const SH_ORDER: usize = 3;
@@ -26,20 +25,6 @@ pub fn settings(base: &DecomposeSettings) -> DecomposeSettings {
     }
 }
 
-/// The frame's lighting from a decomposition made with [`settings`].
-pub fn lighting(decomposition: &Decomposition) -> FrameLighting {
-    let sh = decomposition.sh.with_order(SH_ORDER);
-    FrameLighting {
-        // Glossy surfaces reflect the same order-3 SH, convolved with their lobe.
-        reflections: crate::reflection::ReflectedEnvironment::Sh(sh.clone()),
-        sh,
-        lights: decomposition.lights.iter().take(1).copied().collect(),
-        lights_indirect: false,
-        shadows: true,
-        sh_transfer: ShTransfer::Unshadowed,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -54,7 +39,7 @@ mod tests {
     /// map, and the rest is order-3 SH applied unshadowed, adding up to the map.
     #[test]
     fn the_light_is_on_the_disc_and_carries_it() {
-        use crate::lighting::{EnvironmentLighting, RenderMode};
+        use crate::lighting::{EnvironmentLighting, RenderMode, ShTransfer};
         let sun = Vec3::new(-0.4, 0.7, 0.5).normalize();
         let radius = 2f32.to_radians();
         let (sky, disc) = (0.4, 300.0);

@@ -1,8 +1,8 @@
 //! The static scene on the GPU: vertices, indices, baked transfer, and the per-vertex PRT
 //! radiance computed from them every time the lighting changes (`shaders/transfer.wgsl`).
 
-use super::RenderError;
 use super::environment::{mip_chain_of, upload_mip_chain};
+use super::error::{BakeMismatch, RenderError};
 use super::materials::GpuMaterials;
 use super::shaders::{MAX_GPU_COEFFS, MAX_GPU_ORDER, Shader, TRANSFER_WORKGROUP};
 use crate::lighting::{FrameLighting, ShTransfer};
@@ -92,25 +92,27 @@ impl GpuScene {
         let mesh = &geometry.mesh;
         let order = transfer.settings.order;
         if transfer.direct.vertex_count() != mesh.vertex_count() {
-            return Err(RenderError::Bake(format!(
-                "the bake has {} vertices, the scene {}",
-                transfer.direct.vertex_count(),
-                mesh.vertex_count()
-            )));
+            return Err(BakeMismatch::VertexCount {
+                bake: transfer.direct.vertex_count(),
+                scene: mesh.vertex_count(),
+            }
+            .into());
         }
         if order > MAX_GPU_ORDER {
-            return Err(RenderError::Bake(format!(
-                "the bake's SH order {order} is above the renderer's maximum {MAX_GPU_ORDER}"
-            )));
+            return Err(BakeMismatch::OrderTooHigh {
+                order,
+                max: MAX_GPU_ORDER,
+            }
+            .into());
         }
         let limit = device.limits().max_storage_buffer_binding_size as usize;
         let transfer_bytes = transfer.direct.as_slice().len() * 4;
         if transfer_bytes > limit {
-            return Err(RenderError::Bake(format!(
-                "the transfer ({} MB) exceeds the adapter's storage buffer limit ({} MB)",
-                transfer_bytes >> 20,
-                limit >> 20
-            )));
+            return Err(BakeMismatch::TooLarge {
+                mb: transfer_bytes >> 20,
+                limit_mb: limit >> 20,
+            }
+            .into());
         }
         let vertices: Vec<Vertex> = (0..mesh.vertex_count())
             .map(|v| Vertex {

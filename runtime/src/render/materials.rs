@@ -2,7 +2,7 @@
 //! 0 the diffuse one), a per-vertex index into it with the vertex's specular occlusion, and the
 //! shininess slots the reflection maps are prefiltered for (`shaders/glossy.wgsl`).
 
-use super::RenderError;
+use super::error::RenderError;
 use super::pass_helpers::writable_buffer;
 use super::shaders::MAX_MATERIALS;
 use bytemuck::{Pod, Zeroable};

@@ -17,6 +17,7 @@
 //! every pass repeats.
 
 pub mod environment;
+mod error;
 pub mod gpu;
 pub mod gpu_scene;
 pub mod light_pass;
@@ -32,6 +33,8 @@ pub mod uniforms;
 
 use crate::lighting::ShTransfer;
 use environment::EnvironmentTexture;
+use error::checked;
+pub use error::{BakeMismatch, ReadbackError, RenderError};
 use foundation::Rgb;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
@@ -52,37 +55,6 @@ use targets::Targets;
 use uniforms::{FrameBuffers, FrameParameters, FrameUniform};
 
 pub use crate::lighting::{FrameLighting, RenderMode};
-
-#[derive(Debug, thiserror::Error)]
-pub enum RenderError {
-    #[error(transparent)]
-    Gpu(#[from] GpuError),
-    #[error("cannot use the bake: {0}")]
-    Bake(String),
-    #[error(transparent)]
-    Settings(#[from] InvalidSettings),
-    #[error("reading the image back failed: {0}")]
-    Readback(String),
-    #[error("the graphics driver rejected the work: {0}")]
-    Device(String),
-}
-
-/// Runs `work` with wgpu validation and out-of-memory errors turned into a `RenderError`
-/// (instead of wgpu's default of panicking).
-fn checked<T>(
-    device: &wgpu::Device,
-    work: impl FnOnce() -> Result<T, RenderError>,
-) -> Result<T, RenderError> {
-    let memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-    let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let result = work();
-    let validation = pollster::block_on(validation.pop());
-    let memory = pollster::block_on(memory.pop());
-    match (validation.or(memory), result) {
-        (Some(error), _) => Err(RenderError::Device(error.to_string())),
-        (None, result) => result,
-    }
-}
 
 /// Refuses an image larger than the adapter's textures can be (before the driver would).
 fn check_image_size(device: &wgpu::Device, camera: &Camera) -> Result<(), RenderError> {

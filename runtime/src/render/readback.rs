@@ -1,6 +1,6 @@
 //! Copying a texture back to the CPU (the rendered image, window screenshots).
 
-use super::RenderError;
+use super::error::{ReadbackError, RenderError};
 
 /// The texel rows of a single-layer `texture` whose texels are `bytes_per_texel` bytes, tightly
 /// packed (the copy's 256-byte row alignment removed). Waits for the GPU.
@@ -43,15 +43,14 @@ pub fn read_texture(
     slice.map_async(wgpu::MapMode::Read, move |result| {
         let _ = sender.send(result);
     });
-    let failed = |e: &dyn std::fmt::Display| RenderError::Readback(e.to_string());
     device
         .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| failed(&e))?;
+        .map_err(ReadbackError::from)?;
     receiver
         .recv()
-        .map_err(|e| failed(&e))?
-        .map_err(|e| failed(&e))?;
-    let data = slice.get_mapped_range().map_err(|e| failed(&e))?;
+        .map_err(ReadbackError::from)?
+        .map_err(ReadbackError::from)?;
+    let data = slice.get_mapped_range().map_err(ReadbackError::from)?;
     let mut texels = Vec::with_capacity((row_bytes * height) as usize);
     for row in data.chunks_exact(padded_row_bytes as usize) {
         texels.extend_from_slice(&row[..row_bytes as usize]);

@@ -8,7 +8,7 @@
 //! cascades would multiply the shadow passes (one per light already) for views that look far
 //! into a scene, which these are not.
 
-use super::RenderError;
+use super::error::RenderError;
 use super::gpu_scene::{self, GpuScene};
 use super::pass_helpers::{
     begin_pass, color_attachment, depth_attachment, nearest_depth, texture, two_sided_triangles,

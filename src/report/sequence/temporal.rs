@@ -1,0 +1,105 @@
+//! A sequence's temporal error (how a method's change from frame to frame differs from the
+//! reference's) and its popping frames.
+
+use foundation::image_io::{RgbImageF32, tonemap};
+use foundation::luminance;
+
+/// A frame pops when its temporal error is more than this multiple of its neighbours' (a
+/// spike: a light or shadow appearing or vanishing at once, not the steady change of a moving
+/// map)...
+pub const POP_SPIKE: f64 = 2.0;
+/// ... and above this (tone-mapped luminance), so that a near-static sequence's noise does not
+/// count.
+pub const POP_FLOOR: f64 = 0.002;
+
+/// Tone-mapped luminance of every pixel.
+pub(super) fn tonemapped_luminance(image: &RgbImageF32, exposure: f32) -> Vec<f32> {
+    image
+        .pixels
+        .iter()
+        .map(|p| luminance(tonemap(*p, exposure)))
+        .collect()
+}
+
+/// Temporal error of a method's frame: the mean over covered pixels of how much its change
+/// differs from the reference's.
+pub(super) fn temporal(
+    now: &[f32],
+    before: &[f32],
+    reference_now: &[f32],
+    reference_before: &[f32],
+    covered: &[bool],
+) -> f64 {
+    let (mut sum, mut count) = (0.0f64, 0usize);
+    for i in 0..now.len() {
+        if covered[i] {
+            let change = now[i] - before[i];
+            let reference_change = reference_now[i] - reference_before[i];
+            sum += (change - reference_change).abs() as f64;
+            count += 1;
+        }
+    }
+    sum / count.max(1) as f64
+}
+
+/// Frames on each side whose temporal errors a frame is compared with.
+const POP_WINDOW: usize = 3;
+
+/// Marks the popping frames of one method's temporal errors (frame 0 has none): a frame pops
+/// when its temporal error is a spike against its neighbours' (the median of up to
+/// `POP_WINDOW` frames on each side), so that a sequence whose motion speeds up or slows down
+/// pops nowhere, while a light appearing at once does.
+pub(super) fn mark_popping(temporal: &[Option<f64>]) -> Vec<bool> {
+    (0..temporal.len())
+        .map(|t| {
+            let Some(value) = temporal[t] else {
+                return false;
+            };
+            let neighbours: Vec<f64> = (t.saturating_sub(POP_WINDOW)..=t + POP_WINDOW)
+                .filter(|&u| u != t)
+                .filter_map(|u| temporal.get(u).copied().flatten())
+                .collect();
+            if neighbours.is_empty() {
+                return false;
+            }
+            let local = crate::support::median(neighbours);
+            value > POP_SPIKE * local && value > POP_FLOOR
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn temporal_error_measures_changes_beyond_the_reference() {
+        let covered = [true, true, false];
+        // The reference brightens pixel 0 by 0.1, the method by 0.3; pixel 1 is unchanged; the
+        // uncovered pixel 2 does not count.
+        let t = temporal(
+            &[0.6, 0.2, 9.0],
+            &[0.3, 0.2, 0.0],
+            &[0.5, 0.2, 0.0],
+            &[0.4, 0.2, 0.0],
+            &covered,
+        );
+        assert!((t - 0.1).abs() < 1e-6, "{t}");
+    }
+
+    #[test]
+    fn popping_frames_are_spikes_of_the_temporal_error() {
+        let steady = [None, Some(0.01), Some(0.012), Some(0.011), Some(0.009)];
+        assert!(mark_popping(&steady).iter().all(|p| !p));
+        let pop = [None, Some(0.01), Some(0.05), Some(0.011), Some(0.009)];
+        assert_eq!(mark_popping(&pop), [false, false, true, false, false]);
+        // A motion that speeds up and slows down again does not pop.
+        let ramp: Vec<Option<f64>> = std::iter::once(None)
+            .chain((1..30).map(|t| Some(0.004 + 0.006 * (t as f64 / 5.0).sin().abs())))
+            .collect();
+        assert!(mark_popping(&ramp).iter().all(|p| !p));
+        // Tiny errors never pop.
+        let still = [None, Some(1e-5), Some(1e-3), Some(1e-5)];
+        assert!(mark_popping(&still).iter().all(|p| !p));
+    }
+}

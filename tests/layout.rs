@@ -1,0 +1,122 @@
+//! The layout rules of the source tree (README, "Layout"), checked on every test run: no import
+//! cycle between files, no function over 100 lines outside tests, no source file over 600 lines.
+//!
+//! The checks read the sources as text with a small tokenizer (strings, characters and comments
+//! skipped), which is all these rules need.
+
+#[path = "layout/scan.rs"]
+mod scan;
+
+use scan::{SourceTree, function_spans, tokens};
+use std::path::Path;
+
+const MAX_FUNCTION_LINES: usize = 100;
+const MAX_FILE_LINES: usize = 600;
+
+fn tree() -> SourceTree {
+    SourceTree::read(Path::new(env!("CARGO_MANIFEST_DIR")))
+}
+
+#[test]
+fn no_source_file_is_over_600_lines() {
+    let tree = tree();
+    let long: Vec<String> = tree
+        .all_files()
+        .filter(|f| f.lines > MAX_FILE_LINES)
+        .map(|f| format!("{} ({} lines)", f.path.display(), f.lines))
+        .collect();
+    assert!(
+        long.is_empty(),
+        "files over {MAX_FILE_LINES} lines:\n{}",
+        long.join("\n")
+    );
+}
+
+#[test]
+fn no_function_outside_tests_is_over_100_lines() {
+    let tree = tree();
+    let mut long = Vec::new();
+    for file in tree.all_files().filter(|f| !f.is_test_file) {
+        for span in function_spans(&tokens(&file.text)) {
+            if !span.in_test && span.lines > MAX_FUNCTION_LINES {
+                long.push(format!(
+                    "{}:{} fn {} ({} lines)",
+                    file.path.display(),
+                    span.line,
+                    span.name,
+                    span.lines
+                ));
+            }
+        }
+    }
+    assert!(
+        long.is_empty(),
+        "functions over {MAX_FUNCTION_LINES} lines:\n{}",
+        long.join("\n")
+    );
+}
+
+#[test]
+fn no_import_cycle_between_files() {
+    let tree = tree();
+    let cycles = tree.import_cycles();
+    let shown: Vec<String> = cycles
+        .iter()
+        .map(|cycle| {
+            cycle
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(" -> ")
+        })
+        .collect();
+    assert!(
+        cycles.is_empty(),
+        "import cycles between files:\n{}",
+        shown.join("\n")
+    );
+}
+
+/// The checks themselves: each finds what it must on a small made-up crate.
+#[test]
+fn the_checks_find_what_they_look_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("lib/src");
+    std::fs::create_dir_all(src.join("a")).unwrap();
+    std::fs::write(src.join("lib.rs"), "mod a;\nmod b;\npub use a::Thing;\n").unwrap();
+    std::fs::write(
+        src.join("a/mod.rs"),
+        "mod inner;\npub use inner::Thing;\nuse crate::b::helper;\npub fn local() {}\n",
+    )
+    .unwrap();
+    std::fs::write(src.join("a/inner.rs"), "pub struct Thing;\n").unwrap();
+    let long_body = "    let x = 1;\n".repeat(MAX_FUNCTION_LINES);
+    std::fs::write(
+        src.join("b.rs"),
+        format!(
+            "use crate::a::{{Thing, local}}; // \"crate::x\" in a string or comment is no import\n\
+             pub fn helper() {{\n{long_body}}}\n#[cfg(test)]\nmod tests {{\n    fn long() {{\n{long_body}}}\n}}\n"
+        ),
+    )
+    .unwrap();
+    let tree = SourceTree::read_crates(&[dir.path().join("lib")]);
+    let cycles = tree.import_cycles();
+    assert_eq!(cycles.len(), 1, "{cycles:?}");
+    let names: Vec<String> = cycles[0]
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into())
+        .collect();
+    assert!(
+        names.contains(&"b.rs".into()) && names.contains(&"mod.rs".into()),
+        "{names:?}"
+    );
+    // `crate::a::Thing` is a re-export: that edge goes to a/inner.rs, which is in no cycle;
+    // the cycle is b.rs <-> a/mod.rs through `local` and `helper`.
+    assert!(!names.contains(&"inner.rs".into()), "{names:?}");
+    let b = tree.all_files().find(|f| f.path.ends_with("b.rs")).unwrap();
+    let spans = function_spans(&tokens(&b.text));
+    let helper = spans.iter().find(|s| s.name == "helper").unwrap();
+    assert!(helper.lines > MAX_FUNCTION_LINES && !helper.in_test);
+    assert!(spans.iter().find(|s| s.name == "long").unwrap().in_test);
+    assert!(b.lines > 2 * MAX_FUNCTION_LINES);
+}
