@@ -51,6 +51,21 @@ pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
     Vec3::new(d.x, d.y, z)
 }
 
+/// The pdf per solid angle of [`cosine_hemisphere`]'s directions at cosine `cos` to the
+/// normal (zero below the surface).
+#[inline]
+pub fn cosine_hemisphere_pdf(cos: f32) -> f32 {
+    cos.max(0.0) * std::f32::consts::FRAC_1_PI
+}
+
+/// The power heuristic (β = 2) weight of a sample drawn with pdf `pdf_a` when another strategy
+/// would draw it with `pdf_b` (Veach 1997); the two weights of a direction add up to one.
+#[inline]
+pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
+    let (a, b) = (pdf_a * pdf_a, pdf_b * pdf_b);
+    if a + b > 0.0 { a / (a + b) } else { 0.0 }
+}
+
 /// Orthonormal frame around a unit normal.
 #[derive(Debug, Clone, Copy)]
 pub struct Frame {
@@ -97,6 +112,40 @@ pub fn hash_to_unit2(h: u64) -> Vec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn power_heuristic_weights_sum_to_one() {
+        let (a, b) = (0.3, 2.0);
+        assert!((power_heuristic(a, b) + power_heuristic(b, a) - 1.0).abs() < 1e-6);
+        assert_eq!(power_heuristic(0.0, 0.0), 0.0);
+    }
+
+    /// The cosine warp's samples follow its pdf: the share of them within angle θ of the
+    /// normal is ∫ pdf over that cap, 1 − cos²θ.
+    #[test]
+    fn cosine_samples_follow_their_pdf() {
+        let n = 128 * 128;
+        let samples: Vec<Vec3> = (0..n)
+            .map(|i| cosine_hemisphere(hammersley(i, n)))
+            .collect();
+        for c in [0.2f32, 0.5, 0.8, 0.95] {
+            let share = samples.iter().filter(|w| w.z > c).count() as f32 / n as f32;
+            assert!((share - (1.0 - c * c)).abs() < 2e-3, "cos {c}: {share}");
+            // The same cap by integrating the pdf (in cos θ, times 2π).
+            let steps = 1000;
+            let integral: f32 = (0..steps)
+                .map(|k| {
+                    let mu = c + (1.0 - c) * (k as f32 + 0.5) / steps as f32;
+                    cosine_hemisphere_pdf(mu) * std::f32::consts::TAU * (1.0 - c) / steps as f32
+                })
+                .sum();
+            assert!(
+                (integral - (1.0 - c * c)).abs() < 1e-4,
+                "cos {c}: {integral}"
+            );
+        }
+        assert_eq!(cosine_hemisphere_pdf(-0.5), 0.0);
+    }
 
     #[test]
     fn hammersley_is_stratified_in_both_axes() {

@@ -4,17 +4,16 @@
 //! diffuse part or the Phong lobe, chosen by their reflectances' luminance (one-sample MIS
 //! over the two: the pdf is their mixture).
 
-use super::environment::EnvironmentLight;
+use super::environment::{EnvironmentLight, PendingTexel};
 use super::sampler::PathSampler;
 use foundation::bvh::RAY_OFFSET_FRACTION;
 use foundation::bvh::{Hit, SceneBvh, Skip};
 use foundation::color::{Rgb, luminance};
 use foundation::infra::huge_pages::HugePageTable;
-use foundation::material::{Material, front_view, mirror, phong_lobe, sample_phong_lobe};
-use foundation::sampling::{Frame, cosine_hemisphere};
+use foundation::material::{Material, PhongBsdf};
+use foundation::sampling::{Frame, cosine_hemisphere, cosine_hemisphere_pdf, power_heuristic};
 use foundation::scene::{NO_TEXTURE, SceneMesh};
 use glam::Vec3;
-use std::f32::consts::FRAC_1_PI;
 
 /// A shading point.
 #[derive(Debug, Clone, Copy)]
@@ -40,77 +39,6 @@ pub struct PathEstimate {
     /// surfaces): what decides a report's highlight region.
     pub specular: Rgb,
     pub direct: DirectVisibility,
-}
-
-/// A glossy point's BRDF toward one direction: `f cos` of each part and the pdf of the
-/// mixture that samples it.
-#[derive(Debug, Clone, Copy)]
-struct GlossyEval {
-    diffuse: Rgb,
-    specular: Rgb,
-    pdf: f32,
-}
-
-/// How a glossy point samples and evaluates its BRDF for one view.
-#[derive(Debug, Clone, Copy)]
-struct GlossyLobes {
-    n: Vec3,
-    /// The mirror direction of the view.
-    mirror: Vec3,
-    albedo: Rgb,
-    material: Material,
-    /// Probability of sampling the lobe rather than the cosine.
-    lobe_probability: f32,
-}
-
-impl GlossyLobes {
-    /// `None` for a black surface (nothing to sample).
-    fn new(point: &SurfacePoint, wo: Vec3) -> Option<Self> {
-        let n = point.shading_normal;
-        let (d, s) = (
-            luminance(point.albedo).max(0.0),
-            luminance(point.material.specular).max(0.0),
-        );
-        if d + s <= 0.0 {
-            return None;
-        }
-        Some(Self {
-            n,
-            mirror: mirror(front_view(wo, n), n),
-            albedo: point.albedo,
-            material: point.material,
-            lobe_probability: s / (d + s),
-        })
-    }
-
-    fn eval(&self, w: Vec3) -> GlossyEval {
-        let cos = self.n.dot(w);
-        if cos <= 0.0 {
-            return GlossyEval {
-                diffuse: Rgb::ZERO,
-                specular: Rgb::ZERO,
-                pdf: 0.0,
-            };
-        }
-        let lobe = phong_lobe(self.mirror.dot(w), self.material.shininess);
-        GlossyEval {
-            diffuse: self.albedo * (cos * FRAC_1_PI),
-            specular: self.material.specular * lobe,
-            pdf: (1.0 - self.lobe_probability) * cos * FRAC_1_PI + self.lobe_probability * lobe,
-        }
-    }
-
-    /// A direction from the mixture (one 2D sample: its first coordinate also picks the part).
-    fn sample(&self, u: glam::Vec2) -> Vec3 {
-        let p = self.lobe_probability;
-        if u.x < p {
-            let u = glam::Vec2::new((u.x / p).min(1.0 - f32::EPSILON), u.y);
-            Frame::from_normal(self.mirror).to_world(sample_phong_lobe(u, self.material.shininess))
-        } else {
-            let u = glam::Vec2::new(((u.x - p) / (1.0 - p)).min(1.0 - f32::EPSILON), u.y);
-            Frame::from_normal(self.n).to_world(cosine_hemisphere(u))
-        }
-    }
 }
 
 /// Light reaching the first shading point directly from the environment, in luminance: what
@@ -155,12 +83,6 @@ pub struct Integrator<'a> {
     triangle_textures: Vec<u32>,
     /// Per triangle, its material; empty for a diffuse scene.
     triangle_materials: HugePageTable<Material>,
-}
-
-#[inline]
-fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
-    let (a, b) = (pdf_a * pdf_a, pdf_b * pdf_b);
-    if a + b > 0.0 { a / (a + b) } else { 0.0 }
 }
 
 impl<'a> Integrator<'a> {
@@ -290,131 +212,56 @@ impl<'a> Integrator<'a> {
         rays: &mut u64,
     ) -> PathEstimate {
         let mut out = PathEstimate::default();
-        let mut point = *start;
-        let mut wo = wo;
-        // The path's weight up to the current point, not counting its BRDF; and the part of it
-        // that left the first point through its specular lobe.
-        let mut before = Rgb::ONE;
-        let mut specular_before = Rgb::ZERO;
+        let mut path = PathVertex {
+            point: *start,
+            wo,
+            before: Rgb::ONE,
+            specular_before: Rgb::ZERO,
+        };
         // The first vertex's light sample; later ones are drawn as soon as the ray that finds
         // their vertex returns (below).
         let mut light_sample = self.light.sample_texel(sampler.next_2d());
         for depth in 0..=self.bounces {
-            let n = point.shading_normal;
+            let point = path.point;
             let glossy = if point.material.is_glossy() {
-                match GlossyLobes::new(&point, wo) {
-                    Some(lobes) => Some(lobes),
+                match PhongBsdf::new(point.shading_normal, point.albedo, point.material, path.wo) {
+                    Some(bsdf) => Some(bsdf),
                     None => break,
                 }
             } else {
                 None
             };
-            // A Lambertian point's weight (cos/pdf cancels): the arithmetic of a diffuse path
-            // is the same as before glossy surfaces existed.
-            let throughput = before * point.albedo;
-            // Next-event estimation toward the environment.
-            if let Some((w, texel)) = light_sample {
-                let cos = n.dot(w);
-                if cos > 0.0 {
-                    *rays += 1;
-                    let visible = !self.occluded(&point, w);
-                    // Read after the ray, which gave the texel time to arrive.
-                    let (le, pdf_light) = self.light.texel_value(texel);
-                    if depth == 0 && pdf_light > 0.0 {
-                        let weight = luminance(le) * cos / pdf_light;
-                        out.direct.unoccluded += weight;
-                        if visible {
-                            out.direct.visible += weight;
-                        }
-                    }
-                    if visible && pdf_light > 0.0 {
-                        match &glossy {
-                            None => {
-                                let pdf_surface = cos * FRAC_1_PI;
-                                let mis = power_heuristic(pdf_light, pdf_surface);
-                                let factor = cos * FRAC_1_PI / pdf_light * mis;
-                                out.radiance += throughput * le * factor;
-                                // Only paths through a glossy first point carry a specular part.
-                                if !self.triangle_materials.is_empty() {
-                                    out.specular += specular_before * point.albedo * le * factor;
-                                }
-                            }
-                            Some(lobes) => {
-                                let f = lobes.eval(w);
-                                let scale = le * (power_heuristic(pdf_light, f.pdf) / pdf_light);
-                                out.radiance += before * (f.diffuse + f.specular) * scale;
-                                out.specular += if depth == 0 {
-                                    before * f.specular * scale
-                                } else {
-                                    specular_before * (f.diffuse + f.specular) * scale
-                                };
-                            }
-                        }
-                    }
-                }
+            if let Some(sample) = light_sample {
+                self.next_event(&path, glossy.as_ref(), sample, depth, rays, &mut out);
             }
-            // Continuation by the BRDF; on escape it is the other MIS strategy for the
+            // Continuation by the BSDF; on escape it is the other MIS strategy for the
             // environment.
-            let u = sampler.next_2d();
-            let (w, pdf_surface, weight, specular_weight) = match &glossy {
-                None => {
-                    let w = Frame::from_normal(n).to_world(cosine_hemisphere(u));
-                    let pdf = n.dot(w).max(0.0) * FRAC_1_PI;
-                    (w, pdf, point.albedo, point.albedo)
-                }
-                Some(lobes) => {
-                    let w = lobes.sample(u);
-                    let f = lobes.eval(w);
-                    if f.pdf <= 0.0 {
-                        // Below the surface: the lobe's part past the horizon reflects nothing.
-                        break;
-                    }
-                    let weight = (f.diffuse + f.specular) / f.pdf;
-                    let specular = if depth == 0 {
-                        f.specular / f.pdf
-                    } else {
-                        weight
-                    };
-                    (w, f.pdf, weight, specular)
-                }
+            let Some(scatter) = path.scatter(glossy.as_ref(), sampler.next_2d(), depth) else {
+                break;
             };
-            let next = if glossy.is_some() {
-                before * weight
-            } else {
-                throughput
-            };
-            specular_before = if depth == 0 {
-                if glossy.is_some() {
-                    before * specular_weight
-                } else {
-                    Rgb::ZERO
-                }
-            } else {
-                specular_before * specular_weight
-            };
-            before = next;
+            let w = scatter.direction;
             // The environment seen along an escaping continuation, MIS-weighted; its texel
             // is asked for now and read after the ray.
             let escape = self.light.escape_texel(w);
             let escaped = || {
                 let (le, pdf_light) = self.light.texel_value(escape);
-                le * power_heuristic(pdf_surface, pdf_light)
+                le * power_heuristic(scatter.pdf, pdf_light)
             };
             *rays += 1;
             if depth == self.bounces {
                 // Only whether it escapes matters: an occlusion ray suffices.
                 if !self.occluded(&point, w) {
                     let le = escaped();
-                    out.radiance += before * le;
-                    out.specular += specular_before * le;
+                    out.radiance += path.before * le;
+                    out.specular += path.specular_before * le;
                 }
                 break;
             }
             match self.trace(&point, w) {
                 None => {
                     let le = escaped();
-                    out.radiance += before * le;
-                    out.specular += specular_before * le;
+                    out.radiance += path.before * le;
+                    out.specular += path.specular_before * le;
                     break;
                 }
                 Some(hit) => {
@@ -425,21 +272,138 @@ impl<'a> Integrator<'a> {
                         self.triangles.as_ptr().wrapping_add(hit.triangle as usize),
                     );
                     light_sample = self.light.sample_texel(sampler.next_2d());
-                    point = self.surface(&hit);
-                    wo = -w;
+                    path.point = self.surface(&hit);
+                    path.wo = -w;
                 }
             }
         }
         out
     }
+
+    /// Next-event estimation toward the environment from the path's current point, with the
+    /// light sample `(w, texel)`: adds its MIS-weighted contribution (and, at the first point,
+    /// the direct visibility) to `out`.
+    #[inline]
+    fn next_event(
+        &self,
+        path: &PathVertex,
+        glossy: Option<&PhongBsdf>,
+        (w, texel): (Vec3, PendingTexel),
+        depth: u32,
+        rays: &mut u64,
+        out: &mut PathEstimate,
+    ) {
+        let point = &path.point;
+        let cos = point.shading_normal.dot(w);
+        if cos <= 0.0 {
+            return;
+        }
+        *rays += 1;
+        let visible = !self.occluded(point, w);
+        // Read after the ray, which gave the texel time to arrive.
+        let (le, pdf_light) = self.light.texel_value(texel);
+        if depth == 0 && pdf_light > 0.0 {
+            let weight = luminance(le) * cos / pdf_light;
+            out.direct.unoccluded += weight;
+            if visible {
+                out.direct.visible += weight;
+            }
+        }
+        if !visible || pdf_light <= 0.0 {
+            return;
+        }
+        match glossy {
+            None => {
+                // A Lambertian point's weight (cos/pdf cancels): the arithmetic of a diffuse
+                // path is the same as before glossy surfaces existed.
+                let throughput = path.before * point.albedo;
+                let pdf_surface = cosine_hemisphere_pdf(cos);
+                let mis = power_heuristic(pdf_light, pdf_surface);
+                let factor = cosine_hemisphere_pdf(cos) / pdf_light * mis;
+                out.radiance += throughput * le * factor;
+                // Only paths through a glossy first point carry a specular part.
+                if !self.triangle_materials.is_empty() {
+                    out.specular += path.specular_before * point.albedo * le * factor;
+                }
+            }
+            Some(bsdf) => {
+                let f = bsdf.eval(w);
+                let scale = le * (power_heuristic(pdf_light, f.pdf) / pdf_light);
+                out.radiance += path.before * (f.diffuse + f.specular) * scale;
+                out.specular += if depth == 0 {
+                    path.before * f.specular * scale
+                } else {
+                    path.specular_before * (f.diffuse + f.specular) * scale
+                };
+            }
+        }
+    }
 }
 
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn power_heuristic_weights_sum_to_one() {
-        let (a, b) = (0.3, 2.0);
-        assert!((super::power_heuristic(a, b) + super::power_heuristic(b, a) - 1.0).abs() < 1e-6);
-        assert_eq!(super::power_heuristic(0.0, 0.0), 0.0);
+/// Where a path is: its current point, the direction back toward the previous one, and its
+/// weight up to the point, not counting the point's BSDF, with the part of that weight that
+/// left the first point through its specular lobe.
+struct PathVertex {
+    point: SurfacePoint,
+    wo: Vec3,
+    before: Rgb,
+    specular_before: Rgb,
+}
+
+/// A continuation direction and the pdf it was drawn with.
+#[derive(Clone, Copy)]
+struct Scatter {
+    direction: Vec3,
+    pdf: f32,
+}
+
+impl PathVertex {
+    /// Draws the continuation from the point's BSDF (`glossy`, or Lambertian) and moves the
+    /// path's weights past the point; `None` where the sampled direction reflects nothing.
+    #[inline]
+    fn scatter(
+        &mut self,
+        glossy: Option<&PhongBsdf>,
+        u: glam::Vec2,
+        depth: u32,
+    ) -> Option<Scatter> {
+        let albedo = self.point.albedo;
+        let (scatter, weight, specular_weight) = match glossy {
+            None => {
+                let n = self.point.shading_normal;
+                let w = Frame::from_normal(n).to_world(cosine_hemisphere(u));
+                let pdf = cosine_hemisphere_pdf(n.dot(w));
+                (Scatter { direction: w, pdf }, albedo, albedo)
+            }
+            Some(bsdf) => {
+                let w = bsdf.sample(u);
+                let f = bsdf.eval(w);
+                if f.pdf <= 0.0 {
+                    // Below the surface: the lobe's part past the horizon reflects nothing.
+                    return None;
+                }
+                let weight = (f.diffuse + f.specular) / f.pdf;
+                let specular = if depth == 0 {
+                    f.specular / f.pdf
+                } else {
+                    weight
+                };
+                (
+                    Scatter {
+                        direction: w,
+                        pdf: f.pdf,
+                    },
+                    weight,
+                    specular,
+                )
+            }
+        };
+        self.specular_before = match (depth, glossy) {
+            (0, Some(_)) => self.before * specular_weight,
+            (0, None) => Rgb::ZERO,
+            _ => self.specular_before * specular_weight,
+        };
+        self.before *= weight;
+        Some(scatter)
     }
 }

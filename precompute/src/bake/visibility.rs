@@ -92,14 +92,19 @@ pub(super) fn trace_vertices(
     let mesh = &geometry.mesh;
     let order = settings.order;
     let n = num_coeffs(order);
-    let basis = ShBasis::<f32>::new(order).expect("validated settings");
-    let samples = base_samples(settings.samples);
-    let inv_samples = 1.0 / settings.samples as f32;
-    let offset = RAY_OFFSET_FRACTION * geometry.diagonal();
-    let record_hits = settings.bounces > 0;
-    let front_normals: Vec<Vec3> = (0..mesh.triangle_count())
-        .map(|t| mesh.front_normal(t))
-        .collect();
+    let tracer = VertexTracer {
+        geometry,
+        bvh,
+        basis: ShBasis::<f32>::new(order).expect("validated settings"),
+        samples: base_samples(settings.samples),
+        inv_samples: 1.0 / settings.samples as f32,
+        offset: RAY_OFFSET_FRACTION * geometry.diagonal(),
+        record_hits: settings.bounces > 0,
+        front_normals: (0..mesh.triangle_count())
+            .map(|t| mesh.front_normal(t))
+            .collect(),
+        seed: settings.seed,
+    };
     let vertex_count = mesh.vertex_count();
 
     let chunks: Vec<Chunk> = (0..vertex_count.div_ceil(CHUNK))
@@ -107,7 +112,7 @@ pub(super) fn trace_vertices(
         .map_init(
             || Scratch {
                 basis: vec![0.0; n],
-                hits: Vec::with_capacity(3 * samples.len()),
+                hits: Vec::with_capacity(3 * tracer.samples.len()),
             },
             |scratch, chunk_index| {
                 let vertices = chunk_index * CHUNK..((chunk_index + 1) * CHUNK).min(vertex_count);
@@ -117,47 +122,9 @@ pub(super) fn trace_vertices(
                     inside: Vec::with_capacity(vertices.len()),
                 };
                 for (local, v) in vertices.clone().enumerate() {
-                    let normal = mesh.normals[v];
-                    let frame = Frame::from_normal(normal);
-                    let origin = mesh.positions[v] + normal * offset;
-                    let rotation = hash_to_unit2(mix64(settings.seed ^ mix64(v as u64)));
                     let visibility = &mut chunk.visibility[local * n..(local + 1) * n];
-                    scratch.hits.clear();
-                    let mut back_faces = 0u32;
-                    for u in &samples {
-                        let direction =
-                            frame.to_world(cosine_hemisphere(cranley_patterson(*u, rotation)));
-                        match bvh.closest_hit(
-                            origin,
-                            direction,
-                            0.0,
-                            f32::INFINITY,
-                            Skip::VertexTriangles(v as u32),
-                        ) {
-                            None => {
-                                accumulate_basis(&basis, direction, &mut scratch.basis, visibility)
-                            }
-                            Some(hit) => {
-                                if direction.dot(front_normals[hit.triangle as usize]) > 0.0 {
-                                    back_faces += 1;
-                                }
-                                if record_hits {
-                                    // Either side of a triangle shows its front's radiance
-                                    // (CONVENTIONS.md, "Surfaces").
-                                    let corners = mesh.triangles[hit.triangle as usize];
-                                    for (i, w) in corners.iter().zip(hit.barycentrics()) {
-                                        scratch.hits.push((*i, w * inv_samples));
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    chunk
-                        .inside
-                        .push(back_faces as f32 > INSIDE_BACKFACE_FRACTION * samples.len() as f32);
-                    for y in visibility.iter_mut() {
-                        *y *= inv_samples;
-                    }
+                    let inside = tracer.trace(v, scratch, visibility);
+                    chunk.inside.push(inside);
                     // Merge the hits into one sparse row of the interreflection operator.
                     scratch.hits.sort_unstable_by_key(|(i, _)| *i);
                     chunk.operator.push_sorted_row(&scratch.hits);
@@ -182,6 +149,63 @@ pub(super) fn trace_vertices(
         visibility,
         operator: InterreflectionOperator::from_blocks(blocks),
         inside,
+    }
+}
+
+/// What tracing one vertex's rays needs, shared by every vertex.
+struct VertexTracer<'a> {
+    geometry: &'a SceneMesh,
+    bvh: &'a SceneBvh,
+    basis: ShBasis<f32>,
+    samples: Vec<Vec2>,
+    inv_samples: f32,
+    offset: f32,
+    /// Whether hits are recorded (for the interreflection operator).
+    record_hits: bool,
+    front_normals: Vec<Vec3>,
+    seed: u64,
+}
+
+impl VertexTracer<'_> {
+    /// Traces vertex `v`'s rays: adds `(1/N) Σ Y_k(ω)` over the escaping ones to `visibility`,
+    /// leaves the hits' interpolation weights in `scratch.hits`, and says whether the vertex
+    /// is inside a solid.
+    #[inline]
+    fn trace(&self, v: usize, scratch: &mut Scratch, visibility: &mut [f32]) -> bool {
+        let mesh = &self.geometry.mesh;
+        let normal = mesh.normals[v];
+        let frame = Frame::from_normal(normal);
+        let origin = mesh.positions[v] + normal * self.offset;
+        let rotation = hash_to_unit2(mix64(self.seed ^ mix64(v as u64)));
+        scratch.hits.clear();
+        let mut back_faces = 0u32;
+        for u in &self.samples {
+            let direction = frame.to_world(cosine_hemisphere(cranley_patterson(*u, rotation)));
+            let skip = Skip::VertexTriangles(v as u32);
+            match self
+                .bvh
+                .closest_hit(origin, direction, 0.0, f32::INFINITY, skip)
+            {
+                None => accumulate_basis(&self.basis, direction, &mut scratch.basis, visibility),
+                Some(hit) => {
+                    if direction.dot(self.front_normals[hit.triangle as usize]) > 0.0 {
+                        back_faces += 1;
+                    }
+                    if self.record_hits {
+                        // Either side of a triangle shows its front's radiance
+                        // (CONVENTIONS.md, "Surfaces").
+                        let corners = mesh.triangles[hit.triangle as usize];
+                        for (i, w) in corners.iter().zip(hit.barycentrics()) {
+                            scratch.hits.push((*i, w * self.inv_samples));
+                        }
+                    }
+                }
+            }
+        }
+        for y in visibility.iter_mut() {
+            *y *= self.inv_samples;
+        }
+        back_faces as f32 > INSIDE_BACKFACE_FRACTION * self.samples.len() as f32
     }
 }
 

@@ -1,49 +1,8 @@
-//! Surface materials: Lambertian diffuse plus an optional normalised Phong lobe
-//! (CONVENTIONS.md, "Glossy materials").
-//!
-//! `f(ω_i, ω_o) = k_d/π + k_s (s + 1)/(2π) cos^s α / (n·ω_i)`, with `α` the angle between the
-//! incident direction and the mirror direction `r` of the view, for `n·ω_i > 0`. Dividing the
-//! lobe by the cosine makes the reflected radiance `k_d E(n)/π + k_s (D_s ∗ L)(r)`: the map
-//! convolved with the normalised lobe `D_s(α) = (s + 1)/(2π) cos^s α` around `r` (exact
-//! except where the lobe crosses the horizon), so a prefiltered reflection map is exact and a
-//! directional light of power `P` adds `k_s P D_s(α)`.
-//!
-//! Every consumer (the path tracer, the GPU passes, the SH baseline, the Mitsuba plugin) uses
-//! these functions or their WGSL/Python transcriptions.
+//! The normalised Phong lobe: its value, sampling and pdf, the mirror direction, and its
+//! spherical-harmonic convolution factors.
 
-use crate::color::Rgb;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
-
-/// Largest shininess a scene may give (a lobe about 0.6° wide).
-pub const MAX_SHININESS: f32 = 10_000.0;
-
-/// The glossy part of a surface (its diffuse albedo lives with the geometry).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct Material {
-    /// `k_s` per channel; zero for a purely diffuse surface.
-    pub specular: Rgb,
-    /// Phong exponent `s` (meaningless when `specular` is zero).
-    pub shininess: f32,
-}
-
-impl Material {
-    /// Lambertian only.
-    pub const DIFFUSE: Material = Material {
-        specular: Rgb::ZERO,
-        shininess: 0.0,
-    };
-
-    pub fn is_glossy(&self) -> bool {
-        self.specular.max_element() > 0.0
-    }
-}
-
-impl Default for Material {
-    fn default() -> Self {
-        Self::DIFFUSE
-    }
-}
 
 /// The normalised lobe `D_s(α) = (s + 1)/(2π) cos^s α` (zero beyond 90°): integrates to 1
 /// over the sphere.
@@ -53,6 +12,12 @@ pub fn phong_lobe(cos_alpha: f32, shininess: f32) -> f32 {
         return 0.0;
     }
     (shininess + 1.0) / (2.0 * PI) * cos_alpha.powf(shininess)
+}
+
+/// The pdf per solid angle of [`sample_phong_lobe`]'s directions: the lobe itself.
+#[inline]
+pub fn phong_lobe_pdf(cos_alpha: f32, shininess: f32) -> f32 {
+    phong_lobe(cos_alpha, shininess)
 }
 
 /// A direction distributed as [`phong_lobe`] around +Z (its pdf per solid angle is the lobe
@@ -132,18 +97,6 @@ pub fn widened_shininess(shininess: f32, source_variance: f32) -> f32 {
 #[inline]
 pub fn source_variance(core: f32, halo: f32, core_fraction: f32) -> f32 {
     (core_fraction * core * core + (1.0 - core_fraction) * halo * halo) / 4.0
-}
-
-/// `k_d + k_s ≤ 1` per channel (energy conservation), with a reason when it does not hold.
-pub fn check_energy(albedo: Rgb, specular: Rgb) -> Result<(), String> {
-    let sum = albedo + specular;
-    if sum.max_element() > 1.0 + 1e-6 {
-        return Err(format!(
-            "albedo + specular is {:.3?}: it must be at most 1 per channel (energy conservation)",
-            sum.to_array()
-        ));
-    }
-    Ok(())
 }
 
 #[cfg(test)]
@@ -241,12 +194,10 @@ mod tests {
     }
 
     #[test]
-    fn widening_adds_variances_and_energy_is_checked() {
+    fn widening_adds_variances() {
         assert!((widened_shininess(100.0, 0.0) - 100.0).abs() < 1e-3);
         // A disc of radius 0.2 (variance 0.01) on a lobe of variance 0.01: half the shininess.
         let v = source_variance(0.2, 0.2, 1.0);
         assert!((widened_shininess(100.0, v) - 50.0).abs() < 1e-3);
-        assert!(check_energy(Rgb::splat(0.5), Rgb::splat(0.5)).is_ok());
-        assert!(check_energy(Rgb::new(0.5, 0.7, 0.1), Rgb::splat(0.4)).is_err());
     }
 }
