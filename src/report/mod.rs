@@ -256,6 +256,9 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
     })
 }
 
+/// One method's points of the threshold sweep, by its name.
+type MethodSweep = (String, Vec<SweepPoint>);
+
 /// One method's frame: its lights, what its lighting cost and its frame time.
 struct RenderedMethod {
     method: Method,
@@ -325,7 +328,7 @@ fn threshold_sweep(
     reference: &ReferenceImages,
     masks: &Masks,
     exposure: f32,
-) -> anyhow::Result<(Vec<(String, Vec<SweepPoint>)>, Vec<Curve>)> {
+) -> anyhow::Result<(Vec<MethodSweep>, Vec<Curve>)> {
     let order = job.renderer.order();
     let mut sweep = Vec::new();
     let mut curves = Vec::new();

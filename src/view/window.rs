@@ -1,24 +1,16 @@
 //! The window's GPU side: the surface, the tone-mapping pass that shows the renderer's HDR
 //! image, egui's pass on top, and window screenshots.
 
+use runtime::render::bindings::DISPLAY;
 use runtime::render::pass_helpers::{
     FullscreenPass, begin_pass, color_attachment, texture, writable_buffer,
 };
 use runtime::render::readback::read_texture;
 use runtime::render::shaders::Shader;
+use runtime::render::uniforms::DisplayUniform;
 use runtime::render::{Backend, GpuContext, Renderer};
 use std::sync::Arc;
 use winit::window::Window;
-
-/// Matches `Display` in `shaders/display.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct DisplayUniform {
-    exposure: f32,
-    /// 1: encode sRGB in the shader (the surface format is not an sRGB one).
-    encode_srgb: u32,
-    _pad: [u32; 2],
-}
 
 pub struct WindowGpu {
     pub gpu: GpuContext,
@@ -26,6 +18,7 @@ pub struct WindowGpu {
     pub config: wgpu::SurfaceConfiguration,
     pub egui: egui_wgpu::Renderer,
     display_pipeline: wgpu::RenderPipeline,
+    display_layout: wgpu::BindGroupLayout,
     display_uniform: wgpu::Buffer,
     display_bind_group: Option<wgpu::BindGroup>,
 }
@@ -66,10 +59,16 @@ impl WindowGpu {
         surface.configure(&gpu.device, &config);
         let device = &gpu.device;
         let module = Shader::Display.module(device);
+        let display_layout = DISPLAY.layout(device);
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("display"),
+            bind_group_layouts: &[Some(&display_layout)],
+            immediate_size: 0,
+        });
         let display_pipeline = FullscreenPass {
             label: "display",
             module: &module,
-            layout: None,
+            layout: Some(&pipeline_layout),
             target: format.into(),
             constants: &[],
         }
@@ -87,6 +86,7 @@ impl WindowGpu {
             config,
             egui,
             display_pipeline,
+            display_layout,
             display_uniform,
             display_bind_group: None,
         })
@@ -115,31 +115,24 @@ impl WindowGpu {
         screen: &egui_wgpu::ScreenDescriptor,
     ) {
         let device = &self.gpu.device;
-        let uniform = DisplayUniform {
-            exposure,
-            encode_srgb: u32::from(!self.config.format.is_srgb()),
-            _pad: [0; 2],
-        };
+        let uniform = DisplayUniform::new(exposure, !self.config.format.is_srgb());
         self.gpu
             .queue
             .write_buffer(&self.display_uniform, 0, bytemuck::bytes_of(&uniform));
         if let Some(renderer) = renderer
             && self.display_bind_group.is_none()
         {
-            self.display_bind_group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("display"),
-                layout: &self.display_pipeline.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: self.display_uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(renderer.color_view()),
-                    },
+            self.display_bind_group = Some(DISPLAY.bind_group(
+                device,
+                &self.display_layout,
+                &[
+                    ("display", self.display_uniform.as_entire_binding()),
+                    (
+                        "image",
+                        wgpu::BindingResource::TextureView(renderer.color_view()),
+                    ),
                 ],
-            }));
+            ));
         }
         let extra = self
             .egui
@@ -160,7 +153,7 @@ impl WindowGpu {
             .forget_lifetime();
             if let (Some(_), Some(group)) = (renderer, &self.display_bind_group) {
                 pass.set_pipeline(&self.display_pipeline);
-                pass.set_bind_group(0, group, &[]);
+                pass.set_bind_group(DISPLAY.group, group, &[]);
                 pass.draw(0..3, 0..1);
             }
             self.egui.render(&mut pass, paint, screen);

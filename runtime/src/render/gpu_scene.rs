@@ -1,15 +1,16 @@
 //! The static scene on the GPU: vertices, indices, baked transfer, and the per-vertex PRT
 //! radiance computed from them every time the lighting changes (`shaders/transfer.wgsl`).
 
+use super::bindings::ALBEDO_TEXTURE;
 use super::environment::{mip_chain_of, upload_mip_chain};
 use super::error::{BakeMismatch, RenderError};
 use super::materials::GpuMaterials;
-use super::shaders::{MAX_GPU_COEFFS, MAX_GPU_ORDER, Shader, TRANSFER_WORKGROUP};
+use super::shaders::MAX_GPU_ORDER;
+use super::transfer_pass::TransferPass;
 use crate::lighting::{FrameLighting, ShTransfer};
 use bytemuck::{Pod, Zeroable};
 use foundation::color::Rgb;
 use foundation::scene::SceneMesh;
-use foundation::sh::num_coeffs;
 use foundation::texture::AlbedoTexture;
 use glam::Vec3;
 use precompute::bake::Transfer;
@@ -26,17 +27,6 @@ struct Vertex {
     uv: [f32; 2],
 }
 
-/// Matches `Lighting` in `shaders/transfer.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct LightingUniform {
-    vertex_count: u32,
-    coeff_count: u32,
-    _pad: [u32; 2],
-    sh: [[f32; 4]; MAX_GPU_COEFFS],
-    lights_sh: [[f32; 4]; MAX_GPU_COEFFS],
-}
-
 pub struct GpuScene {
     pub vertex_buffer: wgpu::Buffer,
     /// Per-vertex PRT radiance (vec4), written by the transfer pass, read as a vertex buffer.
@@ -49,9 +39,7 @@ pub struct GpuScene {
     pub order: usize,
     /// Scene bounds (min, max).
     pub bounds: (Vec3, Vec3),
-    lighting_buffer: wgpu::Buffer,
-    transfer_pipeline: wgpu::ComputePipeline,
-    transfer_bind_group: wgpu::BindGroup,
+    transfer_pass: TransferPass,
     /// Layout of group 1 of the PRT pass: an albedo texture and its sampler.
     pub texture_layout: wgpu::BindGroupLayout,
     /// One per texture; the first is a white texel for untextured objects.
@@ -140,17 +128,6 @@ impl GpuScene {
             bytemuck::cast_slice(&indices),
             wgpu::BufferUsages::INDEX,
         );
-        let full = transfer.full();
-        let full_buffer = init(
-            "full transfer",
-            bytemuck::cast_slice(full.as_slice()),
-            wgpu::BufferUsages::STORAGE,
-        );
-        let indirect_buffer = init(
-            "indirect transfer",
-            bytemuck::cast_slice(transfer.indirect.as_slice()),
-            wgpu::BufferUsages::STORAGE,
-        );
         let radiance_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("vertex radiance"),
             size: (mesh.vertex_count() * 16) as u64,
@@ -165,47 +142,12 @@ impl GpuScene {
                 | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let lighting_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("lighting"),
-            size: std::mem::size_of::<LightingUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let module = Shader::Transfer.module(device);
-        let transfer_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("transfer"),
-            layout: None,
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        let transfer_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("transfer"),
-            layout: &transfer_pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: lighting_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: full_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: indirect_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: radiance_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: indirect_radiance_buffer.as_entire_binding(),
-                },
-            ],
-        });
+        let transfer_pass = TransferPass::new(
+            device,
+            transfer,
+            &radiance_buffer,
+            &indirect_radiance_buffer,
+        );
         let unoccluded = transfer.direct.unoccluded_fraction(&geometry.albedo);
         let bent = transfer
             .direct
@@ -217,7 +159,7 @@ impl GpuScene {
             .collect();
         let materials = GpuMaterials::new(device, geometry, visibility)?;
         materials.write(queue);
-        let texture_layout = texture_layout(device);
+        let texture_layout = ALBEDO_TEXTURE.layout(device);
         let white = Arc::new(AlbedoTexture {
             width: 1,
             height: 1,
@@ -240,9 +182,7 @@ impl GpuScene {
             vertex_count: mesh.vertex_count() as u32,
             order,
             bounds: mesh.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE)),
-            lighting_buffer,
-            transfer_pipeline,
-            transfer_bind_group,
+            transfer_pass,
         })
     }
 
@@ -259,24 +199,8 @@ impl GpuScene {
             encoder.clear_buffer(&self.indirect_buffer, 0, None);
             return;
         }
-        let n = num_coeffs(self.order);
-        let mut uniform = LightingUniform::zeroed();
-        uniform.vertex_count = self.vertex_count;
-        uniform.coeff_count = n as u32;
-        let sh = lighting.sh.with_order(self.order);
-        let lights_sh = lighting.lights_sh(self.order);
-        for k in 0..n {
-            uniform.sh[k] = sh.as_slice()[k].extend(0.0).to_array();
-            uniform.lights_sh[k] = lights_sh.as_slice()[k].extend(0.0).to_array();
-        }
-        queue.write_buffer(&self.lighting_buffer, 0, bytemuck::bytes_of(&uniform));
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("transfer"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(&self.transfer_pipeline);
-        pass.set_bind_group(0, &self.transfer_bind_group, &[]);
-        pass.dispatch_workgroups(self.vertex_count.div_ceil(TRANSFER_WORKGROUP), 1, 1);
+        self.transfer_pass
+            .record(queue, encoder, lighting, self.order, self.vertex_count);
     }
 
     /// Draws every triangle from its vertices alone (shadow maps).
@@ -294,7 +218,7 @@ impl GpuScene {
         pass.set_vertex_buffer(3, self.indirect_buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
         for (range, group) in &self.draws {
-            pass.set_bind_group(1, &self.texture_groups[*group], &[]);
+            pass.set_bind_group(ALBEDO_TEXTURE.group, &self.texture_groups[*group], &[]);
             pass.draw_indexed(range.clone(), 0, 0..1);
         }
     }
@@ -320,31 +244,6 @@ fn draws(geometry: &SceneMesh) -> Vec<(std::ops::Range<u32>, usize)> {
     draws
 }
 
-/// Group 1 of the PRT pass: a filterable 2D texture and a filtering sampler.
-fn texture_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("albedo texture"),
-        entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                count: None,
-            },
-        ],
-    })
-}
-
 /// An albedo texture with its mipmaps, sampled trilinearly with repeat wrapping (the reference
 /// looks the base level up bilinearly: `AlbedoTexture::bilinear`).
 fn texture_group(
@@ -364,20 +263,13 @@ fn texture_group(
         mipmap_filter: wgpu::MipmapFilterMode::Linear,
         ..Default::default()
     });
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("albedo texture"),
+    let view = gpu_texture.create_view(&Default::default());
+    ALBEDO_TEXTURE.bind_group(
+        device,
         layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(
-                    &gpu_texture.create_view(&Default::default()),
-                ),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::Sampler(&sampler),
-            },
+        &[
+            ("albedo_texture", wgpu::BindingResource::TextureView(&view)),
+            ("albedo_sampler", wgpu::BindingResource::Sampler(&sampler)),
         ],
-    })
+    )
 }

@@ -3,6 +3,7 @@
 //! image, and the environment behind the scene (`shaders/lights.wgsl`). Summing the lights in
 //! one pass gives the same image as one pass per light and reads the G-buffer once.
 
+use super::bindings::LIGHTS;
 use super::environment::EnvironmentTexture;
 use super::pass_helpers::{FullscreenPass, begin_pass, color_attachment};
 use super::shaders::Shader;
@@ -30,10 +31,7 @@ pub struct LightPass {
 
 impl LightPass {
     pub fn new(device: &wgpu::Device) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("light pass"),
-            entries: &layout_entries(),
-        });
+        let layout = LIGHTS.layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("light pass"),
             bind_group_layouts: &[Some(&layout)],
@@ -98,7 +96,7 @@ impl LightPass {
         let kernel_from_radius = inputs.shadow_maps.settings().from_angular_radius;
         let variant = usize::from(shadows) * 2 + usize::from(kernel_from_radius);
         pass.set_pipeline(&self.pipelines[variant]);
-        pass.set_bind_group(0, &*bind_group, &[]);
+        pass.set_bind_group(LIGHTS.group, &*bind_group, &[]);
         pass.draw(0..3, 0..1);
     }
 }
@@ -109,68 +107,25 @@ fn bind_group(
     inputs: &LightPassInputs,
 ) -> wgpu::BindGroup {
     let view = wgpu::BindingResource::TextureView;
-    let resources = [
-        inputs.buffers.frame.as_entire_binding(),
-        inputs.buffers.lights.as_entire_binding(),
-        view(&inputs.targets.depth_copy_view),
-        view(&inputs.targets.normal_view),
-        view(&inputs.targets.albedo_view),
-        view(inputs.shadow_maps.array_view()),
-        wgpu::BindingResource::Sampler(&inputs.shadow_maps.sampler),
-        view(&inputs.environment.view),
-        view(inputs.shadow_maps.depth_copy_array_view()),
-        wgpu::BindingResource::Sampler(&inputs.environment.sampler),
-        inputs.materials.as_entire_binding(),
-    ];
-    let entries: Vec<wgpu::BindGroupEntry> = resources
-        .into_iter()
-        .enumerate()
-        .map(|(binding, resource)| wgpu::BindGroupEntry {
-            binding: binding as u32,
-            resource,
-        })
-        .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("light pass"),
+    let sampler = wgpu::BindingResource::Sampler;
+    LIGHTS.bind_group(
+        device,
         layout,
-        entries: &entries,
-    })
-}
-
-/// Bindings 0–10 of `shaders/lights.wgsl`, in order.
-fn layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
-    use wgpu::{BindingType, TextureSampleType as S, TextureViewDimension as D};
-    let uniform = BindingType::Buffer {
-        ty: wgpu::BufferBindingType::Uniform,
-        has_dynamic_offset: false,
-        min_binding_size: None,
-    };
-    let texture = |sample_type, view_dimension| BindingType::Texture {
-        sample_type,
-        view_dimension,
-        multisampled: false,
-    };
-    let float = S::Float { filterable: false };
-    [
-        uniform,                                                    // frame
-        uniform,                                                    // lights
-        texture(float, D::D2),                                      // depth
-        texture(float, D::D2),                                      // normals
-        texture(float, D::D2),                                      // albedo
-        texture(S::Depth, D::D2Array),                              // shadow maps
-        BindingType::Sampler(wgpu::SamplerBindingType::Comparison), // shadow sampler
-        texture(S::Float { filterable: true }, D::D2),              // environment
-        texture(float, D::D2Array),                                 // shadow depths
-        BindingType::Sampler(wgpu::SamplerBindingType::Filtering),  // environment sampler
-        uniform,                                                    // materials
-    ]
-    .into_iter()
-    .enumerate()
-    .map(|(binding, ty)| wgpu::BindGroupLayoutEntry {
-        binding: binding as u32,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty,
-        count: None,
-    })
-    .collect()
+        &[
+            ("frame", inputs.buffers.frame.as_entire_binding()),
+            ("lights", inputs.buffers.lights.as_entire_binding()),
+            ("depth_buffer", view(&inputs.targets.depth_copy_view)),
+            ("normal_buffer", view(&inputs.targets.normal_view)),
+            ("albedo_buffer", view(&inputs.targets.albedo_view)),
+            ("shadow_maps", view(inputs.shadow_maps.array_view())),
+            ("shadow_sampler", sampler(&inputs.shadow_maps.sampler)),
+            ("environment", view(&inputs.environment.view)),
+            (
+                "shadow_depths",
+                view(inputs.shadow_maps.depth_copy_array_view()),
+            ),
+            ("environment_sampler", sampler(&inputs.environment.sampler)),
+            ("materials", inputs.materials.as_entire_binding()),
+        ],
+    )
 }

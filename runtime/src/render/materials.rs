@@ -14,7 +14,7 @@ use wgpu::util::DeviceExt;
 /// Matches `Material` in `shaders/glossy.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct MaterialUniform {
+pub(super) struct MaterialUniform {
     specular: [f32; 4],
     slot: [u32; 4],
 }

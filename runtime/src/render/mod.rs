@@ -16,6 +16,7 @@
 //! opens the device, [`readback`] copies images back, [`pass_helpers`] builds the descriptors
 //! every pass repeats.
 
+pub mod bindings;
 pub mod environment;
 mod error;
 pub mod gpu;
@@ -29,6 +30,7 @@ pub mod reflection_maps;
 pub mod shaders;
 pub mod shadow_maps;
 pub mod targets;
+mod transfer_pass;
 pub mod uniforms;
 
 use crate::lighting::ShTransfer;

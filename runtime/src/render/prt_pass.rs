@@ -1,6 +1,7 @@
 //! The PRT pass (thesis 4.4, first pass): the scene with its per-vertex PRT radiance, writing
 //! depth, normals and albedo for the light pass (`shaders/geometry.wgsl`).
 
+use super::bindings::PRT_FRAME;
 use super::gpu_scene::{self, GpuScene};
 use super::materials::MATERIAL_LAYOUT;
 use super::pass_helpers::{
@@ -30,38 +31,7 @@ impl PrtPass {
     /// `texture_layout`: the scene's albedo textures (group 1, [`GpuScene::texture_layout`]).
     pub fn new(device: &wgpu::Device, texture_layout: &wgpu::BindGroupLayout) -> Self {
         let module = Shader::Geometry.module(device);
-        let uniform = wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        };
-        let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty,
-            count: None,
-        };
-        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("prt pass frame"),
-            entries: &[
-                entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, uniform),
-                entry(1, wgpu::ShaderStages::FRAGMENT, uniform),
-                entry(
-                    2,
-                    wgpu::ShaderStages::FRAGMENT,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                ),
-                entry(
-                    3,
-                    wgpu::ShaderStages::FRAGMENT,
-                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                ),
-            ],
-        });
+        let frame_layout = PRT_FRAME.layout(device);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("prt pass"),
             bind_group_layouts: &[Some(&frame_layout), Some(texture_layout)],
@@ -120,28 +90,22 @@ impl PrtPass {
     ) {
         let layout = &self.frame_layout;
         let bind_group = self.bind_group.get_or_insert_with(|| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("prt pass"),
+            PRT_FRAME.bind_group(
+                device,
                 layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: inputs.frame.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: inputs.materials.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(&inputs.reflections.view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::Sampler(&inputs.reflections.sampler),
-                    },
+                &[
+                    ("frame", inputs.frame.as_entire_binding()),
+                    ("materials", inputs.materials.as_entire_binding()),
+                    (
+                        "reflection_maps",
+                        wgpu::BindingResource::TextureView(&inputs.reflections.view),
+                    ),
+                    (
+                        "reflection_sampler",
+                        wgpu::BindingResource::Sampler(&inputs.reflections.sampler),
+                    ),
                 ],
-            })
+            )
         });
         let clear = Some(wgpu::Color::TRANSPARENT);
         let mut pass = begin_pass(
@@ -157,7 +121,7 @@ impl PrtPass {
             depth_attachment(&targets.depth_view),
         );
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &*bind_group, &[]);
+        pass.set_bind_group(PRT_FRAME.group, &*bind_group, &[]);
         scene.draw_with_radiance(&mut pass);
     }
 }

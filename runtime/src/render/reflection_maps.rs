@@ -6,6 +6,7 @@
 //! lobe on the remainder's mip chain); an SH environment is convolved exactly on the CPU by
 //! its zonal factors and uploaded.
 
+use super::bindings::{PREFILTER, PREFILTER_JOB_SIZE};
 use super::environment::{mip_chain_of, rgba16f_texels};
 use super::pass_helpers::{FullscreenPass, array_layer_count, begin_pass, color_attachment};
 use super::shaders::Shader;
@@ -20,10 +21,10 @@ const JOB_STRIDE: u64 = 256;
 /// Most shininess slots (the jobs buffer is sized for them).
 pub const MAX_SLOTS: usize = super::shaders::MAX_MATERIALS;
 
-/// Matches `Job` in `shaders/prefilter.wgsl`.
+/// Matches `Job` in `shaders/prefilter.wgsl` ([`PREFILTER_JOB_SIZE`] bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct Job {
+pub(super) struct Job {
     face: u32,
     shininess: f32,
     target_size: f32,
@@ -49,37 +50,7 @@ impl ReflectionMaps {
     /// Black maps of `face_size` (one slot) until the first [`Self::update`].
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, face_size: usize) -> Self {
         let module = Shader::Prefilter.module(device);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("prefilter"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(size_of::<Job>() as u64),
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
+        let layout = PREFILTER.layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("prefilter"),
             bind_group_layouts: &[Some(&layout)],
@@ -209,33 +180,35 @@ impl ReflectionMaps {
             }
         }
         queue.write_buffer(&self.jobs, 0, &jobs);
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("prefilter"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        let source = array_view(&texture);
+        let bind_group = PREFILTER.bind_group(
+            device,
+            &self.layout,
+            &[
+                (
+                    "job",
+                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                         buffer: &self.jobs,
                         offset: 0,
-                        size: wgpu::BufferSize::new(size_of::<Job>() as u64),
+                        size: wgpu::BufferSize::new(PREFILTER_JOB_SIZE),
                     }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&array_view(&texture)),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::Sampler(&self.sampler),
-                },
+                ),
+                ("source", wgpu::BindingResource::TextureView(&source)),
+                (
+                    "source_sampler",
+                    wgpu::BindingResource::Sampler(&self.sampler),
+                ),
             ],
-        });
+        );
         for layer in 0..6 * self.slots.len() {
             let view = self.layer_view(layer);
             let mut pass = begin_pass(encoder, "prefilter", &[color_attachment(&view, None)], None);
             pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind_group, &[(layer as u64 * JOB_STRIDE) as u32]);
+            pass.set_bind_group(
+                PREFILTER.group,
+                &bind_group,
+                &[(layer as u64 * JOB_STRIDE) as u32],
+            );
             pass.draw(0..3, 0..1);
         }
     }

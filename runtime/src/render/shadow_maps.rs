@@ -8,6 +8,7 @@
 //! cascades would multiply the shadow passes (one per light already) for views that look far
 //! into a scene, which these are not.
 
+use super::bindings::{SHADOW_VIEW, SHADOW_VIEW_SIZE};
 use super::error::RenderError;
 use super::gpu_scene::{self, GpuScene};
 use super::pass_helpers::{
@@ -307,18 +308,18 @@ impl Layers {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let view_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadow view"),
-            layout: view_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        let view_bind_group = SHADOW_VIEW.bind_group(
+            device,
+            view_layout,
+            &[(
+                "view",
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                     buffer: &view_buffer,
                     offset: 0,
-                    size: std::num::NonZeroU64::new(64),
+                    size: wgpu::BufferSize::new(SHADOW_VIEW_SIZE),
                 }),
-            }],
-        });
+            )],
+        );
         Self {
             count,
             array_view: array_view(&maps),
@@ -345,19 +346,7 @@ pub struct ShadowMaps {
 impl ShadowMaps {
     pub fn new(device: &wgpu::Device, settings: ShadowSettings) -> Result<Self, RenderError> {
         settings.validate()?;
-        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shadow view"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: std::num::NonZeroU64::new(64),
-                },
-                count: None,
-            }],
-        });
+        let view_layout = SHADOW_VIEW.layout(device);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow pass"),
             bind_group_layouts: &[Some(&view_layout)],
@@ -484,7 +473,7 @@ impl ShadowMaps {
                 depth_attachment(&layers.layer_views[i]),
             );
             pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &layers.view_bind_group, &[offset as u32]);
+            pass.set_bind_group(SHADOW_VIEW.group, &layers.view_bind_group, &[offset as u32]);
             scene.draw_depth_only(&mut pass);
         }
         layers.rendered = matrices.to_vec();

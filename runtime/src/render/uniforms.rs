@@ -46,6 +46,26 @@ impl LightUniform {
     }
 }
 
+/// Matches `Display` in `shaders/display.wgsl`: how the viewer shows the renderer's image.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct DisplayUniform {
+    exposure: f32,
+    /// 1: encode sRGB in the shader (the surface format is not an sRGB one).
+    encode_srgb: u32,
+    _pad: [u32; 2],
+}
+
+impl DisplayUniform {
+    pub fn new(exposure: f32, encode_srgb: bool) -> Self {
+        Self {
+            exposure,
+            encode_srgb: u32::from(encode_srgb),
+            _pad: [0; 2],
+        }
+    }
+}
+
 /// What the frame uniform is made of.
 pub struct FrameParameters<'a> {
     pub camera: &'a Camera,

@@ -137,7 +137,7 @@ pub fn write_sequence_report(
         });
         previous = Some((reference_y, ys));
     }
-    let report = summarise(scene, sequence_path, &settings, frames, &light_changes);
+    let report = summarise(scene, sequence_path, settings, frames, &light_changes);
     write_outputs(&report, &gif_frames, camera.width * 3, camera.height, out)?;
     print_summary(&report);
     println!("\nwrote {}", out.join("report.html").display());

@@ -1,0 +1,427 @@
+//! Every bind group of `shaders/`, declared once by the names the WGSL gives its bindings.
+//! Layouts and bind groups are built from these declarations, bind groups take their resources
+//! by name, and a test checks each declaration against the WGSL (names, numbers, kinds), so a
+//! binding that drifts fails the test suite instead of the driver.
+
+use super::shaders::Shader;
+use wgpu::{SamplerBindingType, ShaderStages as Stages, TextureViewDimension as Dim};
+
+/// What a binding holds, as the Rust side declares it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Resource {
+    Uniform,
+    /// A uniform read at a dynamic offset, `size` bytes at a time.
+    DynamicUniform {
+        size: u64,
+    },
+    Storage {
+        read_only: bool,
+    },
+    /// A float texture.
+    Texture {
+        dimension: Dim,
+        filterable: bool,
+    },
+    DepthTexture {
+        dimension: Dim,
+    },
+    Sampler(SamplerBindingType),
+}
+
+/// One binding: the WGSL variable's name, the stages that read it and what it holds. Its
+/// number is its place in the group's list.
+#[derive(Debug, Clone, Copy)]
+pub struct Binding {
+    pub name: &'static str,
+    pub stages: Stages,
+    pub resource: Resource,
+}
+
+/// One bind group of a shader.
+#[derive(Debug)]
+pub struct BindGroupDecl {
+    pub label: &'static str,
+    pub shader: Shader,
+    pub group: u32,
+    pub bindings: &'static [Binding],
+}
+
+const fn binding(name: &'static str, stages: Stages, resource: Resource) -> Binding {
+    Binding {
+        name,
+        stages,
+        resource,
+    }
+}
+
+const FRAGMENT: Stages = Stages::FRAGMENT;
+const FLOAT_2D: Resource = Resource::Texture {
+    dimension: Dim::D2,
+    filterable: false,
+};
+const FILTERABLE_2D: Resource = Resource::Texture {
+    dimension: Dim::D2,
+    filterable: true,
+};
+const FILTERABLE_ARRAY: Resource = Resource::Texture {
+    dimension: Dim::D2Array,
+    filterable: true,
+};
+const FILTERING: Resource = Resource::Sampler(SamplerBindingType::Filtering);
+
+/// `shaders/transfer.wgsl`: the per-vertex transfer pass.
+pub const TRANSFER: BindGroupDecl = BindGroupDecl {
+    label: "transfer",
+    shader: Shader::Transfer,
+    group: 0,
+    bindings: &[
+        binding("lighting", Stages::COMPUTE, Resource::Uniform),
+        binding(
+            "full_transfer",
+            Stages::COMPUTE,
+            Resource::Storage { read_only: true },
+        ),
+        binding(
+            "indirect_transfer",
+            Stages::COMPUTE,
+            Resource::Storage { read_only: true },
+        ),
+        binding(
+            "radiance",
+            Stages::COMPUTE,
+            Resource::Storage { read_only: false },
+        ),
+        binding(
+            "indirect_radiance",
+            Stages::COMPUTE,
+            Resource::Storage { read_only: false },
+        ),
+    ],
+};
+
+/// `shaders/geometry.wgsl`, group 0: the frame, the materials and the reflection maps.
+pub const PRT_FRAME: BindGroupDecl = BindGroupDecl {
+    label: "prt pass frame",
+    shader: Shader::Geometry,
+    group: 0,
+    bindings: &[
+        binding("frame", Stages::VERTEX_FRAGMENT, Resource::Uniform),
+        binding("materials", FRAGMENT, Resource::Uniform),
+        binding("reflection_maps", FRAGMENT, FILTERABLE_ARRAY),
+        binding("reflection_sampler", FRAGMENT, FILTERING),
+    ],
+};
+
+/// `shaders/geometry.wgsl`, group 1: an object's albedo texture.
+pub const ALBEDO_TEXTURE: BindGroupDecl = BindGroupDecl {
+    label: "albedo texture",
+    shader: Shader::Geometry,
+    group: 1,
+    bindings: &[
+        binding("albedo_texture", FRAGMENT, FILTERABLE_2D),
+        binding("albedo_sampler", FRAGMENT, FILTERING),
+    ],
+};
+
+/// Bytes of one shadow view (`ShadowView` in `shaders/shadow.wgsl`: a light's view-projection).
+pub const SHADOW_VIEW_SIZE: u64 = 64;
+
+/// `shaders/shadow.wgsl`: one light's view, at a dynamic offset.
+pub const SHADOW_VIEW: BindGroupDecl = BindGroupDecl {
+    label: "shadow view",
+    shader: Shader::Shadow,
+    group: 0,
+    bindings: &[binding(
+        "view",
+        Stages::VERTEX,
+        Resource::DynamicUniform {
+            size: SHADOW_VIEW_SIZE,
+        },
+    )],
+};
+
+/// `shaders/lights.wgsl`: the G-buffer, the shadow maps and the environment.
+pub const LIGHTS: BindGroupDecl = BindGroupDecl {
+    label: "light pass",
+    shader: Shader::Lights,
+    group: 0,
+    bindings: &[
+        binding("frame", FRAGMENT, Resource::Uniform),
+        binding("lights", FRAGMENT, Resource::Uniform),
+        binding("depth_buffer", FRAGMENT, FLOAT_2D),
+        binding("normal_buffer", FRAGMENT, FLOAT_2D),
+        binding("albedo_buffer", FRAGMENT, FLOAT_2D),
+        binding(
+            "shadow_maps",
+            FRAGMENT,
+            Resource::DepthTexture {
+                dimension: Dim::D2Array,
+            },
+        ),
+        binding(
+            "shadow_sampler",
+            FRAGMENT,
+            Resource::Sampler(SamplerBindingType::Comparison),
+        ),
+        binding("environment", FRAGMENT, FILTERABLE_2D),
+        binding(
+            "shadow_depths",
+            FRAGMENT,
+            Resource::Texture {
+                dimension: Dim::D2Array,
+                filterable: false,
+            },
+        ),
+        binding("environment_sampler", FRAGMENT, FILTERING),
+        binding("materials", FRAGMENT, Resource::Uniform),
+    ],
+};
+
+/// Bytes of one prefilter job (`Job` in `shaders/prefilter.wgsl`).
+pub const PREFILTER_JOB_SIZE: u64 = 32;
+
+/// `shaders/prefilter.wgsl`: one face's job (at a dynamic offset) and the source cube.
+pub const PREFILTER: BindGroupDecl = BindGroupDecl {
+    label: "prefilter",
+    shader: Shader::Prefilter,
+    group: 0,
+    bindings: &[
+        binding(
+            "job",
+            FRAGMENT,
+            Resource::DynamicUniform {
+                size: PREFILTER_JOB_SIZE,
+            },
+        ),
+        binding("source", FRAGMENT, FILTERABLE_ARRAY),
+        binding("source_sampler", FRAGMENT, FILTERING),
+    ],
+};
+
+/// `shaders/display.wgsl`: tone mapping the renderer's image to a window.
+pub const DISPLAY: BindGroupDecl = BindGroupDecl {
+    label: "display",
+    shader: Shader::Display,
+    group: 0,
+    bindings: &[
+        binding("display", FRAGMENT, Resource::Uniform),
+        binding("image", FRAGMENT, FLOAT_2D),
+    ],
+};
+
+/// Every declaration, for the test against the WGSL.
+#[cfg(test)]
+pub const ALL: [&BindGroupDecl; 7] = [
+    &TRANSFER,
+    &PRT_FRAME,
+    &ALBEDO_TEXTURE,
+    &SHADOW_VIEW,
+    &LIGHTS,
+    &PREFILTER,
+    &DISPLAY,
+];
+
+impl Resource {
+    fn binding_type(self) -> wgpu::BindingType {
+        use wgpu::{BindingType, BufferBindingType, TextureSampleType};
+        let buffer = |ty, has_dynamic_offset, min_binding_size| BindingType::Buffer {
+            ty,
+            has_dynamic_offset,
+            min_binding_size,
+        };
+        let texture = |sample_type, view_dimension| BindingType::Texture {
+            sample_type,
+            view_dimension,
+            multisampled: false,
+        };
+        match self {
+            Resource::Uniform => buffer(BufferBindingType::Uniform, false, None),
+            Resource::DynamicUniform { size } => buffer(
+                BufferBindingType::Uniform,
+                true,
+                wgpu::BufferSize::new(size),
+            ),
+            Resource::Storage { read_only } => {
+                buffer(BufferBindingType::Storage { read_only }, false, None)
+            }
+            Resource::Texture {
+                dimension,
+                filterable,
+            } => texture(TextureSampleType::Float { filterable }, dimension),
+            Resource::DepthTexture { dimension } => texture(TextureSampleType::Depth, dimension),
+            Resource::Sampler(ty) => BindingType::Sampler(ty),
+        }
+    }
+}
+
+impl BindGroupDecl {
+    /// The group's layout: binding `k` is the `k`-th declared.
+    pub fn layout(&self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        let entries: Vec<wgpu::BindGroupLayoutEntry> = self
+            .bindings
+            .iter()
+            .enumerate()
+            .map(|(k, b)| wgpu::BindGroupLayoutEntry {
+                binding: k as u32,
+                visibility: b.stages,
+                ty: b.resource.binding_type(),
+                count: None,
+            })
+            .collect();
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(self.label),
+            entries: &entries,
+        })
+    }
+
+    /// A bind group of `layout` (made by [`Self::layout`]) from resources given by their
+    /// bindings' names, in the declared order.
+    pub fn bind_group(
+        &self,
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        resources: &[(&str, wgpu::BindingResource)],
+    ) -> wgpu::BindGroup {
+        let declared: Vec<&str> = self.bindings.iter().map(|b| b.name).collect();
+        let given: Vec<&str> = resources.iter().map(|(name, _)| *name).collect();
+        assert_eq!(
+            given, declared,
+            "{}: resources against the declaration",
+            self.label
+        );
+        let entries: Vec<wgpu::BindGroupEntry> = resources
+            .iter()
+            .enumerate()
+            .map(|(k, (_, resource))| wgpu::BindGroupEntry {
+                binding: k as u32,
+                resource: resource.clone(),
+            })
+            .collect();
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(self.label),
+            layout,
+            entries: &entries,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use naga::{AddressSpace, ImageClass, ImageDimension, ScalarKind, StorageAccess, TypeInner};
+
+    fn module(shader: Shader) -> naga::Module {
+        naga::front::wgsl::parse_str(&shader.source()).expect("the shaders parse (shaders.rs)")
+    }
+
+    /// Whether the WGSL variable `var` holds what `resource` declares.
+    fn holds(module: &naga::Module, var: &naga::GlobalVariable, resource: Resource) -> bool {
+        let image = |dimension: Dim| match dimension {
+            Dim::D2 => (ImageDimension::D2, false),
+            Dim::D2Array => (ImageDimension::D2, true),
+            Dim::Cube => (ImageDimension::Cube, false),
+            _ => (ImageDimension::D3, false),
+        };
+        let inner = &module.types[var.ty].inner;
+        match resource {
+            Resource::Uniform | Resource::DynamicUniform { .. } => {
+                var.space == AddressSpace::Uniform
+            }
+            Resource::Storage { read_only } => matches!(var.space,
+                AddressSpace::Storage { access } if access.contains(StorageAccess::STORE) != read_only),
+            Resource::Texture { dimension, .. } => matches!(*inner,
+                TypeInner::Image { dim, arrayed, class: ImageClass::Sampled { kind: ScalarKind::Float, multi: false } }
+                    if (dim, arrayed) == image(dimension)),
+            Resource::DepthTexture { dimension } => matches!(*inner,
+                TypeInner::Image { dim, arrayed, class: ImageClass::Depth { multi: false } }
+                    if (dim, arrayed) == image(dimension)),
+            Resource::Sampler(ty) => matches!(*inner,
+                TypeInner::Sampler { comparison } if comparison == (ty == SamplerBindingType::Comparison)),
+        }
+    }
+
+    /// Every declared group is exactly its shader's: the same names at the same numbers, each
+    /// holding what the Rust side binds, and nothing the Rust side does not declare.
+    #[test]
+    fn declarations_match_the_wgsl() {
+        for decl in ALL {
+            let module = module(decl.shader);
+            let mut in_wgsl: Vec<(u32, &str, &naga::GlobalVariable)> = module
+                .global_variables
+                .iter()
+                .filter_map(|(_, var)| {
+                    let b = var.binding.as_ref()?;
+                    (b.group == decl.group)
+                        .then(|| (b.binding, var.name.as_deref().unwrap_or(""), var))
+                })
+                .collect();
+            in_wgsl.sort_by_key(|(number, ..)| *number);
+            let wgsl: Vec<(u32, &str)> = in_wgsl.iter().map(|(n, name, _)| (*n, *name)).collect();
+            let declared: Vec<(u32, &str)> = decl
+                .bindings
+                .iter()
+                .enumerate()
+                .map(|(k, b)| (k as u32, b.name))
+                .collect();
+            assert_eq!(
+                declared, wgsl,
+                "{}: bindings of group {}",
+                decl.label, decl.group
+            );
+            for ((_, name, var), b) in in_wgsl.iter().zip(decl.bindings) {
+                assert!(
+                    holds(&module, var, b.resource),
+                    "{}: `{name}` is not a {:?} in the WGSL",
+                    decl.label,
+                    b.resource
+                );
+            }
+        }
+    }
+
+    /// The Rust copies of WGSL structs have the WGSL's size (so arrays of them keep their
+    /// stride), and the dynamic offsets step by it.
+    #[test]
+    fn rust_structs_have_the_wgsl_layout() {
+        use super::super::{materials, reflection_maps, transfer_pass, uniforms};
+        use std::mem::size_of;
+        let structs = [
+            (
+                Shader::Transfer,
+                "Lighting",
+                size_of::<transfer_pass::LightingUniform>(),
+            ),
+            (Shader::Lights, "Frame", size_of::<uniforms::FrameUniform>()),
+            (Shader::Lights, "Light", size_of::<uniforms::LightUniform>()),
+            (
+                Shader::Lights,
+                "Material",
+                size_of::<materials::MaterialUniform>(),
+            ),
+            (Shader::Prefilter, "Job", size_of::<reflection_maps::Job>()),
+            (Shader::Prefilter, "Job", PREFILTER_JOB_SIZE as usize),
+            (Shader::Shadow, "ShadowView", SHADOW_VIEW_SIZE as usize),
+            (
+                Shader::Display,
+                "Display",
+                size_of::<uniforms::DisplayUniform>(),
+            ),
+        ];
+        for (shader, name, rust_size) in structs {
+            let module = module(shader);
+            let mut layouter = naga::proc::Layouter::default();
+            layouter
+                .update(module.to_ctx())
+                .expect("the shaders lay out");
+            let (handle, _) = module
+                .types
+                .iter()
+                .find(|(_, ty)| ty.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("{shader:?} has no struct {name}"));
+            assert_eq!(
+                layouter[handle].size as usize, rust_size,
+                "{shader:?}: {name} in WGSL against its Rust copy"
+            );
+        }
+    }
+}
