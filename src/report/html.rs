@@ -149,27 +149,32 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
             );
         }
         if !map.methods.is_empty() {
-            let n = &map.noise;
-            let optional = |v: f64| {
-                if v.is_finite() {
-                    format!("{v:.4}")
-                } else {
-                    "–".into()
-                }
-            };
-            let _ = write!(
-                html,
-                "<tr class=\"noise\"><td class=\"name\" colspan=\"2\">reference noise floor ({} spp)</td><td></td>\
-                 <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td colspan=\"4\"></td></tr>",
-                map.reference_spp,
-                optional(n.mean),
-                optional(n.shadow_mean),
-                optional(n.penumbra_mean),
-                optional(n.relative_rmse),
-            );
+            noise_row(html, map);
         }
     }
     html.push_str("</table>");
+}
+
+/// The row of the reference's noise floor under a map's methods.
+fn noise_row(html: &mut String, map: &MapReport) {
+    let n = &map.noise;
+    let optional = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.4}")
+        } else {
+            "–".into()
+        }
+    };
+    let _ = write!(
+        html,
+        "<tr class=\"noise\"><td class=\"name\" colspan=\"2\">reference noise floor ({} spp)</td><td></td>\
+         <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td colspan=\"4\"></td></tr>",
+        map.reference_spp,
+        optional(n.mean),
+        optional(n.shadow_mean),
+        optional(n.penumbra_mean),
+        optional(n.relative_rmse),
+    );
 }
 
 fn sweep_table(html: &mut String, map: &MapReport) {

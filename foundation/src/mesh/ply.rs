@@ -95,29 +95,47 @@ impl PropertyAccess for PlyFace {
 }
 
 pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
-    let to_error = |e: ply_rs_bw::parser::ParseError, what: &str| {
-        // ply-rs messages span several indented lines; keep them on one.
-        let text = e
-            .to_string()
-            .split_whitespace()
-            .collect::<Vec<_>>()
-            .join(" ");
-        match e.line() {
-            Some(line) => MeshError::Syntax {
-                path: path.to_owned(),
-                line,
-                message: format!(
-                    "{what}: {}",
-                    text.strip_prefix(&format!("Line {line}: "))
-                        .unwrap_or(&text)
-                ),
-            },
-            None => MeshError::Invalid {
-                path: path.to_owned(),
-                message: format!("{what}: {text}"),
-            },
-        }
-    };
+    let (vertices, faces) = read_elements(path, bytes)?;
+    let positions: Vec<Vec3> = vertices.iter().map(|v| Vec3::from(v.position)).collect();
+    let normals = (!vertices.is_empty() && vertices.iter().all(|v| v.has_normal))
+        .then(|| vertices.iter().map(|v| Vec3::from(v.normal)).collect());
+    let triangles = triangulate(path, &faces, positions.len())?;
+    Ok(RawMesh {
+        positions,
+        normals,
+        triangles,
+        uvs: None,
+    })
+}
+
+/// A ply-rs error as a mesh error naming the file, the line and `what` was being read.
+fn parse_error(path: &Path, e: ply_rs_bw::parser::ParseError, what: &str) -> MeshError {
+    // ply-rs messages span several indented lines; keep them on one.
+    let text = e
+        .to_string()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    match e.line() {
+        Some(line) => MeshError::Syntax {
+            path: path.to_owned(),
+            line,
+            message: format!(
+                "{what}: {}",
+                text.strip_prefix(&format!("Line {line}: "))
+                    .unwrap_or(&text)
+            ),
+        },
+        None => MeshError::Invalid {
+            path: path.to_owned(),
+            message: format!("{what}: {text}"),
+        },
+    }
+}
+
+/// The file's vertices and faces (other elements are read and dropped).
+fn read_elements(path: &Path, bytes: &[u8]) -> Result<(Vec<PlyVertex>, Vec<PlyFace>), MeshError> {
+    let to_error = |e, what: &str| parse_error(path, e, what);
     let mut reader = Reader::new(bytes);
     let vertex_parser = Parser::<PlyVertex>::new();
     let face_parser = Parser::<PlyFace>::new();
@@ -162,9 +180,15 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
         }
     }
 
-    let positions: Vec<Vec3> = vertices.iter().map(|v| Vec3::from(v.position)).collect();
-    let normals = (!vertices.is_empty() && vertices.iter().all(|v| v.has_normal))
-        .then(|| vertices.iter().map(|v| Vec3::from(v.normal)).collect());
+    Ok((vertices, faces))
+}
+
+/// The faces as triangles (fans of convex polygons), checked against `vertex_count`.
+fn triangulate(
+    path: &Path,
+    faces: &[PlyFace],
+    vertex_count: usize,
+) -> Result<Vec<[u32; 3]>, MeshError> {
     let mut triangles = Vec::with_capacity(faces.len());
     for (f, face) in faces.iter().enumerate() {
         let indices = &face.indices;
@@ -177,15 +201,11 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
                 ),
             });
         }
-        if let Some(&bad) = indices
-            .iter()
-            .find(|&&i| i < 0 || i >= positions.len() as i64)
-        {
+        if let Some(&bad) = indices.iter().find(|&&i| i < 0 || i >= vertex_count as i64) {
             return Err(MeshError::Invalid {
                 path: path.to_owned(),
                 message: format!(
-                    "face {f} refers to vertex {bad}, but there are only {} vertices",
-                    positions.len()
+                    "face {f} refers to vertex {bad}, but there are only {vertex_count} vertices"
                 ),
             });
         }
@@ -194,12 +214,7 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
             triangles.push([indices[0], indices[k], indices[k + 1]].map(|i| i as u32));
         }
     }
-    Ok(RawMesh {
-        positions,
-        normals,
-        triangles,
-        uvs: None,
-    })
+    Ok(triangles)
 }
 
 #[cfg(test)]

@@ -7,12 +7,11 @@ use foundation::envmap::EnvMap;
 use foundation::image_io::{RgbImageF32, write_exr};
 use foundation::infra::atomic_file::write_atomic;
 use foundation::mesh::TriangleMesh;
-use foundation::scene::SceneMesh;
+use foundation::scene::{SceneMesh, SceneObject};
 use ply_rs_bw::ply::{
     Addable, DefaultElement, ElementDef, Encoding, Ply, Property, PropertyDef, PropertyType,
     ScalarType,
 };
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
@@ -188,55 +187,59 @@ pub fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
         rotation = settings.rotation_deg,
     );
     for (i, o) in geometry.objects.iter().enumerate() {
-        let a = o.albedo;
-        let reflectance = match o.texture {
-            // The texture with the object's factor folded in, linear, looked up bilinearly
-            // with repeat wrapping (Mitsuba's defaults, and hprt's reference).
-            Some(_) => format!(
-                r#"<texture type="bitmap" name="reflectance">
-                    <string name="filename" value="textures/{}"/>
-                    <boolean name="raw" value="true"/>
-                </texture>"#,
-                texture_file_for(&o.name, i)
-            ),
-            None => format!(
-                r#"<rgb name="reflectance" value="{}, {}, {}"/>"#,
-                a.x, a.y, a.z
-            ),
-        };
-        let m = &o.material;
-        let inner = if m.is_glossy() {
-            format!(
-                r#"<bsdf type="hprtphong">
-                {reflectance}
-                <rgb name="specular" value="{}, {}, {}"/>
-                <float name="exponent" value="{}"/>
-            </bsdf>"#,
-                m.specular.x, m.specular.y, m.specular.z, m.shininess
-            )
-        } else {
-            format!(
-                r#"<bsdf type="diffuse">
-                {reflectance}
-            </bsdf>"#
-            )
-        };
-        let _ = write!(
-            xml,
-            r#"    <shape type="ply" id="{id}">
-        <string name="filename" value="meshes/{file}"/>
-        <boolean name="face_normals" value="false"/>
-        <bsdf type="$surface">
-            {inner}
-        </bsdf>
-    </shape>
-"#,
-            id = xml_escape(&o.name),
-            file = file_name_for(&o.name, i),
-        );
+        xml.push_str(&shape_xml(o, i));
     }
     xml.push_str("</scene>\n");
     xml
+}
+
+/// One object as a Mitsuba shape: its mesh file and its BSDF (diffuse, or hprt's Phong).
+fn shape_xml(o: &SceneObject, i: usize) -> String {
+    let a = o.albedo;
+    let reflectance = match o.texture {
+        // The texture with the object's factor folded in, linear, looked up bilinearly
+        // with repeat wrapping (Mitsuba's defaults, and hprt's reference).
+        Some(_) => format!(
+            r#"<texture type="bitmap" name="reflectance">
+                <string name="filename" value="textures/{}"/>
+                <boolean name="raw" value="true"/>
+            </texture>"#,
+            texture_file_for(&o.name, i)
+        ),
+        None => format!(
+            r#"<rgb name="reflectance" value="{}, {}, {}"/>"#,
+            a.x, a.y, a.z
+        ),
+    };
+    let m = &o.material;
+    let inner = if m.is_glossy() {
+        format!(
+            r#"<bsdf type="hprtphong">
+            {reflectance}
+            <rgb name="specular" value="{}, {}, {}"/>
+            <float name="exponent" value="{}"/>
+        </bsdf>"#,
+            m.specular.x, m.specular.y, m.specular.z, m.shininess
+        )
+    } else {
+        format!(
+            r#"<bsdf type="diffuse">
+            {reflectance}
+        </bsdf>"#
+        )
+    };
+    format!(
+        r#"    <shape type="ply" id="{id}">
+    <string name="filename" value="meshes/{file}"/>
+    <boolean name="face_normals" value="false"/>
+    <bsdf type="$surface">
+        {inner}
+    </bsdf>
+</shape>
+"#,
+        id = xml_escape(&o.name),
+        file = file_name_for(&o.name, i),
+    )
 }
 
 fn xml_escape(s: &str) -> String {

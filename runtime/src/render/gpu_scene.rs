@@ -79,29 +79,7 @@ impl GpuScene {
     ) -> Result<Self, RenderError> {
         let mesh = &geometry.mesh;
         let order = transfer.settings.order;
-        if transfer.direct.vertex_count() != mesh.vertex_count() {
-            return Err(BakeMismatch::VertexCount {
-                bake: transfer.direct.vertex_count(),
-                scene: mesh.vertex_count(),
-            }
-            .into());
-        }
-        if order > MAX_GPU_ORDER {
-            return Err(BakeMismatch::OrderTooHigh {
-                order,
-                max: MAX_GPU_ORDER,
-            }
-            .into());
-        }
-        let limit = device.limits().max_storage_buffer_binding_size as usize;
-        let transfer_bytes = transfer.direct.as_slice().len() * 4;
-        if transfer_bytes > limit {
-            return Err(BakeMismatch::TooLarge {
-                mb: transfer_bytes >> 20,
-                limit_mb: limit >> 20,
-            }
-            .into());
-        }
+        check_bake(device, mesh.vertex_count(), transfer)?;
         let vertices: Vec<Vertex> = (0..mesh.vertex_count())
             .map(|v| Vertex {
                 position: mesh.positions[v].to_array(),
@@ -148,17 +126,7 @@ impl GpuScene {
             &radiance_buffer,
             &indirect_radiance_buffer,
         );
-        let unoccluded = transfer.direct.unoccluded_fraction(&geometry.albedo);
-        let bent = transfer
-            .direct
-            .bent_normals(&geometry.albedo, &mesh.normals);
-        let visibility = bent
-            .iter()
-            .zip(&unoccluded)
-            .map(|(b, v)| b.extend(*v).to_array())
-            .collect();
-        let materials = GpuMaterials::new(device, geometry, visibility)?;
-        materials.write(queue);
+        let materials = materials(device, queue, geometry, transfer)?;
         let texture_layout = ALBEDO_TEXTURE.layout(device);
         let white = Arc::new(AlbedoTexture {
             width: 1,
@@ -227,6 +195,58 @@ impl GpuScene {
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..self.index_count, 0, 0..1);
     }
+}
+
+/// Refuses a bake the renderer cannot draw with this scene on this adapter.
+fn check_bake(
+    device: &wgpu::Device,
+    vertices: usize,
+    transfer: &Transfer,
+) -> Result<(), BakeMismatch> {
+    let order = transfer.settings.order;
+    if transfer.direct.vertex_count() != vertices {
+        return Err(BakeMismatch::VertexCount {
+            bake: transfer.direct.vertex_count(),
+            scene: vertices,
+        });
+    }
+    if order > MAX_GPU_ORDER {
+        return Err(BakeMismatch::OrderTooHigh {
+            order,
+            max: MAX_GPU_ORDER,
+        });
+    }
+    let limit = device.limits().max_storage_buffer_binding_size as usize;
+    let transfer_bytes = transfer.direct.as_slice().len() * 4;
+    if transfer_bytes > limit {
+        return Err(BakeMismatch::TooLarge {
+            mb: transfer_bytes >> 20,
+            limit_mb: limit >> 20,
+        });
+    }
+    Ok(())
+}
+
+/// The glossy materials, with each vertex's bent normal and unoccluded fraction (its
+/// specular occlusion) from the bake.
+fn materials(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    geometry: &SceneMesh,
+    transfer: &Transfer,
+) -> Result<GpuMaterials, RenderError> {
+    let unoccluded = transfer.direct.unoccluded_fraction(&geometry.albedo);
+    let bent = transfer
+        .direct
+        .bent_normals(&geometry.albedo, &geometry.mesh.normals);
+    let visibility = bent
+        .iter()
+        .zip(&unoccluded)
+        .map(|(b, v)| b.extend(*v).to_array())
+        .collect();
+    let materials = GpuMaterials::new(device, geometry, visibility)?;
+    materials.write(queue);
+    Ok(materials)
 }
 
 /// Index ranges of consecutive objects sharing a texture group (0: untextured, `i + 1`:

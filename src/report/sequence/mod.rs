@@ -10,11 +10,12 @@ mod results;
 mod temporal;
 
 use super::stats::error_stats;
-use super::{ReferenceRequest, ReportSettings, reference_images};
+use super::{ReferenceImages, ReferenceRequest, ReportSettings, reference_images};
 use crate::environment::{default_exposure, scene_rotation};
 use crate::sequence::Sequence;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
+use foundation::image_io::RgbImageF32;
 use foundation::luminance;
 use foundation::scene::Scene;
 use output::{print_summary, side_by_side, write_outputs};
@@ -40,7 +41,7 @@ pub fn write_sequence_report(
     crate::support::create_folder(out)?;
     let gpu = GpuContext::headless(settings.backend)?;
     println!("adapter: {}", gpu.description());
-    let mut renderer = Renderer::new(
+    let renderer = Renderer::new(
         &gpu,
         &scene.geometry,
         transfer,
@@ -50,16 +51,23 @@ pub fn write_sequence_report(
     let rotation = scene_rotation(scene, None);
     let first = sequence.frame(0)?;
     let exposure = default_exposure(&first);
-    let (mut lightings, mut base_lighting) =
+    let (lightings, base_lighting) =
         method_lightings(sequence, &first, transfer.settings.order, rotation)?;
+    let mut run = SequenceRun {
+        renderer,
+        lightings,
+        base_lighting,
+        rotation,
+        exposure,
+        previous: None,
+        previous_lights: vec![None; SequenceMethod::ALL.len()],
+        light_changes: vec![0; SequenceMethod::ALL.len()],
+    };
     let request = ReferenceRequest {
         target_noise: None,
         ..settings.reference_request(exposure)
     };
     let mut frames = Vec::new();
-    let mut previous: Option<(Vec<f32>, Vec<Vec<f32>>)> = None;
-    let mut previous_lights = vec![None; SequenceMethod::ALL.len()];
-    let mut light_changes = vec![0usize; SequenceMethod::ALL.len()];
     let mut gif_frames = Vec::new();
     for k in 0..sequence.len() {
         let map = if k == 0 {
@@ -69,25 +77,72 @@ pub fn write_sequence_report(
         };
         let reference =
             reference_images(scene, &camera, &map, rotation, &request, &|_| f64::INFINITY)?;
+        let (results, images, sun) = run.frame(k, &map, &reference, sequence.sun(k))?;
+        // hybrid/tracked | prt | reference
+        gif_frames.push(side_by_side(
+            &[&images[1], &images[0], &reference.radiance],
+            exposure,
+        ));
+        println!("frame {k}/{}: {}", sequence.len() - 1, frame_line(&results));
+        frames.push(SequenceFrame {
+            frame: k,
+            methods: results,
+            sun,
+            reference_cached: reference.cached,
+        });
+    }
+    let report = summarise(scene, sequence_path, settings, frames, &run.light_changes);
+    write_outputs(&report, &gif_frames, camera.width * 3, camera.height, out)?;
+    print_summary(&report);
+    println!("\nwrote {}", out.join("report.html").display());
+    Ok(())
+}
+
+/// The methods' state from frame to frame of a sequence report.
+struct SequenceRun {
+    renderer: Renderer,
+    /// Per method, its lighting.
+    lightings: Vec<EnvironmentLighting>,
+    /// A sun sequence's base map, to measure its own level where the sun's light is.
+    base_lighting: Option<EnvironmentLighting>,
+    rotation: f32,
+    exposure: f32,
+    /// The last frame's tone-mapped luminance: the reference's and each method's.
+    previous: Option<(Vec<f32>, Vec<Vec<f32>>)>,
+    previous_lights: Vec<Option<usize>>,
+    light_changes: Vec<usize>,
+}
+
+impl SequenceRun {
+    /// Renders frame `k` (`map`) with every method and measures it against `reference`: each
+    /// method's result, its image, and how the tracked hybrid follows `sun`, if any.
+    fn frame(
+        &mut self,
+        k: usize,
+        map: &EnvMap,
+        reference: &ReferenceImages,
+        sun: Option<SunDisc>,
+    ) -> anyhow::Result<(Vec<FrameResult>, Vec<RgbImageF32>, Option<SunAccuracy>)> {
+        let exposure = self.exposure;
         let masks = reference.masks();
         let reference_y = tonemapped_luminance(&reference.radiance, exposure);
-        renderer.set_environment(&map, rotation);
+        self.renderer.set_environment(map, self.rotation);
         let mut results = Vec::new();
         let mut ys = Vec::new();
         let mut images = Vec::new();
-        let mut sun = None;
+        let mut accuracy = None;
         for (m, method) in SequenceMethod::ALL.iter().enumerate() {
-            let lighting = &mut lightings[m];
+            let lighting = &mut self.lightings[m];
             if k > 0 {
                 lighting.set_map(map.clone());
             }
             let frame = lighting.frame(method.render_mode(), None);
-            renderer.set_lighting(&frame.lighting)?;
-            renderer.render()?;
-            let image = renderer.read_back()?;
+            self.renderer.set_lighting(&frame.lighting)?;
+            self.renderer.render()?;
+            let image = self.renderer.read_back()?;
             let s = error_stats(&image, &reference.radiance, &masks, exposure);
             let y = tonemapped_luminance(&image, exposure);
-            let temporal_error = previous.as_ref().map(|(reference_before, before)| {
+            let temporal_error = self.previous.as_ref().map(|(reference_before, before)| {
                 temporal(
                     &y,
                     &before[m],
@@ -97,18 +152,18 @@ pub fn write_sequence_report(
                 )
             });
             let lights = frame.lighting.lights.len();
-            if previous_lights[m].is_some_and(|p| p != lights) {
-                light_changes[m] += 1;
+            if self.previous_lights[m].is_some_and(|p| p != lights) {
+                self.light_changes[m] += 1;
             }
-            previous_lights[m] = Some(lights);
+            self.previous_lights[m] = Some(lights);
             if *method == SequenceMethod::HybridTracked
-                && let Some(disc) = sequence.sun(k)
+                && let Some(disc) = &sun
             {
-                sun = sun_accuracy(
+                accuracy = sun_accuracy(
                     &frame.lighting.lights,
-                    &disc,
-                    rotation,
-                    base_lighting.as_mut(),
+                    disc,
+                    self.rotation,
+                    self.base_lighting.as_mut(),
                 );
             }
             results.push(FrameResult {
@@ -123,25 +178,9 @@ pub fn write_sequence_report(
             ys.push(y);
             images.push(image);
         }
-        // hybrid/tracked | prt | reference
-        gif_frames.push(side_by_side(
-            &[&images[1], &images[0], &reference.radiance],
-            exposure,
-        ));
-        println!("frame {k}/{}: {}", sequence.len() - 1, frame_line(&results));
-        frames.push(SequenceFrame {
-            frame: k,
-            methods: results,
-            sun,
-            reference_cached: reference.cached,
-        });
-        previous = Some((reference_y, ys));
+        self.previous = Some((reference_y, ys));
+        Ok((results, images, accuracy))
     }
-    let report = summarise(scene, sequence_path, settings, frames, &light_changes);
-    write_outputs(&report, &gif_frames, camera.width * 3, camera.height, out)?;
-    print_summary(&report);
-    println!("\nwrote {}", out.join("report.html").display());
-    Ok(())
 }
 
 /// The lighting of each method (tracking for the tracked hybrid), and of the base map of a sun

@@ -1,0 +1,42 @@
+//! `hprt bench`: benchmarks anyone can rerun; they print medians over repeats.
+
+mod bake;
+mod reference;
+mod reflections;
+mod render;
+mod turn;
+
+use bake::{BenchBakeArgs, bench_bake};
+use clap::Subcommand;
+use reference::{BenchReferenceArgs, bench_reference};
+use reflections::{BenchReflectionsArgs, bench_reflections};
+use render::{BenchRenderArgs, bench_render};
+use turn::{BenchTurnArgs, bench_turn};
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// Bake throughput: rays per second, bake time and the cost of each bounce.
+    Bake(BenchBakeArgs),
+    /// Reference renderer speed: seconds, rays per second, seconds per megapixel per sample.
+    Reference(BenchReferenceArgs),
+    /// GPU frame times of prt and hybrid, static and dynamic lighting, and the CPU work per
+    /// frame (decomposition and uploads).
+    Render(BenchRenderArgs),
+    /// A full turn of each map: how steady the lights are (light-count changes, power
+    /// variation, direction error) when the decomposition is rotated, against decomposing the
+    /// turned map again every frame; and the per-frame cost of each.
+    Turn(BenchTurnArgs),
+    /// Glossy reflections: the GPU time of prefiltering the map's remainder per lighting
+    /// change, at each face size.
+    Reflections(BenchReflectionsArgs),
+}
+
+pub fn run(command: BenchCommand) -> anyhow::Result<()> {
+    match command {
+        BenchCommand::Bake(args) => bench_bake(args),
+        BenchCommand::Reference(args) => bench_reference(args),
+        BenchCommand::Render(args) => bench_render(args),
+        BenchCommand::Turn(args) => bench_turn(args),
+        BenchCommand::Reflections(args) => bench_reflections(args),
+    }
+}

@@ -1,0 +1,206 @@
+//! The viewer's bake, environment, lighting and renderer: made, reloaded and remade as the
+//! settings change.
+
+use super::App;
+use super::state::BakeJob;
+use crate::bake_cache;
+use crate::environment::default_exposure;
+use foundation::infra::progress::SharedProgress;
+use runtime::EnvironmentLighting;
+use runtime::render::Renderer;
+use std::sync::Arc;
+
+impl App {
+    pub(super) fn load_environment(&mut self) {
+        // The map, and how many of its texels were invalid and set to 0.
+        let loaded = match &self.lighting.sequence {
+            Some((sequence, _)) => sequence.frame(0).map(|map| (map, 0)),
+            None => crate::environment::load_map(&self.settings.env, None)
+                .map(|loaded| (loaded.map, loaded.sanitized)),
+        };
+        let (map, sanitized) = match loaded {
+            Ok(loaded) => loaded,
+            Err(e) => {
+                self.stats.message = format!("cannot load the map: {e:#}");
+                return;
+            }
+        };
+        let mut lighting = match EnvironmentLighting::new(&map, self.settings.decompose_settings())
+        {
+            Ok(lighting) => lighting,
+            Err(e) => {
+                self.stats.message = format!("cannot light the scene with the map: {e}");
+                return;
+            }
+        };
+        if self.settings.exposure == 1.0 && self.lighting.environment.is_none() {
+            self.settings.exposure = default_exposure(&map);
+        }
+        self.lighting.lit_for = None;
+        self.panel.environment_changed();
+        self.stats.message = if sanitized > 0 {
+            format!("{sanitized} texels with negative or invalid radiance set to 0")
+        } else {
+            String::new()
+        };
+        if self.lighting.sequence.is_some()
+            && let Err(e) = lighting.enable_tracking(Some(runtime::TrackingSettings::default()))
+        {
+            self.stats.message = format!("cannot track the lights: {e}");
+        }
+        if let Some(r) = self.window.renderer.as_mut() {
+            r.set_environment(lighting.map(), self.settings.rotation_deg);
+            if let Some(gpu) = self.window.gpu.as_mut() {
+                gpu.renderer_changed();
+            }
+        }
+        self.lighting.environment = Some(lighting);
+    }
+
+    pub(super) fn start_bake(&mut self) {
+        let scene = self.scene.clone();
+        let progress = Arc::new(SharedProgress::default());
+        let shared = progress.clone();
+        let (sender, receiver) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let result = bake_cache::bake_into_cache(&scene, &scene.bake, shared.as_ref())
+                .map(|(_, transfer, _)| transfer);
+            let _ = sender.send(result);
+        });
+        self.bake.job = Some(BakeJob {
+            progress,
+            result: receiver,
+        });
+    }
+
+    pub(super) fn poll_bake(&mut self) {
+        let Some(job) = &self.bake.job else { return };
+        match job.result.try_recv() {
+            Ok(Ok(transfer)) => {
+                self.settings.order = transfer.settings.order;
+                self.bake.transfer = Some(Arc::new(transfer));
+                self.bake.job = None;
+                self.stats.message = format!("baked into {}", self.bake.path.display());
+            }
+            Ok(Err(e)) => {
+                self.stats.message = format!("the bake failed: {e:#}");
+                self.bake.job = None;
+            }
+            Err(_) => {}
+        }
+    }
+
+    /// Shows the next frame of the sequence being played.
+    pub(super) fn advance_sequence(&mut self) -> anyhow::Result<()> {
+        let (Some((sequence, frame)), Some(env)) = (
+            self.lighting.sequence.as_mut(),
+            self.lighting.environment.as_mut(),
+        ) else {
+            return Ok(());
+        };
+        *frame = (*frame + 1) % sequence.len();
+        if *frame == 0 {
+            // Looping: start the tracking afresh, as on the first frame.
+            env.enable_tracking(Some(runtime::TrackingSettings::default()))?;
+        }
+        env.set_map(sequence.frame(*frame)?);
+        if let Some(renderer) = self.window.renderer.as_mut() {
+            renderer.set_environment(env.map(), self.settings.rotation_deg);
+            if let Some(gpu) = self.window.gpu.as_mut() {
+                gpu.renderer_changed();
+            }
+        }
+        self.lighting.lit_for = None;
+        self.panel.environment_changed();
+        Ok(())
+    }
+
+    /// The decomposition (and the renderer's lighting) when anything it depends on changed.
+    pub(super) fn update_lighting(&mut self) -> anyhow::Result<()> {
+        let (Some(env), Some(renderer)) = (
+            self.lighting.environment.as_mut(),
+            self.window.renderer.as_mut(),
+        ) else {
+            return Ok(());
+        };
+        renderer.set_shadow_settings(self.settings.shadow)?;
+        let materials_changed = self
+            .lighting
+            .lit_for
+            .as_ref()
+            .is_none_or(|previous| previous.materials != self.settings.materials);
+        if materials_changed {
+            // Kept within energy conservation: k_s at most 1 − k_d per channel.
+            for (m, o) in self
+                .settings
+                .materials
+                .iter_mut()
+                .zip(&self.scene.geometry.objects)
+            {
+                m.specular = m
+                    .specular
+                    .min(foundation::Rgb::ONE - o.albedo)
+                    .max(foundation::Rgb::ZERO);
+            }
+            renderer.set_materials(&self.settings.materials)?;
+            if renderer.is_glossy() {
+                env.enable_reflections(Some(runtime::render::DEFAULT_REFLECTION_SIZE));
+            }
+        }
+        let needs = match &self.lighting.lit_for {
+            Some(previous) => {
+                materials_changed
+                    || previous.rotation_deg != self.settings.rotation_deg
+                    || previous.decompose_settings() != self.settings.decompose_settings()
+                    || previous.mode != self.settings.mode
+                    || previous.lights_indirect != self.settings.lights_indirect
+                    || previous.median_cut_lights != self.settings.median_cut_lights
+                    || previous.env != self.settings.env
+            }
+            None => true,
+        };
+        if !needs {
+            return Ok(());
+        }
+        env.set_settings(self.settings.decompose_settings())?;
+        env.set_rotation(self.settings.rotation_deg);
+        env.set_median_cut_lights(self.settings.median_cut_lights)?;
+        let frame = env.frame(self.settings.mode, Some(self.settings.lights_indirect));
+        // The panel shows the lights in every mode, plain PRT included.
+        let decomposition = match frame.decomposition {
+            Some(d) => d,
+            None => env.decompose(),
+        };
+        renderer.set_lighting(&frame.lighting)?;
+        renderer.set_environment_rotation(self.settings.rotation_deg);
+        self.lighting.decomposition = Some(decomposition);
+        self.lighting.decomposition_ms = frame.ms;
+        self.lighting.lit_for = Some(self.settings.clone());
+        Ok(())
+    }
+
+    pub(super) fn ensure_renderer(&mut self) -> anyhow::Result<()> {
+        if self.window.renderer.is_some() {
+            return Ok(());
+        }
+        let (Some(gpu), Some(transfer)) = (self.window.gpu.as_mut(), self.bake.transfer.as_ref())
+        else {
+            return Ok(());
+        };
+        let camera = self.input.orbit.camera(gpu.config.width, gpu.config.height);
+        let mut renderer = Renderer::new(
+            &gpu.gpu,
+            &self.scene.geometry,
+            transfer,
+            &camera,
+            self.settings.shadow,
+        )?;
+        if let Some(env) = &self.lighting.environment {
+            renderer.set_environment(env.map(), self.settings.rotation_deg);
+        }
+        gpu.renderer_changed();
+        self.window.renderer = Some(renderer);
+        self.lighting.lit_for = None;
+        Ok(())
+    }
+}
