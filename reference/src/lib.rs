@@ -54,17 +54,23 @@ impl ReferenceSettings {
     }
 
     /// Sobol sequences are 2^16 points long.
-    pub fn validate(&self) -> Result<(), String> {
-        if self.sampler == SamplerKind::Sobol
-            && u64::from(self.first_sample) + u64::from(self.spp) > u64::from(MAX_SOBOL_SAMPLES)
-        {
-            return Err(format!(
-                "the sobol sampler takes at most {MAX_SOBOL_SAMPLES} samples per pixel, {} asked",
-                u64::from(self.first_sample) + u64::from(self.spp)
-            ));
+    pub fn validate(&self) -> Result<(), TooManySamples> {
+        let asked = u64::from(self.first_sample) + u64::from(self.spp);
+        if self.sampler == SamplerKind::Sobol && asked > u64::from(MAX_SOBOL_SAMPLES) {
+            return Err(TooManySamples { asked });
         }
         Ok(())
     }
+}
+
+/// More samples per pixel than the Sobol sequences hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "the sobol sampler takes at most {max} samples per pixel, {asked} asked",
+    max = MAX_SOBOL_SAMPLES
+)]
+pub struct TooManySamples {
+    pub asked: u64,
 }
 
 /// The rendered images.

@@ -76,7 +76,7 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
         sampler: args.sampler,
         ..ReferenceSettings::new(args.spp, args.bounces, args.seed)
     };
-    settings.validate().map_err(anyhow::Error::msg)?;
+    settings.validate()?;
     crate::support::distinct_outputs(&[
         ("-o", Some(&args.output)),
         ("--png", args.png.as_deref()),

@@ -28,6 +28,7 @@ pub mod prt_pass;
 pub mod readback;
 pub mod reflection_maps;
 pub mod shaders;
+mod shadow_fit;
 pub mod shadow_maps;
 pub mod targets;
 mod transfer_pass;
@@ -51,8 +52,10 @@ use precompute::bake::Transfer;
 use prt_pass::{PrtPass, PrtPassInputs};
 use reflection_maps::ReflectionMaps;
 pub use shaders::{MAX_GPU_ORDER, MAX_LIGHTS};
+pub use shadow_fit::{
+    BoundingSphere, ShadowFit, ShadowSettings, shadow_matrix, shadow_texel_size, visible_region,
+};
 use shadow_maps::ShadowMaps;
-pub use shadow_maps::{BoundingSphere, ShadowFit, ShadowSettings};
 use targets::Targets;
 use uniforms::{FrameBuffers, FrameParameters, FrameUniform};
 

@@ -3,7 +3,7 @@
 
 use super::pass_helpers::writable_buffer;
 use super::shaders::MAX_LIGHTS;
-use super::shadow_maps::{BoundingSphere, ShadowFit};
+use super::shadow_fit::{BoundingSphere, ShadowFit};
 use crate::light::DirectionalLight;
 use bytemuck::{Pod, Zeroable};
 use foundation::Rgb;

@@ -38,7 +38,7 @@ pub(super) fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
     let camera = scene.camera.with_size(args.width, args.height);
     camera.validate()?;
     let settings = ReferenceSettings::new(args.spp, args.bounces, 0);
-    settings.validate().map_err(anyhow::Error::msg)?;
+    settings.validate()?;
     let runs = with_threads(args.threads, || {
         let bvh = SceneBvh::build(&scene.geometry.mesh);
         let light = EnvironmentLight::new(&env.loaded.map, env.rotation_deg);

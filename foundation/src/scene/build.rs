@@ -1,0 +1,344 @@
+//! From description to scene: loading every object's mesh, checking its material and
+//! transform, and assembling the geometry, in one ordered step.
+
+use super::description::*;
+use super::geometry::SceneMesh;
+use super::{Scene, SceneError};
+use crate::color::Rgb;
+use crate::material::{MAX_SHININESS, Material, check_energy};
+use crate::mesh::{
+    self, LoadOptions, MeshCleanup, MeshError, TriangleMesh, annulus_mesh, box_mesh,
+};
+use crate::texture::AlbedoTexture;
+use glam::{Mat3, Mat4, Vec3};
+use std::path::Path;
+use std::sync::Arc;
+
+impl Scene {
+    /// Loads a scene file and every mesh it names.
+    pub fn load(path: &Path) -> Result<Self, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|cause| SceneError::Io {
+            path: path.to_owned(),
+            cause,
+        })?;
+        let file: SceneFile = toml::from_str(&text).map_err(|e| SceneError::Parse {
+            path: path.to_owned(),
+            message: e.to_string().trim_end().to_owned(),
+        })?;
+        Self::from_file(path, file)
+    }
+
+    /// Builds a scene from a parsed file; relative paths resolve against `path`'s folder.
+    pub fn from_file(path: &Path, file: SceneFile) -> Result<Self, SceneError> {
+        let invalid = |message: String| SceneError::Invalid {
+            path: path.to_owned(),
+            message,
+        };
+        let dir = path.parent().unwrap_or(Path::new("."));
+        file.camera
+            .validate()
+            .map_err(|m| invalid(format!("camera: {m}")))?;
+        file.bake
+            .validate()
+            .map_err(|m| invalid(format!("bake: {m}")))?;
+        if file.objects.is_empty() {
+            return Err(invalid("the scene has no [[object]]".into()));
+        }
+        let mut geometry = SceneMesh::default();
+        for (index, object) in file.objects.iter().enumerate() {
+            let name = object
+                .name
+                .clone()
+                .unwrap_or_else(|| format!("#{}", index + 1));
+            if let Some(albedo) = object.albedo
+                && !albedo.iter().all(|a| (0.0..1.0).contains(a))
+            {
+                return Err(invalid(format!(
+                    "{name}: albedo {albedo:?} must be in [0, 1) per channel"
+                )));
+            }
+            let material = object_material(object).map_err(|m| invalid(format!("{name}: {m}")))?;
+            let parts = load_object_parts(dir, object).map_err(|e| match e {
+                ObjectError::Mesh(cause) => SceneError::Mesh {
+                    scene: path.to_owned(),
+                    object: name.clone(),
+                    cause,
+                },
+                ObjectError::Spec(m) => invalid(format!("{name}: {m}")),
+            })?;
+            let single = parts.len() == 1;
+            for part in parts {
+                let albedo = object
+                    .albedo
+                    .map(Rgb::from)
+                    .or(part.albedo)
+                    .ok_or_else(|| {
+                        invalid(format!(
+                            "{name}: give it an albedo = [r, g, b] (only glTF models carry \
+                             their own)"
+                        ))
+                    })?;
+                let part_name = match single {
+                    true => name.clone(),
+                    false => format!("{name}/{}", part.name),
+                };
+                let world = transform_mesh(&part.mesh, &object.transform.matrix())
+                    .ok_or_else(|| invalid(format!("{name}: the transform is singular")))?;
+                if material.is_glossy() {
+                    check_energy(albedo, material.specular)
+                        .map_err(|m| invalid(format!("{part_name}: {m}")))?;
+                }
+                // An albedo in the scene file replaces the model's material, texture included.
+                match (object.albedo, part.texture) {
+                    (None, Some(texture)) => {
+                        geometry.push_textured_object(part_name, &world, albedo, texture)
+                    }
+                    _ => geometry.push_object(part_name, &world, albedo),
+                }
+                if let Some(o) = geometry.objects.last_mut() {
+                    o.material = material;
+                }
+            }
+        }
+        if let Some(env) = &file.environment
+            && !env.rotation_deg.is_finite()
+        {
+            return Err(invalid(format!(
+                "environment: rotation_deg {} is not finite",
+                env.rotation_deg
+            )));
+        }
+        let environment = file.environment.map(|env| EnvironmentSpec {
+            map: dir.join(env.map),
+            rotation_deg: env.rotation_deg,
+        });
+        Ok(Self {
+            name: file.name.unwrap_or_else(|| {
+                path.file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| "scene".into())
+            }),
+            path: path.to_owned(),
+            geometry,
+            camera: file.camera,
+            environment,
+            bake: file.bake,
+        })
+    }
+}
+
+/// The specular lobe an object asks for (its energy is checked against each part's albedo).
+fn object_material(object: &ObjectSpec) -> Result<Material, SpecError> {
+    match (object.specular, object.shininess) {
+        (None, None) => Ok(Material::DIFFUSE),
+        (None, Some(_)) => Err(SpecError::ShininessWithoutSpecular),
+        (Some(_), None) => Err(SpecError::SpecularWithoutShininess),
+        (Some(specular), Some(shininess)) => {
+            if !specular.iter().all(|c| (0.0..=1.0).contains(c)) {
+                return Err(SpecError::Specular(specular));
+            }
+            if !(shininess > 0.0 && shininess <= MAX_SHININESS) {
+                return Err(SpecError::Shininess(shininess));
+            }
+            Ok(Material {
+                specular: Rgb::from(specular),
+                shininess,
+            })
+        }
+    }
+}
+
+/// Face names of `skip_faces`, in the order of `box_mesh`'s `skip` flags.
+const BOX_FACES: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
+
+enum ObjectError {
+    Mesh(MeshError),
+    Spec(SpecError),
+}
+
+impl From<SpecError> for ObjectError {
+    fn from(e: SpecError) -> Self {
+        ObjectError::Spec(e)
+    }
+}
+
+/// What is wrong with an object's description in the scene file.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SpecError {
+    #[error("shininess without specular = [r, g, b]")]
+    ShininessWithoutSpecular,
+    #[error("specular needs a shininess (the Phong exponent)")]
+    SpecularWithoutShininess,
+    #[error("specular {0:?} must be in [0, 1] per channel")]
+    Specular([f32; 3]),
+    #[error("shininess {0} must be in (0, {max}]", max = MAX_SHININESS)]
+    Shininess(f32),
+    #[error(
+        "give exactly one of `mesh = \"file\"`, `box = {{ min, max }}` or `annulus = {{ outer_radius }}`"
+    )]
+    Shape,
+    #[error("box min {min:?} must be below max {max:?} on every axis")]
+    BoxBounds { min: [f32; 3], max: [f32; 3] },
+    #[error("box segments {0:?} must be between 1 and 4096")]
+    BoxSegments([u32; 3]),
+    #[error("unknown box face {0:?} in skip_faces (use {faces:?})", faces = BOX_FACES)]
+    BoxFace(String),
+    #[error("annulus radii {inner} .. {outer} must satisfy 0 <= inner < outer")]
+    AnnulusRadii { inner: f32, outer: f32 },
+    #[error("annulus segments {0:?} must be at least [1, 3] and at most 4096")]
+    AnnulusSegments([u32; 2]),
+}
+
+/// One part of an object: a glTF primitive, or the whole of any other object.
+struct ObjectPart {
+    name: String,
+    mesh: TriangleMesh,
+    /// The albedo the model file gives (glTF materials); the texture's factor if textured.
+    albedo: Option<Rgb>,
+    texture: Option<Arc<AlbedoTexture>>,
+}
+
+fn load_object_parts(dir: &Path, object: &ObjectSpec) -> Result<Vec<ObjectPart>, ObjectError> {
+    let whole = |mesh| {
+        vec![ObjectPart {
+            name: String::new(),
+            mesh,
+            albedo: None,
+            texture: None,
+        }]
+    };
+    match (&object.mesh, &object.box_shape, &object.annulus) {
+        (Some(file), None, None) => {
+            let options = LoadOptions {
+                patch_segments: object.patch_segments,
+                skip_patches: object.skip_patches.clone(),
+            };
+            let path = dir.join(file);
+            let cleanup = MeshCleanup {
+                weld: object.weld,
+                ..Default::default()
+            };
+            mesh::read_model(&path, &options)
+                .map_err(ObjectError::Mesh)?
+                .into_iter()
+                .map(|part| {
+                    let (mesh, _report) =
+                        cleanup.run(&path, part.mesh).map_err(ObjectError::Mesh)?;
+                    Ok(ObjectPart {
+                        albedo: part.material.as_ref().map(|m| material_albedo(&path, m)),
+                        texture: part.material.and_then(|m| m.texture),
+                        name: part.name,
+                        mesh,
+                    })
+                })
+                .collect()
+        }
+        (None, Some(b), None) => box_object(b).map(whole),
+        (None, None, Some(a)) => annulus_object(a).map(whole),
+        _ => Err(SpecError::Shape.into()),
+    }
+}
+
+/// Largest albedo a model's material may give: albedos must stay below 1 (a white furnace
+/// would never converge); a glTF base colour of 1 (its default) becomes this.
+pub const MAX_MATERIAL_ALBEDO: f32 = 0.99;
+
+/// The albedo of a glTF material: its base colour factor (which multiplies its texture, if it
+/// has one), kept below 1.
+fn material_albedo(path: &Path, material: &mesh::PartMaterial) -> Rgb {
+    let albedo = material.base_color;
+    // A texture's factor is usually 1 (glTF's default): the texels are the albedo.
+    if material.texture.is_some() {
+        return albedo.clamp(Rgb::ZERO, Rgb::ONE);
+    }
+    if albedo.max_element() > MAX_MATERIAL_ALBEDO {
+        log::warn!(
+            "{}: {}: base colour {:.3?} clamped to {MAX_MATERIAL_ALBEDO} (albedos stay below 1)",
+            path.display(),
+            material.name,
+            albedo.to_array()
+        );
+    }
+    albedo.clamp(Rgb::ZERO, Rgb::splat(MAX_MATERIAL_ALBEDO))
+}
+
+fn box_object(b: &BoxSpec) -> Result<TriangleMesh, ObjectError> {
+    let (min, max) = (Vec3::from(b.min), Vec3::from(b.max));
+    if !(min.is_finite() && max.is_finite() && min.cmplt(max).all()) {
+        return Err(SpecError::BoxBounds {
+            min: b.min,
+            max: b.max,
+        }
+        .into());
+    }
+    if b.segments.iter().any(|&s| s == 0 || s > 4096) {
+        return Err(SpecError::BoxSegments(b.segments).into());
+    }
+    let mut skip = [false; 6];
+    for face in &b.skip_faces {
+        let index = BOX_FACES
+            .iter()
+            .position(|f| f == face)
+            .ok_or_else(|| SpecError::BoxFace(face.clone()))?;
+        skip[index] = true;
+    }
+    if skip.iter().all(|s| *s) {
+        log::warn!(
+            "the box {:?}..{:?} skips all six faces: it adds nothing to the scene",
+            b.min,
+            b.max
+        );
+    }
+    Ok(box_mesh(min, max, b.segments, skip))
+}
+
+fn annulus_object(a: &AnnulusSpec) -> Result<TriangleMesh, ObjectError> {
+    if !(a.inner_radius >= 0.0 && a.outer_radius > a.inner_radius && a.outer_radius.is_finite()) {
+        return Err(SpecError::AnnulusRadii {
+            inner: a.inner_radius,
+            outer: a.outer_radius,
+        }
+        .into());
+    }
+    if a.segments[0] == 0 || a.segments[1] < 3 || a.segments.iter().any(|&s| s > 4096) {
+        return Err(SpecError::AnnulusSegments(a.segments).into());
+    }
+    Ok(annulus_mesh(
+        Vec3::from(a.center),
+        a.inner_radius,
+        a.outer_radius,
+        a.segments,
+    ))
+}
+
+/// Applies an affine transform to positions and (inverse-transpose) normals. `None` if the
+/// transform is singular.
+pub fn transform_mesh(mesh: &TriangleMesh, m: &Mat4) -> Option<TriangleMesh> {
+    let linear = Mat3::from_mat4(*m);
+    let det = linear.determinant();
+    if !det.is_finite() || det.abs() < 1e-12 {
+        return None;
+    }
+    let normal_matrix = linear.inverse().transpose();
+    let mut triangles = mesh.triangles.clone();
+    if det < 0.0 {
+        // A mirroring transform flips the winding; restore outward-facing triangles.
+        for t in &mut triangles {
+            t.swap(1, 2);
+        }
+    }
+    Some(TriangleMesh {
+        positions: mesh
+            .positions
+            .iter()
+            .map(|p| m.transform_point3(*p))
+            .collect(),
+        normals: mesh
+            .normals
+            .iter()
+            .map(|n| (normal_matrix * *n).normalize_or(Vec3::Y))
+            .collect(),
+        triangles,
+        uvs: mesh.uvs.clone(),
+    })
+}

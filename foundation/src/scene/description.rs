@@ -1,0 +1,154 @@
+//! The scene file as written (TOML, `scenes/README.md`): what the user describes, before
+//! anything is loaded.
+
+use crate::bake_settings::BakeSettings;
+use crate::camera::Camera;
+use glam::{Mat4, Quat, Vec3};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// The scene file as written.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub camera: Camera,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub environment: Option<EnvironmentSpec>,
+    #[serde(default)]
+    pub bake: BakeSettings,
+    #[serde(rename = "object", default)]
+    pub objects: Vec<ObjectSpec>,
+}
+
+/// The environment map a scene is lit by unless the command line says otherwise.
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentSpec {
+    /// Path, relative to the scene file.
+    pub map: PathBuf,
+    /// Rotation about +Y in degrees, counter-clockwise seen from above.
+    #[serde(default)]
+    pub rotation_deg: f32,
+}
+
+/// One object: a mesh file or a procedural box, placed by a transform, with an albedo.
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectSpec {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Mesh file (OBJ, PLY, BPT, optionally .gz, or glTF 2.0), relative to the scene file. A
+    /// glTF model becomes one object per triangle primitive, named `name/mesh/primitive`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<PathBuf>,
+    #[serde(rename = "box", skip_serializing_if = "Option::is_none")]
+    pub box_shape: Option<BoxSpec>,
+    /// Lambertian RGB albedo, each channel in [0, 1). Optional for glTF models, whose
+    /// materials give it; when set, it overrides them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub albedo: Option<[f32; 3]>,
+    /// Phong specular reflectance `k_s`, each channel in [0, 1], with `albedo + specular ≤ 1`
+    /// (CONVENTIONS.md, "Glossy materials"); needs `shininess`. None: purely diffuse.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub specular: Option<[f32; 3]>,
+    /// Phong exponent `s` of the specular lobe, in (0, 10000].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shininess: Option<f32>,
+    #[serde(default)]
+    pub transform: Transform,
+    /// Quads per Bézier patch side (BPT meshes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub patch_segments: Option<u32>,
+    /// Bézier patches to leave out (BPT meshes, 0-based).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub skip_patches: Vec<usize>,
+    /// A flat ring (or disc, with `inner_radius = 0`) in the object's XZ plane, facing +Y.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub annulus: Option<AnnulusSpec>,
+    /// Weld coincident vertices (default: when the file has no normals).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weld: Option<bool>,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+    /// Quads along x, y and z.
+    #[serde(default = "default_box_segments")]
+    pub segments: [u32; 3],
+    /// Faces to leave out, named "+x", "-x", "+y", "-y", "+z", "-z" (faces that touch
+    /// something else and are never seen).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub skip_faces: Vec<String>,
+}
+
+fn default_box_segments() -> [u32; 3] {
+    [1, 1, 1]
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnnulusSpec {
+    #[serde(default)]
+    pub center: [f32; 3],
+    #[serde(default)]
+    pub inner_radius: f32,
+    pub outer_radius: f32,
+    /// Quads across the ring and around it.
+    #[serde(default = "default_annulus_segments")]
+    pub segments: [u32; 2],
+}
+
+fn default_annulus_segments() -> [u32; 2] {
+    [1, 64]
+}
+
+/// Object-to-world placement: scale, then rotations about X, Y and Z (degrees), then translate.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Transform {
+    #[serde(default = "one")]
+    pub scale: Scale,
+    #[serde(default)]
+    pub rotate_deg: [f32; 3],
+    #[serde(default)]
+    pub translate: [f32; 3],
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Self {
+            scale: one(),
+            rotate_deg: [0.0; 3],
+            translate: [0.0; 3],
+        }
+    }
+}
+
+fn one() -> Scale {
+    Scale::Uniform(1.0)
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum Scale {
+    Uniform(f32),
+    PerAxis([f32; 3]),
+}
+
+impl Transform {
+    pub fn matrix(&self) -> Mat4 {
+        let scale = match self.scale {
+            Scale::Uniform(s) => Vec3::splat(s),
+            Scale::PerAxis(s) => Vec3::from(s),
+        };
+        let [rx, ry, rz] = self.rotate_deg.map(f32::to_radians);
+        let rotation =
+            Quat::from_rotation_z(rz) * Quat::from_rotation_y(ry) * Quat::from_rotation_x(rx);
+        Mat4::from_scale_rotation_translation(scale, rotation, Vec3::from(self.translate))
+    }
+}

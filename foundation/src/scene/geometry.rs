@@ -1,0 +1,218 @@
+//! The assembled scene: every object's triangles in one world-space mesh, with per-vertex
+//! albedo, the objects' ranges, textures and materials.
+
+use crate::color::Rgb;
+use crate::material::Material;
+use crate::mesh::TriangleMesh;
+use crate::texture::AlbedoTexture;
+use std::sync::Arc;
+
+/// A named part of the scene mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneObject {
+    pub name: String,
+    /// The albedo, or for a textured object the factor its texture is multiplied by.
+    pub albedo: Rgb,
+    pub vertices: std::ops::Range<u32>,
+    pub triangles: std::ops::Range<u32>,
+    /// Index into [`SceneMesh::textures`] of its base colour texture.
+    pub texture: Option<usize>,
+    /// Its specular lobe, if glossy (the albedo above is its diffuse `k_d`).
+    pub material: Material,
+}
+
+/// Marks a triangle without a texture in [`SceneMesh::triangle_textures`].
+pub const NO_TEXTURE: u32 = u32::MAX;
+
+/// All objects merged into one world-space mesh, with a per-vertex albedo.
+#[derive(Debug, Clone, Default)]
+pub struct SceneMesh {
+    /// World-space geometry; its texture coordinates are empty unless an object is textured.
+    pub mesh: TriangleMesh,
+    /// Per vertex: its object's albedo, or for a textured object the factor its texture is
+    /// multiplied by (the bake's transfer is then per unit texel value: CONVENTIONS.md,
+    /// "Textured albedo").
+    pub albedo: Vec<Rgb>,
+    pub objects: Vec<SceneObject>,
+    /// Base colour textures of the textured objects.
+    pub textures: Vec<Arc<AlbedoTexture>>,
+}
+
+impl SceneMesh {
+    /// BLAKE3 hash of everything a bake depends on: positions, normals, triangles, albedos,
+    /// textures and glossy materials.
+    pub fn content_hash(&self) -> [u8; 32] {
+        let mut hasher = blake3::Hasher::new();
+        hasher.update(b"hprt scene mesh v1");
+        hasher.update(&(self.mesh.positions.len() as u64).to_le_bytes());
+        hasher.update(&(self.mesh.triangles.len() as u64).to_le_bytes());
+        for v in self
+            .mesh
+            .positions
+            .iter()
+            .chain(&self.mesh.normals)
+            .chain(&self.albedo)
+        {
+            for c in v.to_array() {
+                hasher.update(&c.to_le_bytes());
+            }
+        }
+        for t in &self.mesh.triangles {
+            for i in t {
+                hasher.update(&i.to_le_bytes());
+            }
+        }
+        // Textures count only where there are some, so untextured scenes keep their hashes
+        // (and their cached bakes).
+        if !self.textures.is_empty() {
+            hasher.update(b"textured");
+            for uv in &self.mesh.uvs {
+                hasher.update(&uv.x.to_le_bytes());
+                hasher.update(&uv.y.to_le_bytes());
+            }
+            for o in &self.objects {
+                hasher.update(&o.texture.map_or(u64::MAX, |t| t as u64).to_le_bytes());
+            }
+            for t in &self.textures {
+                hasher.update(&(t.width as u64).to_le_bytes());
+                hasher.update(&(t.height as u64).to_le_bytes());
+                for texel in &t.texels {
+                    for c in texel.to_array() {
+                        hasher.update(&c.to_le_bytes());
+                    }
+                }
+            }
+        }
+        // Glossy objects reflect their specular energy in the interreflection; diffuse scenes
+        // keep their hashes.
+        if let Some(materials) = self.material_hash() {
+            hasher.update(&materials);
+        }
+        *hasher.finalize().as_bytes()
+    }
+
+    /// Length of the bounding-box diagonal (the scale for ray epsilons).
+    pub fn diagonal(&self) -> f32 {
+        self.mesh
+            .bounds()
+            .map(|(lo, hi)| (hi - lo).length())
+            .unwrap_or(1.0)
+    }
+
+    /// Adds `mesh` (already in world space) as a new object.
+    pub fn push_object(&mut self, name: String, mesh: &TriangleMesh, albedo: Rgb) {
+        let v0 = self.mesh.vertex_count() as u32;
+        let t0 = self.mesh.triangle_count() as u32;
+        self.mesh.append(mesh);
+        self.albedo
+            .extend(std::iter::repeat_n(albedo, mesh.vertex_count()));
+        self.objects.push(SceneObject {
+            name,
+            albedo,
+            vertices: v0..self.mesh.vertex_count() as u32,
+            triangles: t0..self.mesh.triangle_count() as u32,
+            texture: None,
+            material: Material::DIFFUSE,
+        });
+    }
+
+    /// Adds `mesh` (world space, with texture coordinates) whose albedo is `factor` times
+    /// `texture` looked up at each point.
+    pub fn push_textured_object(
+        &mut self,
+        name: String,
+        mesh: &TriangleMesh,
+        factor: Rgb,
+        texture: Arc<AlbedoTexture>,
+    ) {
+        debug_assert_eq!(mesh.uvs.len(), mesh.vertex_count());
+        let index = match self.textures.iter().position(|t| Arc::ptr_eq(t, &texture)) {
+            Some(i) => i,
+            None => {
+                self.textures.push(texture);
+                self.textures.len() - 1
+            }
+        };
+        self.push_object(name, mesh, factor);
+        if let Some(object) = self.objects.last_mut() {
+            object.texture = Some(index);
+        }
+    }
+
+    /// Whether any object has a specular lobe.
+    pub fn is_glossy(&self) -> bool {
+        self.objects.iter().any(|o| o.material.is_glossy())
+    }
+
+    /// Per triangle, its object's material.
+    pub fn triangle_materials(&self) -> Vec<Material> {
+        let mut out = vec![Material::DIFFUSE; self.mesh.triangle_count()];
+        for o in &self.objects {
+            out[o.triangles.start as usize..o.triangles.end as usize].fill(o.material);
+        }
+        out
+    }
+
+    /// BLAKE3 hash of the objects' materials where any is glossy (part of
+    /// [`Self::content_hash`]); `None` for a diffuse scene.
+    pub fn material_hash(&self) -> Option<[u8; 32]> {
+        if !self.is_glossy() {
+            return None;
+        }
+        let mut hasher = blake3::Hasher::new();
+        hasher.update(b"hprt materials v1");
+        for o in &self.objects {
+            hasher.update(&o.triangles.start.to_le_bytes());
+            for c in o.material.specular.to_array() {
+                hasher.update(&c.to_le_bytes());
+            }
+            hasher.update(&o.material.shininess.to_le_bytes());
+        }
+        Some(*hasher.finalize().as_bytes())
+    }
+
+    /// Whether any object is textured.
+    pub fn is_textured(&self) -> bool {
+        !self.textures.is_empty()
+    }
+
+    /// Per triangle, the index of its texture, or [`NO_TEXTURE`].
+    pub fn triangle_textures(&self) -> Vec<u32> {
+        let mut out = vec![NO_TEXTURE; self.mesh.triangle_count()];
+        for o in &self.objects {
+            if let Some(t) = o.texture {
+                out[o.triangles.start as usize..o.triangles.end as usize].fill(t as u32);
+            }
+        }
+        out
+    }
+
+    /// Per vertex, the albedo it reflects toward other surfaces in the bake's interreflection:
+    /// its object's albedo, or for a textured object the factor times the texture averaged
+    /// around the vertex ([`crate::texture::vertex_average`]); a glossy object adds its
+    /// specular reflectance, reflected as if diffusely (its lobe's energy reaches the other
+    /// surfaces; its direction does not: CONVENTIONS.md, "Glossy materials").
+    pub fn reflected_albedo(&self) -> Vec<Rgb> {
+        let mut albedo = self.albedo.clone();
+        for o in &self.objects {
+            let Some(t) = o.texture else { continue };
+            let (v0, v1) = (o.vertices.start as usize, o.vertices.end as usize);
+            let local: Vec<[u32; 3]> = self.mesh.triangles
+                [o.triangles.start as usize..o.triangles.end as usize]
+                .iter()
+                .map(|tri| tri.map(|i| i - v0 as u32))
+                .collect();
+            let averages =
+                crate::texture::vertex_average(&self.textures[t], &self.mesh.uvs[v0..v1], &local);
+            for (a, avg) in albedo[v0..v1].iter_mut().zip(averages) {
+                *a *= avg;
+            }
+        }
+        for o in self.objects.iter().filter(|o| o.material.is_glossy()) {
+            for a in &mut albedo[o.vertices.start as usize..o.vertices.end as usize] {
+                *a += o.material.specular;
+            }
+        }
+        albedo
+    }
+}
