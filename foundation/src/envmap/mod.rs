@@ -4,11 +4,16 @@
 
 mod column;
 pub mod cube;
+mod error;
+mod files;
+mod layouts;
 mod load;
 mod mapping;
 pub mod sampling;
 
-pub use load::{EnvMapError, Layout, LoadedEnvMap, MIN_MAP_WIDTH, load};
+pub use error::EnvMapError;
+pub use layouts::{Layout, probe_coordinates};
+pub use load::{LoadedEnvMap, MIN_MAP_WIDTH, load};
 use mapping::v_of_direction;
 pub use mapping::{YRotation, direction_of_uv, rotate_y, uv_of_direction};
 
