@@ -44,7 +44,11 @@ impl Layout {
 const SUPERSAMPLE: usize = 3;
 
 /// Converts the decoded image(s) into the equirectangular map.
-pub(crate) fn resample(path: &Path, layout: Layout, images: &[RgbImage]) -> Result<EnvMap, EnvMapError> {
+pub(crate) fn resample(
+    path: &Path,
+    layout: Layout,
+    images: &[RgbImage],
+) -> Result<EnvMap, EnvMapError> {
     let bad_shape = |message: String| EnvMapError::Layout {
         path: path.to_owned(),
         message,

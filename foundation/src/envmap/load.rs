@@ -1,16 +1,12 @@
 //! Reading HDR environment maps (OpenEXR, Radiance `.hdr`) in any of the supported layouts.
 
 use super::EnvMap;
-use super::error::EnvMapError;
 use super::cube::ALL_FACES;
+use super::error::EnvMapError;
 use super::files::{RgbImage, read_image};
 use super::layouts::{Layout, resample};
 use crate::color::Rgb;
 use std::path::Path;
-
-
-
-
 
 /// A loaded map: the equirectangular radiance, how many texels were sanitised, and the layout
 /// it was read as.
@@ -73,7 +69,6 @@ pub fn load(path: &Path, layout: Option<Layout>) -> Result<LoadedEnvMap, EnvMapE
     finish(path, layout, images)
 }
 
-
 /// The narrowest map hprt reads, in latitude-longitude texels (the height is half): smaller maps
 /// are integrated too coarsely (a 2x1 uniform map would hold 2π² instead of 4π) and their
 /// resampling to cubes is too uneven (spurious lights).
@@ -133,10 +128,10 @@ fn sanitize(image: &mut RgbImage) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::envmap::cube::FACE_FRAMES;
     use crate::envmap::cube::{CubeFace, horizontal_cross_cell, vertical_cross_cell};
     use crate::envmap::layouts::{probe_coordinates, probe_direction};
     use glam::Vec3;
-    use crate::envmap::cube::FACE_FRAMES;
 
     /// A smooth test function of direction with distinct values everywhere.
     fn pattern(w: Vec3) -> Rgb {

@@ -1,0 +1,75 @@
+//! The median of luminances by a radix selection over their order-preserving bit patterns.
+
+/// `total_cmp`'s order as unsigned integers: flip the sign bit of positives, every bit of
+/// negatives.
+#[inline]
+pub(super) fn order_key(v: f32) -> u32 {
+    let bits = v.to_bits();
+    bits ^ (((bits as i32) >> 31) as u32 | 1 << 31)
+}
+
+/// Bits of an [`order_key`] counted by each level of [`median_of_keys`]' radix selection.
+pub(super) const RADIX_LEVELS: [u32; 3] = [11, 11, 10];
+
+/// The counts of the keys' top [`RADIX_LEVELS`]`[0]` bits: the selection's first histogram,
+/// taken while the keys are gathered.
+pub(super) struct TopBits([u32; 1 << 11]);
+
+impl TopBits {
+    pub(super) fn new() -> Self {
+        Self([0; 1 << 11])
+    }
+
+    #[inline]
+    pub(super) fn count(&mut self, key: u32) -> u32 {
+        self.0[(key >> (32 - RADIX_LEVELS[0])) as usize] += 1;
+        key
+    }
+}
+
+/// The median of the floats whose [`order_key`]s are `keys` (0 when empty): the element at
+/// index `len / 2` in `total_cmp` order, found by radix selection (`top` counts the top bits;
+/// then a histogram of the next bits among the keys left, and so on: no comparison sort).
+/// `keys` is used as scratch.
+pub(super) fn median_of_keys(keys: &mut Vec<u32>, top: &TopBits) -> f32 {
+    if keys.is_empty() {
+        return 0.0;
+    }
+    let mut rank = keys.len() / 2;
+    let mut shift = 32;
+    let mut prefix = 0u32;
+    for (level, bits) in RADIX_LEVELS.into_iter().enumerate() {
+        shift -= bits;
+        let mut counts = [0u32; 1 << 11];
+        if level == 0 {
+            counts = top.0;
+        } else {
+            for k in keys.iter() {
+                counts[((k >> shift) & ((1 << bits) - 1)) as usize] += 1;
+            }
+        }
+        let mut digit = 0;
+        while rank >= counts[digit] as usize {
+            rank -= counts[digit] as usize;
+            digit += 1;
+        }
+        prefix = prefix << bits | digit as u32;
+        keys.retain(|k| k >> shift == prefix);
+        if keys.len() == 1 || shift == 0 {
+            break;
+        }
+    }
+    let key = keys[rank.min(keys.len() - 1)];
+    // Undo `order_key`.
+    f32::from_bits(if key >> 31 == 1 { key ^ 1 << 31 } else { !key })
+}
+
+/// [`median_of_keys`] of keys not counted while gathered.
+#[cfg(test)]
+pub(super) fn median_of(keys: &mut Vec<u32>) -> f32 {
+    let mut top = TopBits::new();
+    keys.iter().for_each(|k| {
+        top.count(*k);
+    });
+    median_of_keys(keys, &top)
+}
