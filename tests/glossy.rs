@@ -13,40 +13,17 @@ use foundation::scene::SceneMesh;
 use foundation::sh::ShCoeffs;
 use foundation::{Rgb, luminance};
 use glam::{Quat, Vec3};
-use precompute::bake::{BakeSettings, Transfer};
 use reference::{self, EnvironmentLight, ReferenceSettings};
 use runtime::reflection::{ReflectedEnvironment, SharedCube, convolve_exact};
 use runtime::render::{FrameLighting, RenderMode};
 use runtime::{CubeGeometry, CubeMap, DecomposeSettings, EnvironmentLighting};
 use std::sync::Arc;
 
-fn bake_of(geometry: &SceneMesh, samples: u32, bounces: u32) -> Transfer {
-    let bvh = SceneBvh::build(&geometry.mesh);
-    let settings = BakeSettings {
-        order: 5,
-        samples,
-        bounces,
-        seed: 0,
-    };
-    bake_quietly(geometry, &bvh, &settings)
-}
-
 fn glossy_sphere(albedo: Rgb, material: Material) -> SceneMesh {
     let mut geometry = SceneMesh::default();
     geometry.push_object("sphere".into(), &sphere_mesh(Vec3::ZERO, 1.0, 5), albedo);
     geometry.objects[0].material = material;
     geometry
-}
-
-fn camera(position: Vec3, target: Vec3, size: u32) -> Camera {
-    Camera {
-        position,
-        target,
-        up: Vec3::Y,
-        fov_y_deg: 40.0,
-        width: size,
-        height: size,
-    }
 }
 
 /// Pixels whose centre ray meets the unit sphere at the origin with `n·v > min_cos`, with the
@@ -91,7 +68,7 @@ fn prefiltered_reflections_match_the_exact_convolution() {
     let gpus = gpus();
     let source_geometry = CubeGeometry::new(64);
     let cube = featured_cube(&source_geometry);
-    let cam = camera(Vec3::new(0.0, 0.4, 3.5), Vec3::ZERO, 64);
+    let cam = camera(Vec3::new(0.0, 0.4, 3.5), Vec3::ZERO, 64, 64);
     let pixels = sphere_pixels(&cam, 0.3);
     for shininess in [8.0, 60.0, 400.0] {
         let material = Material {
@@ -99,7 +76,7 @@ fn prefiltered_reflections_match_the_exact_convolution() {
             shininess,
         };
         let geometry = glossy_sphere(Rgb::ZERO, material);
-        let transfer = bake_of(&geometry, 64, 0);
+        let transfer = bake_of(&geometry, 5, 64, 0);
         // Turned: the maps stay in the map's frame and the lookup turns.
         let orientation = Quat::from_rotation_y(0.7) * Quat::from_rotation_x(0.2);
         let lighting = FrameLighting {
@@ -148,7 +125,7 @@ fn sh_reflections_are_the_zonal_convolution_at_the_mirror_direction() {
             shininess,
         },
     );
-    let transfer = bake_of(&geometry, 64, 0);
+    let transfer = bake_of(&geometry, 5, 64, 0);
     let mut sh = ShCoeffs::zeros(5);
     for (k, c) in sh.as_mut_slice().iter_mut().enumerate() {
         *c = Rgb::new(1.0, 0.6, 0.3) * if k == 0 { 8.0 } else { 1.0 / (1.0 + k as f32) };
@@ -157,7 +134,7 @@ fn sh_reflections_are_the_zonal_convolution_at_the_mirror_direction() {
         reflections: ReflectedEnvironment::Sh(sh.clone()),
         ..FrameLighting::lights_only(5, Vec::new())
     };
-    let cam = camera(Vec3::new(0.3, 0.5, 3.5), Vec3::ZERO, 48);
+    let cam = camera(Vec3::new(0.3, 0.5, 3.5), Vec3::ZERO, 48, 48);
     let mut convolved = sh.clone();
     convolved.scale_bands(&phong_zonal(shininess, 5));
     let pixels = sphere_pixels(&cam, 0.3);
@@ -185,9 +162,9 @@ fn glossy_white_furnace_on_the_gpu() {
             shininess: 60.0,
         },
     );
-    let transfer = bake_of(&geometry, 256, 1);
+    let transfer = bake_of(&geometry, 5, 256, 1);
     let map = EnvMap::uniform(64, 32, Rgb::ONE);
-    let cam = camera(Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, 48);
+    let cam = camera(Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, 48, 48);
     let pixels = sphere_pixels(&cam, 0.5);
     let mut lighting = EnvironmentLighting::new(&map, DecomposeSettings::default()).unwrap();
     lighting.enable_reflections(Some(32));
@@ -234,7 +211,7 @@ fn glossy_highlights_follow_the_reference() {
         let disc = if w.dot(sun) > 0.9985 { 2000.0 } else { 0.0 };
         Rgb::new(0.3, 0.4, 0.6) * (0.5 + w.y.max(0.0)) + Rgb::splat(disc)
     });
-    let transfer = bake_of(&geometry, 256, 2);
+    let transfer = bake_of(&geometry, 5, 256, 2);
     let cam = Camera {
         position: Vec3::new(0.0, 2.0, 5.0),
         target: Vec3::new(0.0, 0.9, 0.0),

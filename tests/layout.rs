@@ -6,9 +6,12 @@
 
 #[path = "layout/scan.rs"]
 mod scan;
+#[path = "layout/tokens.rs"]
+mod tokens;
 
-use scan::{SourceTree, function_spans, tokens};
+use scan::{SourceTree, function_spans};
 use std::path::Path;
+use tokens::tokens;
 
 const MAX_FUNCTION_LINES: usize = 100;
 const MAX_FILE_LINES: usize = 600;

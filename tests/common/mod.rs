@@ -170,3 +170,87 @@ pub fn tone_mapped_error(
         });
     sum / n.max(1) as f32
 }
+
+// Scenes and settings the GPU tests share.
+
+use foundation::Rgb;
+use foundation::bvh::SceneBvh;
+use foundation::camera::Camera;
+use foundation::mesh::{box_mesh, sphere_mesh};
+use foundation::scene::SceneMesh;
+use foundation::sh::ShCoeffs;
+use glam::Vec3;
+use precompute::bake::{BakeSettings, Transfer};
+
+pub fn bake_of(geometry: &SceneMesh, order: usize, samples: u32, bounces: u32) -> Transfer {
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let settings = BakeSettings {
+        order,
+        samples,
+        bounces,
+        seed: 0,
+    };
+    bake_quietly(geometry, &bvh, &settings)
+}
+
+pub fn sphere_on_plane() -> SceneMesh {
+    let mut geometry = SceneMesh::default();
+    geometry.push_object(
+        "sphere".into(),
+        &sphere_mesh(Vec3::new(0.0, 1.0, 0.0), 1.0, 4),
+        Rgb::splat(0.7),
+    );
+    let plane = box_mesh(
+        Vec3::new(-4.0, -0.2, -4.0),
+        Vec3::new(4.0, 0.0, 4.0),
+        [32, 1, 32],
+        [false; 6],
+    );
+    geometry.push_object("plane".into(), &plane, Rgb::new(0.6, 0.5, 0.4));
+    geometry
+}
+
+pub fn camera(position: Vec3, target: Vec3, width: u32, height: u32) -> Camera {
+    Camera {
+        position,
+        target,
+        up: Vec3::Y,
+        fov_y_deg: 40.0,
+        width,
+        height,
+    }
+}
+
+pub fn uniform_sh(order: usize, value: f32) -> ShCoeffs<Rgb> {
+    let mut sh = ShCoeffs::zeros(order);
+    sh.as_mut_slice()[0] = Rgb::splat(value * (4.0 * std::f32::consts::PI).sqrt());
+    sh
+}
+
+/// A floor (y ≤ 0, albedo 0.5, `half_size` from the origin) plus `occluders`.
+pub fn floor_with(half_size: f32, occluders: &[(Vec3, Vec3)]) -> SceneMesh {
+    let mut geometry = SceneMesh::default();
+    let floor = box_mesh(
+        Vec3::new(-half_size, -0.1, -half_size),
+        Vec3::new(half_size, 0.0, half_size),
+        [16, 1, 16],
+        [false; 6],
+    );
+    geometry.push_object("floor".into(), &floor, Rgb::splat(0.5));
+    for (k, (lo, hi)) in occluders.iter().enumerate() {
+        let mesh = box_mesh(*lo, *hi, [4, 1, 1], [false; 6]);
+        geometry.push_object(format!("occluder {k}"), &mesh, Rgb::splat(0.5));
+    }
+    geometry
+}
+
+/// A square of side 2 centred on `centre`, facing `normal`.
+pub fn plane_facing(centre: Vec3, normal: Vec3) -> foundation::mesh::TriangleMesh {
+    let (u, v) = normal.any_orthonormal_pair();
+    foundation::mesh::TriangleMesh {
+        positions: [-u - v, u - v, u + v, -u + v].map(|c| centre + c).to_vec(),
+        normals: vec![normal; 4],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        uvs: Vec::new(),
+    }
+}
