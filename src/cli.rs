@@ -1,7 +1,7 @@
 //! Argument groups that several commands share (clap), and how they turn into library
 //! settings. Each command's own arguments live with the command.
 
-use crate::environment::{self, ChosenEnvironment};
+use crate::maps::{self, ChosenEnvironment};
 use crate::report::{NoiseTarget, ReportSettings};
 use clap::{Args, ValueEnum};
 use foundation::envmap::Layout;
@@ -27,7 +27,7 @@ pub struct EnvironmentArgs {
 
 impl EnvironmentArgs {
     pub fn choose(&self, scene: &Scene) -> anyhow::Result<ChosenEnvironment> {
-        environment::choose(scene, self.env.as_deref(), self.layout, self.rotate)
+        maps::choose(scene, self.env.as_deref(), self.layout, self.rotate)
     }
 }
 

@@ -4,9 +4,9 @@
 mod bake_cache;
 mod cli;
 mod commands;
-mod environment;
+mod maps;
 mod report;
-mod sequence;
+mod env_sequence;
 mod support;
 mod view;
 

@@ -14,7 +14,7 @@ use foundation::sh::ShCoeffs;
 use foundation::{Rgb, luminance};
 use glam::{Quat, Vec3};
 use reference::{self, EnvironmentLight, ReferenceSettings};
-use runtime::reflection::{ReflectedEnvironment, SharedCube, convolve_exact};
+use runtime::{ReflectedEnvironment, SharedCube, convolve_exact};
 use runtime::render::{FrameLighting, RenderMode};
 use runtime::{CubeGeometry, CubeMap, DecomposeSettings, EnvironmentLighting};
 use std::sync::Arc;

@@ -13,7 +13,7 @@ use foundation::sh::ShCoeffs;
 use foundation::{Rgb, luminance};
 use glam::Vec3;
 use reference::{self, EnvironmentLight, ReferenceSettings};
-use runtime::lighting::ShTransfer;
+use runtime::ShTransfer;
 use runtime::render::{FrameLighting, RenderMode, Renderer, ShadowSettings};
 use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer, DirectionalLight};
 

@@ -16,7 +16,7 @@ use foundation::sh::ShCoeffs;
 use foundation::{Rgb, luminance};
 use glam::Vec3;
 use runtime::DirectionalLight;
-use runtime::lighting::ShTransfer;
+use runtime::ShTransfer;
 use runtime::render::FrameLighting;
 
 /// The "SH + sun" peer's SH part is applied per pixel by the normal, unshadowed. The sky is a

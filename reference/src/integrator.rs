@@ -4,7 +4,7 @@
 //! diffuse part or the Phong lobe, chosen by their reflectances' luminance (one-sample MIS
 //! over the two: the pdf is their mixture).
 
-use super::environment::{EnvironmentLight, PendingTexel};
+use super::light::{EnvironmentLight, PendingTexel};
 use super::sampler::PathSampler;
 use foundation::bvh::RAY_OFFSET_FRACTION;
 use foundation::bvh::{Hit, SceneBvh, Skip};

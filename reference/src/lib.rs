@@ -7,12 +7,12 @@
 //! Each pixel has its own random stream, seeded by the seed and the pixel index, so the image
 //! does not depend on the number of threads.
 
-mod environment;
+mod light;
 pub mod export;
 mod integrator;
 mod sampler;
 
-pub use environment::EnvironmentLight;
+pub use light::EnvironmentLight;
 pub use integrator::{DirectVisibility, Integrator, PathEstimate, SurfacePoint};
 pub use sampler::{MAX_SOBOL_SAMPLES, PathSampler, PixelSampler, SamplerKind, SobolSampler};
 

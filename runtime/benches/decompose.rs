@@ -4,7 +4,7 @@
 //! lights under 1 ms on a 256 × 128 map.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use runtime::peers::median_cut::{analysis_map, median_cut};
+use runtime::{analysis_map, median_cut};
 use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer, EnvironmentLighting};
 use std::path::Path;
 

@@ -3,7 +3,7 @@
 
 use foundation::Rgb;
 use foundation::envmap::EnvMap;
-use foundation::envmap::cube::{ALL_FACES, CubeFace, texel_solid_angle};
+use foundation::envmap::faces::{ALL_FACES, CubeFace, texel_solid_angle};
 use glam::Vec3;
 
 /// Direction and solid angle of every texel of a `6 × size × size` cube map; texel index
@@ -73,7 +73,7 @@ impl CubeGeometry {
         }
         let n = self.size as f32;
         for face in ALL_FACES {
-            let [forward, right, down] = foundation::envmap::cube::FACE_FRAMES[face as usize];
+            let [forward, right, down] = foundation::envmap::faces::FACE_FRAMES[face as usize];
             // Skip faces the cone cannot touch: every face point is within 54.74° of its
             // centre direction.
             if axis.dot(forward) < (angle + 0.9553).min(std::f32::consts::PI).cos() {

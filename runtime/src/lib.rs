@@ -2,20 +2,25 @@
 //! lights ([`decompose`]); [`lighting`] is the one path from a map to a frame's lighting, which
 //! the [`render`]er draws through the baked transfer and shadow maps.
 
-pub mod cubemap;
-pub mod decompose;
-pub mod light;
-pub mod lighting;
-pub mod peers;
-pub mod reflection;
+mod cubemap;
+mod decompose;
+mod light;
+mod lighting;
+mod peers;
+mod reflection;
 pub mod render;
-pub mod sequence;
-pub mod tracking;
+mod tracking;
 
 pub use cubemap::{CubeGeometry, CubeMap, CubeResampler, CubeSource};
 pub use decompose::{
     DecomposeError, DecomposeMode, DecomposeSettings, Decomposer, Decomposition, Window,
+    decomposition_picture, describe,
 };
 pub use light::DirectionalLight;
-pub use lighting::{EnvironmentLighting, FrameLighting, LitFrame, RenderMode, ShTransfer};
+pub use lighting::{
+    EnvironmentLighting, FrameLighting, LitFrame, RenderMode, ShTransfer, lights_indirect_default,
+    map_rotation,
+};
+pub use peers::median_cut::{MedianCutError, analysis_map, median_cut};
+pub use reflection::{ReflectedEnvironment, SharedCube, convolve_exact};
 pub use tracking::{LightTracker, TrackedLight, TrackingSettings};

@@ -1,14 +1,14 @@
 //! `hprt decompose`: an environment map into an SH polynomial plus directional lights.
 
 use crate::cli::DecomposeOptions;
-use crate::environment::load_map;
+use crate::maps::load_map;
 use crate::support::median;
 use anyhow::Context;
 use clap::Args;
 use foundation::envmap::Layout;
 use foundation::image_io::write_png_rgb8;
 use foundation::{Rgb, luminance};
-use runtime::decompose::visualize::{decomposition_picture, describe};
+use runtime::{decomposition_picture, describe};
 use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
 use std::path::PathBuf;
 use std::time::Instant;

@@ -4,7 +4,7 @@
 
 use crate::cli::{ImageSizeArgs, ReportOptions};
 use crate::commands::report::write_report;
-use crate::environment::maps_beside;
+use crate::maps::maps_beside;
 use crate::support::load_scene;
 use clap::Args;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! `hprt reference`: the CPU path-traced ground truth.
 
 use crate::cli::{EnvironmentArgs, ImageSizeArgs};
-use crate::environment::default_exposure;
+use crate::maps::default_exposure;
 use crate::support::{TerminalProgress, load_scene, with_threads};
 use anyhow::Context;
 use clap::Args;

@@ -12,7 +12,7 @@ mod settings;
 pub mod stats;
 mod truth;
 
-use crate::environment::{default_exposure, load_map, scene_rotation};
+use crate::maps::{default_exposure, load_map, scene_rotation};
 use crate::support::median;
 use figures::Curve;
 use foundation::camera::Camera;

@@ -4,7 +4,7 @@
 use super::App;
 use super::state::BakeJob;
 use crate::bake_cache;
-use crate::environment::default_exposure;
+use crate::maps::default_exposure;
 use foundation::infra::progress::SharedProgress;
 use runtime::EnvironmentLighting;
 use runtime::render::Renderer;
@@ -15,7 +15,7 @@ impl App {
         // The map, and how many of its texels were invalid and set to 0.
         let loaded = match &self.lighting.sequence {
             Some((sequence, _)) => sequence.frame(0).map(|map| (map, 0)),
-            None => crate::environment::load_map(&self.settings.env, None)
+            None => crate::maps::load_map(&self.settings.env, None)
                 .map(|loaded| (loaded.map, loaded.sanitized)),
         };
         let (map, sanitized) = match loaded {

@@ -16,14 +16,14 @@ mod ui;
 mod window;
 
 use crate::bake_cache;
-use crate::environment::{maps_beside, scene_rotation};
-use crate::sequence::Sequence;
+use crate::maps::{maps_beside, scene_rotation};
+use crate::env_sequence::Sequence;
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
 use foundation::scene::Scene;
 use orbit::Orbit;
-use runtime::lighting::lights_indirect_default;
+use runtime::lights_indirect_default;
 use runtime::render::{Backend, RenderMode, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings};
 use settings::ViewSettings;

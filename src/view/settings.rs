@@ -3,7 +3,7 @@
 use foundation::Rgb;
 use foundation::camera::Camera;
 use foundation::material::{MAX_SHININESS, Material};
-use runtime::lighting::lights_indirect_default;
+use runtime::lights_indirect_default;
 use runtime::render::{RenderMode, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings};
 use std::path::{Path, PathBuf};

@@ -4,7 +4,7 @@ use super::orbit::Orbit;
 use super::script;
 use super::settings::ViewSettings;
 use super::window::WindowGpu;
-use crate::sequence::Sequence;
+use crate::env_sequence::Sequence;
 use crate::support::median;
 use foundation::infra::progress::SharedProgress;
 use precompute::bake::Transfer;

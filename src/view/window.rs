@@ -1,13 +1,7 @@
 //! The window's GPU side: the surface, the tone-mapping pass that shows the renderer's HDR
 //! image, egui's pass on top, and window screenshots.
 
-use runtime::render::bindings::DISPLAY;
-use runtime::render::pass_helpers::{
-    FullscreenPass, begin_pass, color_attachment, texture, writable_buffer,
-};
-use runtime::render::readback::read_texture;
-use runtime::render::shaders::Shader;
-use runtime::render::uniforms::DisplayUniform;
+use runtime::render::{DisplayPass, capture_target, read_texture};
 use runtime::render::{Backend, GpuContext, Renderer};
 use std::sync::Arc;
 use winit::window::Window;
@@ -17,10 +11,7 @@ pub struct WindowGpu {
     pub surface: wgpu::Surface<'static>,
     pub config: wgpu::SurfaceConfiguration,
     pub egui: egui_wgpu::Renderer,
-    display_pipeline: wgpu::RenderPipeline,
-    display_layout: wgpu::BindGroupLayout,
-    display_uniform: wgpu::Buffer,
-    display_bind_group: Option<wgpu::BindGroup>,
+    display: DisplayPass,
 }
 
 impl WindowGpu {
@@ -58,37 +49,14 @@ impl WindowGpu {
         }
         surface.configure(&gpu.device, &config);
         let device = &gpu.device;
-        let module = Shader::Display.module(device);
-        let display_layout = DISPLAY.layout(device);
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("display"),
-            bind_group_layouts: &[Some(&display_layout)],
-            immediate_size: 0,
-        });
-        let display_pipeline = FullscreenPass {
-            label: "display",
-            module: &module,
-            layout: Some(&pipeline_layout),
-            target: format.into(),
-            constants: &[],
-        }
-        .pipeline(device);
-        let display_uniform = writable_buffer(
-            device,
-            "display",
-            size_of::<DisplayUniform>(),
-            wgpu::BufferUsages::UNIFORM,
-        );
+        let display = DisplayPass::new(device, format);
         let egui = egui_wgpu::Renderer::new(device, format, egui_wgpu::RendererOptions::default());
         Ok(Self {
             gpu,
             surface,
             config,
             egui,
-            display_pipeline,
-            display_layout,
-            display_uniform,
-            display_bind_group: None,
+            display,
         })
     }
 
@@ -96,12 +64,12 @@ impl WindowGpu {
         self.config.width = width.max(1);
         self.config.height = height.max(1);
         self.surface.configure(&self.gpu.device, &self.config);
-        self.display_bind_group = None;
+        self.display.renderer_changed();
     }
 
     /// Forget the bind group of the renderer's image (after it was re-created).
     pub fn renderer_changed(&mut self) {
-        self.display_bind_group = None;
+        self.display.renderer_changed();
     }
 
     /// Records the tone-mapped scene (if any) and egui's output into `target`.
@@ -115,49 +83,25 @@ impl WindowGpu {
         screen: &egui_wgpu::ScreenDescriptor,
     ) {
         let device = &self.gpu.device;
-        let uniform = DisplayUniform::new(exposure, !self.config.format.is_srgb());
-        self.gpu
-            .queue
-            .write_buffer(&self.display_uniform, 0, bytemuck::bytes_of(&uniform));
-        if let Some(renderer) = renderer
-            && self.display_bind_group.is_none()
-        {
-            self.display_bind_group = Some(DISPLAY.bind_group(
-                device,
-                &self.display_layout,
-                &[
-                    ("display", self.display_uniform.as_entire_binding()),
-                    (
-                        "image",
-                        wgpu::BindingResource::TextureView(renderer.color_view()),
-                    ),
-                ],
-            ));
-        }
         let extra = self
             .egui
             .update_buffers(device, &self.gpu.queue, encoder, paint, screen);
-        {
-            let background = wgpu::Color {
-                r: 0.05,
-                g: 0.05,
-                b: 0.06,
-                a: 1.0,
-            };
-            let mut pass = begin_pass(
-                encoder,
-                "display",
-                &[color_attachment(target, Some(background))],
-                None,
-            )
-            .forget_lifetime();
-            if let (Some(_), Some(group)) = (renderer, &self.display_bind_group) {
-                pass.set_pipeline(&self.display_pipeline);
-                pass.set_bind_group(DISPLAY.group, group, &[]);
-                pass.draw(0..3, 0..1);
-            }
-            self.egui.render(&mut pass, paint, screen);
-        }
+        let background = wgpu::Color {
+            r: 0.05,
+            g: 0.05,
+            b: 0.06,
+            a: 1.0,
+        };
+        let egui = &self.egui;
+        self.display.record(
+            device,
+            &self.gpu.queue,
+            encoder,
+            target,
+            background,
+            renderer.map(|r| (r, exposure)),
+            |pass| egui.render(pass, paint, screen),
+        );
         self.gpu.queue.submit(extra);
     }
 
@@ -171,13 +115,7 @@ impl WindowGpu {
     ) -> anyhow::Result<(u32, u32, Vec<u8>)> {
         let (width, height) = (self.config.width, self.config.height);
         let device = self.gpu.device.clone();
-        let texture = texture(
-            &device,
-            "window capture",
-            (width, height, 1),
-            self.config.format,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        );
+        let texture = capture_target(&device, width, height, self.config.format);
         let view = texture.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
         self.record(&mut encoder, &view, renderer, exposure, paint, screen);

@@ -2,7 +2,7 @@
 //! resampling to the one equirectangular form.
 
 use super::EnvMap;
-use super::cube::{ALL_FACES, CubeFace, horizontal_cross_cell, vertical_cross_cell};
+use super::faces::{ALL_FACES, CubeFace, horizontal_cross_cell, vertical_cross_cell};
 use super::error::EnvMapError;
 use super::files::RgbImage;
 use glam::Vec3;

@@ -1,7 +1,7 @@
 //! Reading HDR environment maps (OpenEXR, Radiance `.hdr`) in any of the supported layouts.
 
 use super::EnvMap;
-use super::cube::ALL_FACES;
+use super::faces::ALL_FACES;
 use super::error::EnvMapError;
 use super::files::{RgbImage, read_image};
 use super::layouts::{Layout, resample};
@@ -128,8 +128,8 @@ fn sanitize(image: &mut RgbImage) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::envmap::cube::FACE_FRAMES;
-    use crate::envmap::cube::{CubeFace, horizontal_cross_cell, vertical_cross_cell};
+    use crate::envmap::faces::FACE_FRAMES;
+    use crate::envmap::faces::{CubeFace, horizontal_cross_cell, vertical_cross_cell};
     use crate::envmap::layouts::{probe_coordinates, probe_direction};
     use glam::Vec3;
 

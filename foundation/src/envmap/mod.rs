@@ -2,8 +2,9 @@
 //! shared convention (CONVENTIONS.md, "Environment maps"). Every input layout (cube crosses,
 //! six faces, light probes) is resampled into this one form when loaded.
 
+pub mod animated;
 mod column;
-pub mod cube;
+pub mod faces;
 mod error;
 mod files;
 mod layouts;

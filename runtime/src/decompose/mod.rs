@@ -12,19 +12,20 @@
 //! the SH part is refitted to what remains.
 
 mod decomposition;
-pub mod icosphere;
-pub mod peaks;
-pub mod projection;
+mod icosphere;
+mod peaks;
+mod projection;
 mod settings;
-pub mod smoothing;
-pub mod source_size;
-pub mod visualize;
-pub mod weber;
-pub mod window;
+mod smoothing;
+pub(crate) mod source_size;
+mod visualize;
+pub(crate) mod weber;
+mod window;
 
 use crate::cubemap::{CubeGeometry, CubeMap};
 use crate::light::DirectionalLight;
 pub use decomposition::Decomposition;
+pub use visualize::{decomposition_picture, describe};
 use foundation::settings::InvalidSettings;
 use foundation::sh::ShCoeffs;
 use foundation::{Rgb, luminance};

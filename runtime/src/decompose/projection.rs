@@ -127,10 +127,6 @@ impl ShProjector {
         }
     }
 
-    pub fn order(&self) -> usize {
-        self.table.order
-    }
-
     /// Basis values at the texel centres.
     pub fn texel_basis(&self) -> &BasisTable {
         &self.table
@@ -154,19 +150,6 @@ impl ShProjector {
         for channel in [&mut r, &mut g, &mut b] {
             channel.truncate(n);
         }
-        Self::collect(r, g, b)
-    }
-
-    /// Projection of a map that is zero except at the listed texels.
-    pub fn project_sparse(&self, texels: impl Iterator<Item = (u32, Rgb)>) -> ShCoeffs<Rgb> {
-        let n = num_coeffs(self.table.order);
-        let mut sums = [vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]];
-        for (t, c) in texels {
-            let l = c * self.solid_angles[t as usize];
-            let y = self.table.row(t as usize);
-            accumulate(&mut sums, l, y);
-        }
-        let [r, g, b] = sums;
         Self::collect(r, g, b)
     }
 
@@ -215,11 +198,6 @@ mod tests {
             let w = w.normalize();
             let got = sh.eval(w);
             assert!((got - f(w)).abs().max_element() < 2e-3, "{got} vs {}", f(w));
-        }
-        let sparse =
-            projector.project_sparse(map.texels().iter().enumerate().map(|(t, c)| (t as u32, *c)));
-        for (a, b) in sparse.as_slice().iter().zip(sh.as_slice()) {
-            assert!((*a - *b).abs().max_element() < 1e-4);
         }
     }
 }

@@ -1,5 +1,6 @@
 //! The lighting service against decomposing by hand: rotation, modes, tracking.
 
+use super::rotation::rotate_decomposition;
 use super::*;
 use crate::cubemap::CubeSource;
 use crate::decompose::source_size::SourceMeter;
@@ -164,7 +165,7 @@ fn frames_follow_the_rotation_and_the_mode_rules() {
 /// lights never jump in count, and SH part plus lights integrate to the map in every frame.
 #[test]
 fn a_tracked_moving_sun_is_followed_exactly_and_energy_is_kept() {
-    use crate::sequence::{SunArc, direction_of};
+    use foundation::envmap::animated::{SunArc, direction_of};
     let sky = EnvMap::from_fn(512, 256, 1, |w| {
         Rgb::new(0.3, 0.4, 0.6) * (1.1 + w.y) + Rgb::splat(0.1 * w.z.max(0.0))
     });

@@ -2,5 +2,5 @@
 //! renderer (its shadow-map and light passes): [`median_cut`] lights alone, and
 //! [`sh_sun`], one shadowed light plus unshadowed low-order SH irradiance.
 
-pub mod median_cut;
-pub mod sh_sun;
+pub(crate) mod median_cut;
+pub(crate) mod sh_sun;

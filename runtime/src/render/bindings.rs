@@ -286,8 +286,8 @@ impl BindGroupDecl {
         let given: Vec<&str> = resources.iter().map(|(name, _)| *name).collect();
         assert_eq!(
             given, declared,
-            "{}: resources against the declaration",
-            self.label
+            "{} ({:?}, group {}): resources against the declaration",
+            self.label, self.shader, self.group
         );
         let entries: Vec<wgpu::BindGroupEntry> = resources
             .iter()

@@ -2,7 +2,7 @@
 //! radiance computed from them every time the lighting changes (`shaders/transfer.wgsl`).
 
 use super::bindings::ALBEDO_TEXTURE;
-use super::environment::{mip_chain_of, upload_mip_chain};
+use super::environment_texture::{mip_chain_of, upload_mip_chain};
 use super::error::{BakeMismatch, RenderError};
 use super::materials::GpuMaterials;
 use super::shaders::MAX_GPU_ORDER;

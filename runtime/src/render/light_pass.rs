@@ -4,7 +4,7 @@
 //! one pass gives the same image as one pass per light and reads the G-buffer once.
 
 use super::bindings::LIGHTS;
-use super::environment::EnvironmentTexture;
+use super::environment_texture::EnvironmentTexture;
 use super::pass_helpers::{FullscreenPass, begin_pass, color_attachment};
 use super::shaders::Shader;
 use super::shadow_maps::ShadowMaps;

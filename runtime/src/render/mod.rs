@@ -16,27 +16,30 @@
 //! opens the device, [`readback`] copies images back, [`pass_helpers`] builds the descriptors
 //! every pass repeats.
 
-pub mod bindings;
-pub mod environment;
+mod bindings;
+mod environment_texture;
+mod display_pass;
 mod error;
-pub mod gpu;
-pub mod gpu_scene;
-pub mod light_pass;
-pub mod materials;
-pub mod pass_helpers;
-pub mod prt_pass;
-pub mod readback;
-pub mod reflection_maps;
-pub mod shaders;
+mod gpu;
+mod gpu_scene;
+mod light_pass;
+mod materials;
+mod pass_helpers;
+mod prt_pass;
+mod readback;
+mod reflection_maps;
+mod shaders;
 mod shadow_fit;
-pub mod shadow_maps;
-pub mod targets;
+mod shadow_maps;
+mod targets;
 mod transfer_pass;
-pub mod uniforms;
+mod uniforms;
 
 use crate::lighting::ShTransfer;
-use environment::EnvironmentTexture;
+use environment_texture::EnvironmentTexture;
 use error::checked;
+pub use display_pass::{DisplayPass, capture_target};
+pub use readback::read_texture;
 pub use error::{BakeMismatch, ReadbackError, RenderError};
 use foundation::Rgb;
 use foundation::camera::Camera;

@@ -7,7 +7,7 @@
 //! its zonal factors and uploaded.
 
 use super::bindings::{PREFILTER, PREFILTER_JOB_SIZE};
-use super::environment::{mip_chain_of, rgba16f_texels};
+use super::environment_texture::{mip_chain_of, rgba16f_texels};
 use super::pass_helpers::{FullscreenPass, array_layer_count, begin_pass, color_attachment};
 use super::shaders::Shader;
 use crate::cubemap::{CubeGeometry, CubeMap};

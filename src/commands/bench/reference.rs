@@ -1,6 +1,6 @@
 //! `hprt bench reference`: the reference renderer's speed.
 
-use crate::environment::{self};
+use crate::maps::{self};
 use crate::support::{load_scene, median, with_threads};
 use clap::Args;
 use foundation::bvh::SceneBvh;
@@ -34,7 +34,7 @@ pub struct BenchReferenceArgs {
 pub(super) fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
     use reference::{self, EnvironmentLight, ReferenceSettings};
     let scene = load_scene(&args.scene)?;
-    let env = environment::choose(&scene, None, None, None)?;
+    let env = maps::choose(&scene, None, None, None)?;
     let camera = scene.camera.with_size(args.width, args.height);
     camera.validate()?;
     let settings = ReferenceSettings::new(args.spp, args.bounces, 0);

@@ -1,6 +1,6 @@
 //! `hprt bench reflections`: the GPU time of prefiltering glossy reflections.
 
-use crate::environment::load_map;
+use crate::maps::load_map;
 use crate::support::{load_scene, median};
 use clap::Args;
 use foundation::bvh::SceneBvh;
@@ -28,7 +28,7 @@ pub struct BenchReflectionsArgs {
 }
 
 pub(super) fn bench_reflections(args: BenchReflectionsArgs) -> anyhow::Result<()> {
-    use runtime::reflection::{ReflectedEnvironment, SharedCube};
+    use runtime::{ReflectedEnvironment, SharedCube};
     use runtime::render::{GpuContext, RenderMode, Renderer};
     use runtime::{DecomposeSettings, EnvironmentLighting};
     let scene = load_scene(&args.scene)?;

@@ -1,7 +1,7 @@
 //! `hprt bench render`: GPU frame times of prt and hybrid, and the CPU work per frame.
 
 use crate::cli::Switch;
-use crate::environment::load_map;
+use crate::maps::load_map;
 use crate::support::{load_scene, median};
 use clap::Args;
 use foundation::bvh::SceneBvh;

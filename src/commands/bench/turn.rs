@@ -1,6 +1,6 @@
 //! `hprt bench turn`: how steady the lights of a turning map are, and what each frame costs.
 
-use crate::environment::load_map;
+use crate::maps::load_map;
 use crate::support::median;
 use clap::Args;
 use std::path::PathBuf;

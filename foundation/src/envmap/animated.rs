@@ -3,8 +3,8 @@
 //! are the moving test cases of the temporal measurements; a sequence of map files needs
 //! nothing of this module.
 
-use foundation::Rgb;
-use foundation::envmap::EnvMap;
+use crate::color::Rgb;
+use super::EnvMap;
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -79,7 +79,7 @@ impl SunDisc {
                     for b in 0..GRID {
                         let u = (i as f32 + (a as f32 + 0.5) / GRID as f32) / w as f32;
                         let v = (j as f32 + (b as f32 + 0.5) / GRID as f32) / h as f32;
-                        let d = foundation::envmap::direction_of_uv(u, v);
+                        let d = crate::envmap::direction_of_uv(u, v);
                         inside += usize::from(d.dot(self.direction) >= self.angular_radius.cos());
                     }
                 }
@@ -140,7 +140,7 @@ impl SunArc {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use foundation::luminance;
+    use crate::luminance;
 
     #[test]
     fn a_sun_disc_over_a_map_adds_its_power() {

@@ -24,12 +24,12 @@ pub fn load_map(path: &Path, layout: Option<Layout>) -> anyhow::Result<LoadedEnv
 pub struct ChosenEnvironment {
     pub path: PathBuf,
     pub loaded: LoadedEnvMap,
-    /// Degrees about +Y ([`runtime::lighting::map_rotation`]).
+    /// Degrees about +Y ([`runtime::map_rotation`]).
     pub rotation_deg: f32,
 }
 
 /// `env` or the scene's map, `rotate` or the scene's rotation (the rule of
-/// [`runtime::lighting::map_rotation`], for any map).
+/// [`runtime::map_rotation`], for any map).
 pub fn choose(
     scene: &Scene,
     env: Option<&Path>,
@@ -54,7 +54,7 @@ pub fn choose(
 
 /// The rotation a map gets in `scene`: `rotate` if given, else the scene's.
 pub fn scene_rotation(scene: &Scene, rotate: Option<f32>) -> f32 {
-    runtime::lighting::map_rotation(scene.environment.as_ref().map(|e| e.rotation_deg), rotate)
+    runtime::map_rotation(scene.environment.as_ref().map(|e| e.rotation_deg), rotate)
 }
 
 /// The default tone-mapping exposure for a map: a white Lambertian surface seeing the whole

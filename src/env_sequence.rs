@@ -3,10 +3,10 @@
 //! file-name order), or a TOML file naming the frames, a folder, a cross-fade between two maps
 //! or a sun moving over a base map.
 
-use crate::environment::load_map;
+use crate::maps::load_map;
 use anyhow::Context;
 use foundation::envmap::EnvMap;
-use runtime::sequence::{SunArc, SunDisc, crossfade, direction_of};
+use foundation::envmap::animated::{SunArc, SunDisc, crossfade, direction_of};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
