@@ -4,7 +4,7 @@ use glam::{Vec2, Vec3};
 
 /// Van der Corput radical inverse in base 2.
 #[inline]
-pub fn radical_inverse_base2(i: u32) -> f32 {
+pub(crate) fn radical_inverse_base2(i: u32) -> f32 {
     // 0x1p-32: maps the bit-reversed integer into [0, 1).
     (i.reverse_bits() as f64 * (1.0 / 4_294_967_296.0)) as f32
 }
@@ -26,7 +26,7 @@ pub fn cranley_patterson(u: Vec2, offset: Vec2) -> Vec2 {
 /// Shirley–Chiu concentric map from the unit square to the unit disk (area preserving,
 /// low distortion, so stratification survives).
 #[inline]
-pub fn concentric_disk(u: Vec2) -> Vec2 {
+pub(crate) fn concentric_disk(u: Vec2) -> Vec2 {
     let o = 2.0 * u - Vec2::ONE;
     if o.x == 0.0 && o.y == 0.0 {
         return Vec2::ZERO;

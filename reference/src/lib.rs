@@ -101,7 +101,7 @@ impl RenderStats {
 }
 
 /// The random stream of pixel (or vertex) `index`.
-pub fn stream(seed: u64, index: u64) -> Pcg32 {
+pub(crate) fn stream(seed: u64, index: u64) -> Pcg32 {
     Pcg32::new(mix64(seed ^ mix64(index)), index)
 }
 

@@ -22,7 +22,7 @@ pub struct EnvironmentLight<'a> {
 
 /// A texel of the map chosen ahead of its use (see [`EnvironmentLight::sample_texel`]).
 #[derive(Debug, Clone, Copy)]
-pub struct PendingTexel {
+pub(crate) struct PendingTexel {
     index: usize,
     /// Sine of the polar angle of the direction it was chosen for.
     sin_theta: f32,
@@ -64,7 +64,7 @@ impl<'a> EnvironmentLight<'a> {
 
     /// [`Self::sample`] with the radiance arriving from the direction drawn (one lookup).
     #[inline]
-    pub fn sample_with_radiance(&self, u: Vec2) -> Option<(Vec3, f32, Rgb)> {
+    pub(crate) fn sample_with_radiance(&self, u: Vec2) -> Option<(Vec3, f32, Rgb)> {
         let (w, texel) = self.sample_texel(u)?;
         let (radiance, pdf) = self.texel_value(texel);
         (pdf > 0.0).then_some((w, pdf, radiance))
@@ -74,7 +74,7 @@ impl<'a> EnvironmentLight<'a> {
     /// now, read by [`Self::texel_value`] once the shadow ray has decided whether it counts,
     /// so that the read waits on memory while the ray is traced.
     #[inline]
-    pub fn sample_texel(&self, u: Vec2) -> Option<(Vec3, PendingTexel)> {
+    pub(crate) fn sample_texel(&self, u: Vec2) -> Option<(Vec3, PendingTexel)> {
         let (w, sin_theta, index) = self.sampler.as_ref()?.locate(u);
         Some((self.to_world.apply(w), self.pending(index, sin_theta)))
     }
@@ -82,7 +82,7 @@ impl<'a> EnvironmentLight<'a> {
     /// The texel a path escaping along world direction `w` sees, asked of the cache now (as
     /// [`Self::sample_texel`]): computed before the ray that finds out whether it escapes.
     #[inline]
-    pub fn escape_texel(&self, w: Vec3) -> PendingTexel {
+    pub(crate) fn escape_texel(&self, w: Vec3) -> PendingTexel {
         let local = self.to_map.apply(w);
         let (i, j) = self.map.texel_of(local);
         // From x and z, which keep their precision near the poles (unlike 1 − y²).
@@ -98,7 +98,7 @@ impl<'a> EnvironmentLight<'a> {
 
     /// The texel's radiance and the solid-angle density of sampling its direction.
     #[inline]
-    pub fn texel_value(&self, texel: PendingTexel) -> (Rgb, f32) {
+    pub(crate) fn texel_value(&self, texel: PendingTexel) -> (Rgb, f32) {
         let value = self.texels[texel.index];
         let pdf = if texel.sin_theta > 0.0 {
             value.w / texel.sin_theta
@@ -111,7 +111,8 @@ impl<'a> EnvironmentLight<'a> {
     /// The radiance arriving from world direction `w` and the density of sampling it (one
     /// lookup for both: what a path escaping along `w` needs).
     #[inline]
-    pub fn radiance_and_pdf(&self, w: Vec3) -> (Rgb, f32) {
+    #[cfg(test)]
+    pub(crate) fn radiance_and_pdf(&self, w: Vec3) -> (Rgb, f32) {
         self.texel_value(self.escape_texel(w))
     }
 

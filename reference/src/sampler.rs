@@ -94,7 +94,7 @@ impl PixelSampler {
     /// The PCG variant is one stream per pixel and range of samples: `first` (the first sample
     /// of a rendering pass) picks the stream, so a pass that continues another draws new
     /// numbers.
-    pub fn for_pass(kind: SamplerKind, seed: u64, pixel: u64, first: u32) -> Self {
+    pub(crate) fn for_pass(kind: SamplerKind, seed: u64, pixel: u64, first: u32) -> Self {
         match kind {
             SamplerKind::Sobol => Self::Sobol(SobolSampler::new(mix64(seed ^ mix64(pixel)), first)),
             SamplerKind::Independent => {
@@ -110,7 +110,7 @@ impl PixelSampler {
 
     /// Moves on to the next sample of the pixel.
     #[inline]
-    pub fn next_sample(&mut self) {
+    pub(crate) fn next_sample(&mut self) {
         if let Self::Sobol(s) = self {
             *s = SobolSampler::new(s.pixel_seed, s.index + 1);
         }

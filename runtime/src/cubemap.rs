@@ -38,7 +38,7 @@ impl CubeGeometry {
         self.size
     }
 
-    pub fn texel_count(&self) -> usize {
+    pub(crate) fn texel_count(&self) -> usize {
         self.directions.len()
     }
 
@@ -46,7 +46,7 @@ impl CubeGeometry {
         &self.directions
     }
 
-    pub fn solid_angles(&self) -> &[f32] {
+    pub(crate) fn solid_angles(&self) -> &[f32] {
         &self.solid_angles
     }
 
@@ -58,7 +58,7 @@ impl CubeGeometry {
 
     /// Texels whose centres lie within `angle` radians of the unit direction `axis`, found by
     /// scanning only each face's bounding box of the cone (culling everything else).
-    pub fn texels_within(&self, axis: Vec3, angle: f32, out: &mut Vec<u32>) {
+    pub(crate) fn texels_within(&self, axis: Vec3, angle: f32, out: &mut Vec<u32>) {
         out.clear();
         let cos_limit = angle.cos();
         let (s, c) = (angle.sin(), angle.cos());
@@ -185,7 +185,7 @@ impl CubeMap {
         &self.texels
     }
 
-    pub fn texels_mut(&mut self) -> &mut [Rgb] {
+    pub(crate) fn texels_mut(&mut self) -> &mut [Rgb] {
         &mut self.texels
     }
 
@@ -370,13 +370,13 @@ impl CubeResampler {
     }
 
     /// Whether this resampler was set up for `map`'s dimensions.
-    pub fn fits(&self, map: &EnvMap) -> bool {
+    pub(crate) fn fits(&self, map: &EnvMap) -> bool {
         (map.width(), map.height()) == (self.map_width, self.map_height)
     }
 
     /// Fills `out` with `map` turned about +Y by `rotation` radians
     /// (`L'(ω) = L(R_y(−rotation) ω)`, i.e. `u_source = u + rotation/2π`).
-    pub fn resample_into(&self, map: &EnvMap, rotation: f32, out: &mut CubeMap) {
+    pub(crate) fn resample_into(&self, map: &EnvMap, rotation: f32, out: &mut CubeMap) {
         assert!(self.fits(map), "resampler built for another map size");
         assert_eq!(out.size, self.size);
         let w = self.map_width;

@@ -45,7 +45,7 @@ pub enum ReflectedEnvironment {
 /// The map with the lights' share removed: inside the cap of each light (`cap_radius` around
 /// its direction) each channel is clipped to the SH part `sh`, elsewhere the map is kept.
 /// `map`, `sh` and the lights are in the same frame.
-pub fn remainder_cube(
+pub(crate) fn remainder_cube(
     map: &CubeMap,
     geometry: &CubeGeometry,
     sh: &ShCoeffs<Rgb>,
@@ -70,7 +70,7 @@ pub fn remainder_cube(
 
 /// `sh` convolved with the normalised lobe of `shininess`, evaluated at every texel of
 /// `geometry`: the prefiltered reflection map of an SH environment.
-pub fn sh_reflection_map(sh: &ShCoeffs<Rgb>, shininess: f32, geometry: &CubeGeometry) -> CubeMap {
+pub(crate) fn sh_reflection_map(sh: &ShCoeffs<Rgb>, shininess: f32, geometry: &CubeGeometry) -> CubeMap {
     let mut convolved = sh.clone();
     convolved.scale_bands(&phong_zonal(shininess, sh.order()));
     CubeMap::from_fn(geometry, |w| convolved.eval(w))

@@ -34,7 +34,7 @@ pub(super) struct ChildRef {
 
 impl ChildRef {
     #[inline(always)]
-    pub fn is_inner(&self) -> bool {
+    pub(super) fn is_inner(&self) -> bool {
         self.count == INNER
     }
 }
@@ -63,7 +63,7 @@ impl Bvh4 {
     /// Regroups `bvh2`'s binary nodes by fours: a node takes its two children and keeps
     /// opening its largest inner child (by surface area) until it has four. Returns the tree
     /// and, per triangle slot, the obvhs primitive it holds ([`NO_TRIANGLE`] for padding).
-    pub fn from_bvh2(bvh2: &Bvh2) -> (Self, Vec<u32>) {
+    pub(super) fn from_bvh2(bvh2: &Bvh2) -> (Self, Vec<u32>) {
         let mut builder = Builder {
             bvh2,
             nodes: Vec::new(),
@@ -162,16 +162,16 @@ impl Builder<'_> {
 
 impl Bvh4 {
     #[inline(always)]
-    pub fn prefetch(&self, node: u32) {
+    pub(super) fn prefetch(&self, node: u32) {
         crate::infra::prefetch::prefetch(self.nodes.as_ptr().wrapping_add(node as usize));
     }
 
-    pub fn root(&self) -> Option<ChildRef> {
+    pub(super) fn root(&self) -> Option<ChildRef> {
         self.root
     }
 
     #[inline(always)]
-    pub fn child(&self, node: u32, k: usize) -> ChildRef {
+    pub(super) fn child(&self, node: u32, k: usize) -> ChildRef {
         let n = &self.nodes[node as usize];
         ChildRef {
             index: n.child[k],
@@ -182,7 +182,7 @@ impl Bvh4 {
     /// Entry distance of the ray into each of `node`'s four children, and the mask of those
     /// it enters within `[tmin, tmax]`.
     #[inline(always)]
-    pub fn enter(&self, node: u32, ray: &WideRay, tmax: f32) -> (Vec4, u32) {
+    pub(super) fn enter(&self, node: u32, ray: &WideRay, tmax: f32) -> (Vec4, u32) {
         let n = &self.nodes[node as usize];
         let slab = |plane: usize, axis: usize| (n.planes[plane] - ray.origin[axis]) * ray.inv[axis];
         let t_near = slab(ray.near[0], 0)
@@ -214,7 +214,7 @@ pub(super) struct WideRay {
 }
 
 impl WideRay {
-    pub fn new(origin: Vec3A, direction: Vec3A, tmin: f32) -> Self {
+    pub(super) fn new(origin: Vec3A, direction: Vec3A, tmin: f32) -> Self {
         // A zero component would give 0 · ∞ = NaN; a tiny one keeps the arithmetic finite
         // and the answer the same.
         let inverse = |d: f32| {
@@ -323,7 +323,7 @@ pub(super) struct TrianglePacket {
 
 impl TrianglePacket {
     /// Packs `corners(slot)` for each slot; a padding slot gets a triangle no ray hits.
-    pub fn pack(slots: &[u32], corners: impl Fn(u32) -> [Vec3A; 3]) -> HugePageTable<Self> {
+    pub(super) fn pack(slots: &[u32], corners: impl Fn(u32) -> [Vec3A; 3]) -> HugePageTable<Self> {
         HugePageTable::new(slots.chunks(4).map(|chunk| {
             let mut packet = Self {
                 v0: [Vec4::ZERO; 3],
@@ -347,7 +347,7 @@ impl TrianglePacket {
 
     /// Distances to the four triangles, and the mask of those hit within `[tmin, tmax]`.
     #[inline(always)]
-    pub fn intersect(&self, ray: &WideRay, tmin: f32, tmax: f32) -> (Vec4, u32) {
+    pub(super) fn intersect(&self, ray: &WideRay, tmin: f32, tmax: f32) -> (Vec4, u32) {
         let (u, v, t) = moller_trumbore(ray.origin, ray.direction, self.v0, self.e1, self.e2);
         let hit = u.cmpge(Vec4::ZERO)
             & v.cmpge(Vec4::ZERO)
@@ -358,7 +358,7 @@ impl TrianglePacket {
     }
 
     /// One lane's triangle: first vertex and edges.
-    pub fn lane(&self, lane: usize) -> [[f32; 3]; 3] {
+    pub(super) fn lane(&self, lane: usize) -> [[f32; 3]; 3] {
         let get = |v: &[Vec4; 3]| [v[0][lane], v[1][lane], v[2][lane]];
         [get(&self.v0), get(&self.e1), get(&self.e2)]
     }

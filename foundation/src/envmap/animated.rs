@@ -41,7 +41,7 @@ pub struct SunDisc {
 
 impl SunDisc {
     /// A disc whose integral `∫ L dω` is `power`.
-    pub fn with_power(direction: Vec3, angular_radius: f32, power: Rgb) -> Self {
+    pub(crate) fn with_power(direction: Vec3, angular_radius: f32, power: Rgb) -> Self {
         Self {
             direction: direction.normalize(),
             angular_radius,

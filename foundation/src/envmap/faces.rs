@@ -100,7 +100,7 @@ impl CubeFace {
 
 /// Solid angle of the face region `[a0, a1] × [b0, b1]` (exact, via the area element
 /// `(1 + a² + b²)^(-3/2)`).
-pub fn face_solid_angle(a0: f32, a1: f32, b0: f32, b1: f32) -> f32 {
+pub(crate) fn face_solid_angle(a0: f32, a1: f32, b0: f32, b1: f32) -> f32 {
     let corner = |a: f32, b: f32| (a * b / (a * a + b * b + 1.0).sqrt()).atan();
     corner(a1, b1) - corner(a0, b1) - corner(a1, b0) + corner(a0, b0)
 }
@@ -112,7 +112,7 @@ pub fn texel_solid_angle(size: usize, x: usize, y: usize) -> f32 {
 }
 
 /// Cell `(column, row)` of each face in a horizontal (4×3) cross.
-pub fn horizontal_cross_cell(face: CubeFace) -> (usize, usize) {
+pub(crate) fn horizontal_cross_cell(face: CubeFace) -> (usize, usize) {
     match face {
         CubeFace::NegX => (0, 1),
         CubeFace::NegZ => (1, 1),
@@ -124,7 +124,7 @@ pub fn horizontal_cross_cell(face: CubeFace) -> (usize, usize) {
 }
 
 /// Cell of each face in a vertical (3×4) cross, and whether it is stored rotated by 180°.
-pub fn vertical_cross_cell(face: CubeFace) -> ((usize, usize), bool) {
+pub(crate) fn vertical_cross_cell(face: CubeFace) -> ((usize, usize), bool) {
     match face {
         CubeFace::NegX => ((0, 1), false),
         CubeFace::NegZ => ((1, 1), false),

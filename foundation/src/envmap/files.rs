@@ -159,7 +159,7 @@ fn read_hdr(path: &Path) -> Result<RgbImage, EnvMapError> {
 
 /// Most texels an input image may declare (8192 × 4096: 400 MB as float RGB): checked against
 /// the file's header before its pixels are allocated.
-pub const MAX_IMAGE_TEXELS: usize = 8192 * 4096;
+pub(super) const MAX_IMAGE_TEXELS: usize = 8192 * 4096;
 
 /// Refuses an image whose declared size is over [`MAX_IMAGE_TEXELS`].
 pub(crate) fn check_size(path: &Path, width: usize, height: usize) -> Result<(), EnvMapError> {

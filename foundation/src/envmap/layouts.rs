@@ -29,7 +29,7 @@ crate::named_enum! {
 
 impl Layout {
     /// The layout implied by an image's aspect ratio.
-    pub fn from_aspect(width: usize, height: usize) -> Option<Layout> {
+    pub(crate) fn from_aspect(width: usize, height: usize) -> Option<Layout> {
         match (width, height) {
             (w, h) if w == 2 * h => Some(Layout::Equirect),
             (w, h) if 3 * w == 4 * h => Some(Layout::CrossHorizontal),
@@ -134,7 +134,7 @@ pub(crate) fn resample(
 /// Debevec's angular map: the image centre looks toward -Z, the rim toward +Z, and the radius
 /// from the centre is proportional to the angle from -Z. Returns `(u, v)` in the unit disc,
 /// `v` up.
-pub fn probe_coordinates(w: Vec3) -> (f32, f32) {
+pub(crate) fn probe_coordinates(w: Vec3) -> (f32, f32) {
     let planar = (w.x * w.x + w.y * w.y).sqrt();
     if planar < 1e-9 {
         return if w.z < 0.0 { (0.0, 0.0) } else { (1.0, 0.0) };

@@ -13,7 +13,7 @@ mod mapping;
 pub mod sampling;
 
 pub use error::EnvMapError;
-pub use layouts::{Layout, probe_coordinates};
+pub use layouts::Layout;
 pub use load::{LoadedEnvMap, MIN_MAP_WIDTH, load};
 use mapping::v_of_direction;
 pub use mapping::{YRotation, direction_of_uv, rotate_y, uv_of_direction};

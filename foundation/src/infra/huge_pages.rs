@@ -75,7 +75,8 @@ impl<T: Copy> HugePageTable<T> {
     }
 
     /// Whether the table has a mapping of its own (which asked for huge pages).
-    pub fn is_mapped(&self) -> bool {
+    #[cfg(test)]
+    pub(crate) fn is_mapped(&self) -> bool {
         matches!(self.storage, Storage::Mapped { .. })
     }
 }

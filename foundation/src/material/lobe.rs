@@ -14,16 +14,10 @@ pub fn phong_lobe(cos_alpha: f32, shininess: f32) -> f32 {
     (shininess + 1.0) / (2.0 * PI) * cos_alpha.powf(shininess)
 }
 
-/// The pdf per solid angle of [`sample_phong_lobe`]'s directions: the lobe itself.
-#[inline]
-pub fn phong_lobe_pdf(cos_alpha: f32, shininess: f32) -> f32 {
-    phong_lobe(cos_alpha, shininess)
-}
-
 /// A direction distributed as [`phong_lobe`] around +Z (its pdf per solid angle is the lobe
 /// itself): `cos α = u₀^(1/(s+1))`, `φ = 2π u₁`.
 #[inline]
-pub fn sample_phong_lobe(u: Vec2, shininess: f32) -> Vec3 {
+pub(crate) fn sample_phong_lobe(u: Vec2, shininess: f32) -> Vec3 {
     let cos = u.x.powf(1.0 / (shininess + 1.0));
     let sin = (1.0 - cos * cos).max(0.0).sqrt();
     let phi = 2.0 * PI * u.y;
@@ -40,7 +34,7 @@ pub fn mirror(wo: Vec3, n: Vec3) -> Vec3 {
 /// through the tangent plane, so both sides of a triangle show its front (CONVENTIONS.md,
 /// "Surfaces").
 #[inline]
-pub fn front_view(wo: Vec3, n: Vec3) -> Vec3 {
+pub(crate) fn front_view(wo: Vec3, n: Vec3) -> Vec3 {
     let c = n.dot(wo);
     if c < 0.0 { wo - 2.0 * c * n } else { wo }
 }
@@ -83,21 +77,7 @@ pub fn phong_zonal(shininess: f32, order: usize) -> Vec<f32> {
     out
 }
 
-/// The shininess of the lobe seen from a source of angular variance `source_variance` (per
-/// axis, radians²; a uniform disc of radius ρ has ρ²/4): in the small-angle limit the lobe is
-/// a Gaussian of variance `1/s` per axis, and convolving it with the source adds the
-/// variances. The widened lobe stays normalised, so a light's specular energy is kept.
-#[inline]
-pub fn widened_shininess(shininess: f32, source_variance: f32) -> f32 {
-    1.0 / (1.0 / shininess.max(1e-6) + source_variance.max(0.0))
-}
 
-/// The angular variance per axis of a source made of a uniform core disc of radius `core`
-/// holding `core_fraction` of the power and a uniform halo disc of radius `halo`.
-#[inline]
-pub fn source_variance(core: f32, halo: f32, core_fraction: f32) -> f32 {
-    (core_fraction * core * core + (1.0 - core_fraction) * halo * halo) / 4.0
-}
 
 #[cfg(test)]
 mod tests {
@@ -191,13 +171,5 @@ mod tests {
         assert_eq!(front_view(front, n), front);
         let r = mirror(front, n);
         assert!((r - Vec3::new(-0.6, 0.8, 0.0)).length() < 1e-6);
-    }
-
-    #[test]
-    fn widening_adds_variances() {
-        assert!((widened_shininess(100.0, 0.0) - 100.0).abs() < 1e-3);
-        // A disc of radius 0.2 (variance 0.01) on a lobe of variance 0.01: half the shininess.
-        let v = source_variance(0.2, 0.2, 1.0);
-        assert!((widened_shininess(100.0, v) - 50.0).abs() < 1e-3);
     }
 }

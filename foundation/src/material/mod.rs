@@ -15,10 +15,8 @@ mod bsdf;
 mod lobe;
 
 pub use bsdf::{BsdfEval, PhongBsdf};
-pub use lobe::{
-    front_view, mirror, phong_lobe, phong_lobe_pdf, phong_zonal, sample_phong_lobe,
-    source_variance, widened_shininess,
-};
+
+pub use lobe::{mirror, phong_lobe, phong_zonal};
 
 use crate::color::Rgb;
 
@@ -63,7 +61,7 @@ pub struct EnergyError {
 }
 
 /// `k_d + k_s ≤ 1` per channel (energy conservation).
-pub fn check_energy(albedo: Rgb, specular: Rgb) -> Result<(), EnergyError> {
+pub(crate) fn check_energy(albedo: Rgb, specular: Rgb) -> Result<(), EnergyError> {
     let sum = albedo + specular;
     if sum.max_element() > 1.0 + 1e-6 {
         return Err(EnergyError { sum });

@@ -33,7 +33,7 @@ fn bernstein3(t: f32) -> [f32; 4] {
 }
 
 /// Parses a `.bpt` file, reporting the line of any error.
-pub fn read_bpt(path: &Path, bytes: &[u8]) -> Result<Vec<BezierPatch>, MeshError> {
+pub(crate) fn read_bpt(path: &Path, bytes: &[u8]) -> Result<Vec<BezierPatch>, MeshError> {
     let syntax = |line: usize, message: String| MeshError::Syntax {
         path: path.to_owned(),
         line,
@@ -114,7 +114,7 @@ pub fn read_bpt(path: &Path, bytes: &[u8]) -> Result<Vec<BezierPatch>, MeshError
 /// so no zero-area triangle or NaN normal is ever produced. Seams are welded later.
 /// Winding: the face normal is `∂P/∂t × ∂P/∂s` (s along rows, t along columns), which makes
 /// every patch of Newell's teapot face outwards.
-pub fn tessellate_patches(patches: &[BezierPatch], segments: u32) -> RawMesh {
+pub(crate) fn tessellate_patches(patches: &[BezierPatch], segments: u32) -> RawMesh {
     let n = segments.max(1) as usize;
     let mut mesh = RawMesh::default();
     for patch in patches {

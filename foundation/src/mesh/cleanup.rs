@@ -118,7 +118,7 @@ impl MeshCleanup {
 
 /// Largest coordinate magnitude a mesh may have: products of two edge vectors (areas, normals)
 /// must stay finite in f32.
-pub const MAX_COORDINATE: f32 = 1e15;
+pub(super) const MAX_COORDINATE: f32 = 1e15;
 
 /// Finite coordinates, finite normals of the right count, indices in range.
 fn validate(raw: &RawMesh) -> Result<(), String> {
@@ -222,7 +222,7 @@ fn weld_positions(positions: &[Vec3], tolerance: f32) -> (Vec<u32>, Vec<u32>) {
 }
 
 /// Angle-weighted vertex normals (Thürmer & Wüthrich), robust to uneven tessellation.
-pub fn smooth_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+pub(super) fn smooth_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
     let mut sums = vec![Vec3::ZERO; positions.len()];
     for tri in triangles {
         let p = tri.map(|i| positions[i as usize]);

@@ -40,7 +40,7 @@ const COMPRESSION_EXTENSIONS: [&str; 3] = [
     "KHR_mesh_quantization",
 ];
 
-pub fn parse_gltf(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, MeshError> {
+pub(super) fn parse_gltf(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, MeshError> {
     let invalid = |message: String| MeshError::Invalid {
         path: path.to_owned(),
         message,

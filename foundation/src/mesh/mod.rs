@@ -11,11 +11,12 @@ mod ply;
 mod shapes;
 mod triangle_mesh;
 
-pub use bpt::{BezierPatch, read_bpt, tessellate_patches};
+pub use bpt::BezierPatch;
 pub use cleanup::{CleanupReport, MeshCleanup};
 pub use error::MeshError;
 pub use gltf::{ModelPart, PartMaterial};
-pub use shapes::{annulus_mesh, box_mesh, icosahedron, sphere_mesh, subdivide};
+pub(crate) use shapes::annulus_mesh;
+pub use shapes::{box_mesh, icosahedron, sphere_mesh, subdivide};
 pub use triangle_mesh::{RawMesh, TriangleMesh};
 
 use std::path::Path;
@@ -88,7 +89,7 @@ pub fn is_mesh_file(path: &Path) -> bool {
 }
 
 /// Whether `path` names a glTF 2.0 model (`.gltf` or `.glb`).
-pub fn is_gltf(path: &Path) -> bool {
+pub(crate) fn is_gltf(path: &Path) -> bool {
     matches!(format_of(path), Some("gltf" | "glb"))
 }
 

@@ -36,7 +36,7 @@ fn syntax_error(path: &Path, bytes: &[u8], e: tobj::LoadError) -> MeshError {
 }
 
 /// The whole file as one mesh, materials ignored.
-pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
+pub(super) fn parse_obj(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let mut reader = std::io::BufReader::new(bytes);
     let (models, _) = tobj::load_obj_buf(&mut reader, &load_options(), |_| {
         Ok((Vec::new(), Default::default()))
@@ -82,7 +82,7 @@ fn model_mesh(m: &tobj::Mesh) -> RawMesh {
 /// (sRGB) as its texture, texture coordinates flipped to glTF's top-left origin. `None` when
 /// the file names no material library, or one that defines no material, or one that cannot be
 /// read (with a warning): the scene's albedo applies to the whole file.
-pub fn parse_obj_parts(path: &Path, bytes: &[u8]) -> Result<Option<Vec<ModelPart>>, MeshError> {
+pub(super) fn parse_obj_parts(path: &Path, bytes: &[u8]) -> Result<Option<Vec<ModelPart>>, MeshError> {
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut reader = std::io::BufReader::new(bytes);
     let (models, materials) = tobj::load_obj_buf(&mut reader, &load_options(), |p| {
@@ -147,7 +147,7 @@ pub fn parse_obj_parts(path: &Path, bytes: &[u8]) -> Result<Option<Vec<ModelPart
 }
 
 /// An 8- or 16-bit image file as an sRGB-encoded albedo texture, decoded to linear RGB.
-pub fn read_srgb_texture(path: &Path) -> Result<AlbedoTexture, MeshError> {
+pub(super) fn read_srgb_texture(path: &Path) -> Result<AlbedoTexture, MeshError> {
     let image = image::open(path).map_err(|e| MeshError::Invalid {
         path: path.to_owned(),
         message: format!("cannot read the texture: {e}"),

@@ -94,7 +94,7 @@ impl PropertyAccess for PlyFace {
     }
 }
 
-pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
+pub(super) fn parse_ply(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let (vertices, faces) = read_elements(path, bytes)?;
     let positions: Vec<Vec3> = vertices.iter().map(|v| Vec3::from(v.position)).collect();
     let normals = (!vertices.is_empty() && vertices.iter().all(|v| v.has_normal))

@@ -59,7 +59,7 @@ impl TriangleMesh {
 
     /// Appends `other`, offsetting its indices. Texture coordinates stay one per vertex where
     /// either mesh has them (zero for the other's vertices).
-    pub fn append(&mut self, other: &TriangleMesh) {
+    pub(crate) fn append(&mut self, other: &TriangleMesh) {
         let base = self.positions.len() as u32;
         if !self.uvs.is_empty() || !other.uvs.is_empty() {
             self.uvs.resize(self.positions.len(), Vec2::ZERO);

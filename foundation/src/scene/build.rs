@@ -164,7 +164,7 @@ impl From<SpecError> for ObjectError {
 
 /// What is wrong with an object's description in the scene file.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SpecError {
+pub(super) enum SpecError {
     #[error("shininess without specular = [r, g, b]")]
     ShininessWithoutSpecular,
     #[error("specular needs a shininess (the Phong exponent)")]
@@ -313,7 +313,7 @@ fn annulus_object(a: &AnnulusSpec) -> Result<TriangleMesh, ObjectError> {
 
 /// Applies an affine transform to positions and (inverse-transpose) normals. `None` if the
 /// transform is singular.
-pub fn transform_mesh(mesh: &TriangleMesh, m: &Mat4) -> Option<TriangleMesh> {
+pub(crate) fn transform_mesh(mesh: &TriangleMesh, m: &Mat4) -> Option<TriangleMesh> {
     let linear = Mat3::from_mat4(*m);
     let det = linear.determinant();
     if !det.is_finite() || det.abs() < 1e-12 {

@@ -155,7 +155,7 @@ impl SceneMesh {
 
     /// BLAKE3 hash of the objects' materials where any is glossy (part of
     /// [`Self::content_hash`]); `None` for a diffuse scene.
-    pub fn material_hash(&self) -> Option<[u8; 32]> {
+    pub(crate) fn material_hash(&self) -> Option<[u8; 32]> {
         if !self.is_glossy() {
             return None;
         }

@@ -6,7 +6,7 @@ mod description;
 mod geometry;
 pub mod model;
 
-pub use build::{MAX_MATERIAL_ALBEDO, transform_mesh};
+pub use build::MAX_MATERIAL_ALBEDO;
 pub use description::{
     AnnulusSpec, BoxSpec, EnvironmentSpec, ObjectSpec, Scale, SceneFile, Transform,
 };
@@ -53,6 +53,7 @@ pub struct Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use super::build::transform_mesh;
     use crate::color::Rgb;
     use crate::material::Material;
     use crate::mesh::box_mesh;

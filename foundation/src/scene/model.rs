@@ -142,7 +142,7 @@ impl Scene {
     }
 
     /// The scene for a bare model file, with the ground slab.
-    pub fn for_model(model: &Path) -> Result<Self, SceneError> {
+    pub(crate) fn for_model(model: &Path) -> Result<Self, SceneError> {
         let name = model
             .file_name()
             .map(PathBuf::from)

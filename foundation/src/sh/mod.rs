@@ -106,7 +106,7 @@ impl<F: Float> ShBasis<F> {
     /// Writes `Y_k(w)` for every `k` into `out[..n²]`; `w` must be a unit vector given as
     /// world `[x, y, z]`.
     #[inline]
-    pub fn eval_into(&self, w: [F; 3], out: &mut [F]) {
+    pub(crate) fn eval_into(&self, w: [F; 3], out: &mut [F]) {
         let n = self.order;
         let out = &mut out[..n * n];
         // Textbook frame: polar axis = world +Y, azimuth from +Z toward +X.
@@ -198,9 +198,6 @@ impl<C: Copy + Default> ShCoeffs<C> {
         &mut self.coeffs
     }
 
-    pub fn into_vec(self) -> Vec<C> {
-        self.coeffs
-    }
 
     /// The expansion cut (or zero-padded) to `order` bands.
     pub fn with_order(&self, order: usize) -> Self {
@@ -272,7 +269,8 @@ where
 
 impl ShCoeffs<f32> {
     /// Energy `Σ_m c_lm²` of each band: invariant under rotations of the function.
-    pub fn band_energies(&self) -> Vec<f32> {
+    #[cfg(test)]
+    pub(crate) fn band_energies(&self) -> Vec<f32> {
         (0..self.order)
             .map(|l| {
                 (-(l as isize)..=l as isize)
@@ -317,14 +315,14 @@ pub(crate) mod test_support {
     use glam::DVec3;
 
     /// The basis at `w` in double precision.
-    pub fn eval64(basis: &ShBasis<f64>, w: DVec3) -> Vec<f64> {
+    pub(crate) fn eval64(basis: &ShBasis<f64>, w: DVec3) -> Vec<f64> {
         let mut out = vec![0.0; basis.num_coeffs()];
         basis.eval_into(w.to_array(), &mut out);
         out
     }
 
     /// Projects `f` with a quadrature exact for products of `order`-band functions.
-    pub fn project64(order: usize, f: impl Fn(DVec3) -> f64) -> Vec<f64> {
+    pub(crate) fn project64(order: usize, f: impl Fn(DVec3) -> f64) -> Vec<f64> {
         let basis = ShBasis::<f64>::new(order).unwrap();
         let q = SphereQuadrature::gauss_product(order + 2);
         let mut c = vec![0.0f64; basis.num_coeffs()];
@@ -338,7 +336,7 @@ pub(crate) mod test_support {
     }
 
     /// Reproducible coefficients in `[-1, 1)`.
-    pub fn random_coeffs(order: usize, seed: u64) -> ShCoeffs<f32> {
+    pub(crate) fn random_coeffs(order: usize, seed: u64) -> ShCoeffs<f32> {
         let mut state = seed;
         let coeffs = (0..num_coeffs(order))
             .map(|_| {

@@ -3,7 +3,7 @@
 use glam::DVec3;
 
 /// Gauss–Legendre nodes and weights on `[-1, 1]` (Newton iteration on `P_n`).
-pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+pub(crate) fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     let mut nodes = Vec::with_capacity(n);
     for i in 0..n {
         let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
@@ -31,14 +31,14 @@ pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
 }
 
 /// A set of unit directions with weights summing to 4π.
-pub struct SphereQuadrature {
+pub(crate) struct SphereQuadrature {
     points: Vec<(DVec3, f64)>,
 }
 
 impl SphereQuadrature {
     /// Gauss–Legendre in `cos θ` (polar axis +Y) times `2n` equispaced azimuths: exact for
     /// spherical polynomials of degree below `2n`.
-    pub fn gauss_product(n: usize) -> Self {
+    pub(crate) fn gauss_product(n: usize) -> Self {
         let azimuths = 2 * n;
         let mut points = Vec::with_capacity(n * azimuths);
         for (z, wz) in gauss_legendre(n) {
@@ -52,12 +52,12 @@ impl SphereQuadrature {
         Self { points }
     }
 
-    pub fn points(&self) -> &[(DVec3, f64)] {
+    pub(crate) fn points(&self) -> &[(DVec3, f64)] {
         &self.points
     }
 
     /// `∫ f(w) dw` over the sphere.
-    pub fn integrate(&self, f: impl Fn(DVec3) -> f64) -> f64 {
+    pub(crate) fn integrate(&self, f: impl Fn(DVec3) -> f64) -> f64 {
         self.points.iter().map(|(w, weight)| f(*w) * weight).sum()
     }
 }

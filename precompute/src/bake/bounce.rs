@@ -17,7 +17,7 @@ pub struct InterreflectionOperator {
 
 /// Compressed rows of `rows` consecutive vertices.
 #[derive(Debug, Clone, Default)]
-pub struct OperatorBlock {
+pub(crate) struct OperatorBlock {
     /// `row_starts[r]..row_starts[r + 1]` indexes `columns`/`weights` of the block's row `r`.
     pub row_starts: Vec<u32>,
     pub columns: Vec<u32>,
@@ -25,19 +25,19 @@ pub struct OperatorBlock {
 }
 
 impl OperatorBlock {
-    pub fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Self {
             row_starts: vec![0],
             ..Default::default()
         }
     }
 
-    pub fn rows(&self) -> usize {
+    pub(crate) fn rows(&self) -> usize {
         self.row_starts.len() - 1
     }
 
     /// Appends a row given as `(column, weight)` pairs sorted by column; equal columns merge.
-    pub fn push_sorted_row(&mut self, entries: &[(u32, f32)]) {
+    pub(crate) fn push_sorted_row(&mut self, entries: &[(u32, f32)]) {
         let row_start = self.columns.len();
         for &(j, w) in entries {
             let last = self.columns.len().wrapping_sub(1);
@@ -52,7 +52,7 @@ impl OperatorBlock {
     }
 
     /// Releases the growth slack of the entry vectors.
-    pub fn shrink_to_fit(&mut self) {
+    pub(crate) fn shrink_to_fit(&mut self) {
         self.columns.shrink_to_fit();
         self.weights.shrink_to_fit();
     }
@@ -65,7 +65,7 @@ impl OperatorBlock {
 
 impl InterreflectionOperator {
     /// Blocks covering consecutive vertex ranges, in order.
-    pub fn from_blocks(blocks: Vec<OperatorBlock>) -> Self {
+    pub(crate) fn from_blocks(blocks: Vec<OperatorBlock>) -> Self {
         Self { blocks }
     }
 
@@ -75,7 +75,8 @@ impl InterreflectionOperator {
     }
 
     /// Sum of row `v`: the fraction of `v`'s (cosine-weighted) hemisphere that sees front faces.
-    pub fn row_sum(&self, mut v: usize) -> f32 {
+    #[cfg(test)]
+    pub(crate) fn row_sum(&self, mut v: usize) -> f32 {
         for block in &self.blocks {
             if v < block.rows() {
                 return block.row(v).1.iter().sum();

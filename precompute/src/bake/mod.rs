@@ -13,7 +13,8 @@ mod transfer;
 mod visibility;
 
 pub use bounce::InterreflectionOperator;
-pub use inside::{VertexNeighbours, fill_inside};
+pub(crate) use inside::fill_inside;
+pub use inside::VertexNeighbours;
 pub use transfer::TransferVectors;
 pub use visibility::INSIDE_BACKFACE_FRACTION;
 

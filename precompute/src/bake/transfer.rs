@@ -123,7 +123,7 @@ impl TransferVectors {
 
     /// Element-wise sum (direct + indirect = full transfer).
     /// Each vertex's vectors times its albedo, channel by channel.
-    pub fn scaled_per_vertex(&self, albedo: &[Rgb]) -> TransferVectors {
+    pub(crate) fn scaled_per_vertex(&self, albedo: &[Rgb]) -> TransferVectors {
         let mut out = self.clone();
         let per_channel = self.stride() / 3;
         for (vector, rho) in out.data.chunks_exact_mut(self.stride()).zip(albedo) {

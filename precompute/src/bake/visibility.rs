@@ -30,7 +30,7 @@ pub const INSIDE_BACKFACE_FRACTION: f32 = 0.5;
 
 impl TracedVertices {
     /// `T_direct,c(v) = ρ_c(v) · visibility(v)`.
-    pub fn direct_transfer(&self, albedo: &[Rgb], order: usize) -> TransferVectors {
+    pub(super) fn direct_transfer(&self, albedo: &[Rgb], order: usize) -> TransferVectors {
         debug_assert_eq!(order, self.order);
         let n = num_coeffs(order);
         let mut out = TransferVectors::zeros(order, albedo.len());

@@ -38,7 +38,7 @@ pub fn mitsuba_max_depth(bounces: u32) -> u32 {
 /// A binary little-endian PLY with positions, normals and, for a textured mesh, texture
 /// coordinates (`u`, `v`: hprt's and Mitsuba's bitmap convention agree, origin at the image's
 /// top left).
-pub fn ply_bytes(mesh: &TriangleMesh) -> Vec<u8> {
+pub(crate) fn ply_bytes(mesh: &TriangleMesh) -> Vec<u8> {
     let textured = !mesh.uvs.is_empty();
     let names: &[&str] = if textured {
         &["x", "y", "z", "nx", "ny", "nz", "u", "v"]
@@ -133,7 +133,7 @@ fn file_name_for(name: &str, index: usize) -> String {
 }
 
 /// The Mitsuba 3 scene description.
-pub fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
+pub(crate) fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> String {
     let c = &settings.camera;
     let v = |v: glam::Vec3| format!("{}, {}, {}", v.x, v.y, v.z);
     let mut xml = format!(

@@ -5,7 +5,7 @@ use glam::Vec3;
 
 /// Unit vertices of a subdivided icosahedron with their one-ring neighbours.
 #[derive(Debug, Clone)]
-pub struct Icosphere {
+pub(crate) struct Icosphere {
     pub vertices: Vec<Vec3>,
     pub neighbours: Vec<Vec<u32>>,
     /// Mean angle between neighbouring vertices, in radians.
@@ -14,7 +14,7 @@ pub struct Icosphere {
 
 impl Icosphere {
     /// `level` subdivisions of the regular icosahedron: `10·4^level + 2` vertices.
-    pub fn new(level: u32) -> Self {
+    pub(crate) fn new(level: u32) -> Self {
         let (mut vertices, mut triangles) = icosahedron();
         for _ in 0..level {
             (vertices, triangles) = subdivide(&vertices, &triangles);
@@ -47,7 +47,7 @@ impl Icosphere {
     }
 
     /// Vertices within two rings of `v` (excluding `v`).
-    pub fn two_ring(&self, v: u32, out: &mut Vec<u32>) {
+    pub(crate) fn two_ring(&self, v: u32, out: &mut Vec<u32>) {
         out.clear();
         for &n in &self.neighbours[v as usize] {
             if !out.contains(&n) {
@@ -63,7 +63,7 @@ impl Icosphere {
 
     /// Follows steepest ascent of `values` from every vertex; returns the local maxima
     /// reached (each once, in increasing vertex order).
-    pub fn hill_climb_maxima(&self, values: &[f32]) -> Vec<u32> {
+    pub(crate) fn hill_climb_maxima(&self, values: &[f32]) -> Vec<u32> {
         let n = self.vertices.len();
         // Uphill successor of each vertex (itself at a maximum), then follow the chains.
         let successor: Vec<u32> = (0..n as u32)

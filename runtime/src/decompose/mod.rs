@@ -32,9 +32,8 @@ use foundation::{Rgb, luminance};
 use glam::Vec3;
 use icosphere::Icosphere;
 use projection::{BasisColumns, ShProjector};
-pub use settings::{
-    ANALYSIS_FACE_SIZE, DecomposeError, DecomposeMode, DecomposeSettings, MAX_CANDIDATES,
-};
+pub(crate) use settings::{ANALYSIS_FACE_SIZE, MAX_CANDIDATES};
+pub use settings::{DecomposeError, DecomposeMode, DecomposeSettings};
 use smoothing::GaussianSmoothing;
 use std::f32::consts::PI;
 pub use window::Window;
@@ -138,7 +137,8 @@ impl Decomposer {
         &self.geometry
     }
 
-    pub fn icosphere(&self) -> &Icosphere {
+    #[cfg(test)]
+    pub(crate) fn icosphere(&self) -> &Icosphere {
         &self.ico
     }
 

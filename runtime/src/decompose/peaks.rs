@@ -7,7 +7,7 @@ use glam::Vec3;
 
 /// Weighted least-squares fit of `f(x, y) = c0 + c1 x + c2 y + c3 x² + c4 xy + c5 y²` to
 /// samples `(x, y, f, weight)`; `None` when the samples do not determine it.
-pub fn fit_quadric(samples: &[(f32, f32, f32, f32)]) -> Option<[f32; 6]> {
+pub(crate) fn fit_quadric(samples: &[(f32, f32, f32, f32)]) -> Option<[f32; 6]> {
     // Normal equations AᵀWA c = AᵀWf, solved in f64 by Gaussian elimination with pivoting.
     let mut m = [[0.0f64; 7]; 6];
     for &(x, y, f, weight) in samples {
@@ -45,7 +45,7 @@ pub fn fit_quadric(samples: &[(f32, f32, f32, f32)]) -> Option<[f32; 6]> {
 }
 
 /// The maximum of a fitted quadric, `(x, y, value)`, if its Hessian is negative definite.
-pub fn quadric_maximum(c: &[f32; 6]) -> Option<(f32, f32, f32)> {
+pub(crate) fn quadric_maximum(c: &[f32; 6]) -> Option<(f32, f32, f32)> {
     let (a, b, d) = (2.0 * c[3], c[4], 2.0 * c[5]);
     let det = a * d - b * b;
     if !(a < 0.0 && det > 0.0) {
@@ -64,7 +64,7 @@ pub fn quadric_maximum(c: &[f32; 6]) -> Option<(f32, f32, f32)> {
 /// Gaussian fit) keeps the tails, where the background dominates, from distorting it.
 /// Returns the refined direction and value; falls back to the vertex when the fit is not a
 /// maximum or lands outside the one-ring.
-pub fn refine_peak(
+pub(crate) fn refine_peak(
     ico: &Icosphere,
     values: &[f32],
     vertex: u32,

@@ -9,7 +9,7 @@ use glam::Vec3;
 /// SH basis values at a fixed set of directions: row `i` holds `Y_k(d_i)` for the `n²` k,
 /// padded with zeros to a multiple of [`LANES`] so that whole rows vectorize.
 #[derive(Debug, Clone)]
-pub struct BasisTable {
+pub(crate) struct BasisTable {
     order: usize,
     stride: usize,
     values: Vec<f32>,
@@ -19,7 +19,7 @@ pub struct BasisTable {
 const LANES: usize = 8;
 
 impl BasisTable {
-    pub fn new(order: usize, directions: &[Vec3]) -> Self {
+    pub(crate) fn new(order: usize, directions: &[Vec3]) -> Self {
         let basis = ShBasis::<f32>::new(order).expect("a supported SH order");
         let n = basis.num_coeffs();
         let stride = n.next_multiple_of(LANES);
@@ -35,7 +35,7 @@ impl BasisTable {
     }
 
     #[inline]
-    pub fn row(&self, i: usize) -> &[f32] {
+    pub(crate) fn row(&self, i: usize) -> &[f32] {
         &self.values[i * self.stride..][..num_coeffs(self.order)]
     }
 
@@ -49,14 +49,14 @@ impl BasisTable {
 /// Y_k(d_i)`): evaluating an expansion at every direction then runs over the directions in
 /// step, each direction's sum still taken coefficient after coefficient.
 #[derive(Debug, Clone)]
-pub struct BasisColumns {
+pub(crate) struct BasisColumns {
     order: usize,
     count: usize,
     values: Vec<f32>,
 }
 
 impl BasisColumns {
-    pub fn new(order: usize, directions: &[Vec3]) -> Self {
+    pub(crate) fn new(order: usize, directions: &[Vec3]) -> Self {
         let rows = BasisTable::new(order, directions);
         let n = num_coeffs(order);
         let count = directions.len();
@@ -75,7 +75,7 @@ impl BasisColumns {
 
     /// The value of `coeffs` at every direction (bands beyond the table's order ignored):
     /// the same floats as [`ShCoeffs::eval`] direction by direction.
-    pub fn eval_all(&self, coeffs: &ShCoeffs<Rgb>, out: &mut Vec<Rgb>) {
+    pub(crate) fn eval_all(&self, coeffs: &ShCoeffs<Rgb>, out: &mut Vec<Rgb>) {
         let n = num_coeffs(self.order.min(coeffs.order()));
         let [mut r, mut g, mut b] = [0, 1, 2].map(|_| vec![0.0f32; self.count]);
         for (c, column) in coeffs.as_slice()[..n]
@@ -114,13 +114,13 @@ pub(super) fn accumulate(sums: &mut [Vec<f32>; 3], l: Rgb, basis: &[f32]) {
 
 /// Projects cube maps onto SH of one order.
 #[derive(Debug, Clone)]
-pub struct ShProjector {
+pub(crate) struct ShProjector {
     table: BasisTable,
     solid_angles: Vec<f32>,
 }
 
 impl ShProjector {
-    pub fn new(geometry: &CubeGeometry, order: usize) -> Self {
+    pub(crate) fn new(geometry: &CubeGeometry, order: usize) -> Self {
         Self {
             table: BasisTable::new(order, geometry.directions()),
             solid_angles: geometry.solid_angles().to_vec(),
@@ -128,12 +128,12 @@ impl ShProjector {
     }
 
     /// Basis values at the texel centres.
-    pub fn texel_basis(&self) -> &BasisTable {
+    pub(crate) fn texel_basis(&self) -> &BasisTable {
         &self.table
     }
 
     /// `SH(L)_k = Σ_t L_t Y_k(ω_t) Δω_t`.
-    pub fn project(&self, map: &CubeMap) -> ShCoeffs<Rgb> {
+    pub(crate) fn project(&self, map: &CubeMap) -> ShCoeffs<Rgb> {
         let n = num_coeffs(self.table.order);
         let stride = self.table.stride;
         let mut sums = [

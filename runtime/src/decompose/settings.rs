@@ -60,10 +60,10 @@ impl Default for DecomposeSettings {
 /// smoothing kernel of a few degrees lose nothing at this resolution; larger input maps are
 /// box-filtered down to it (solid-angle weighted, so integrals are kept), while light caps are
 /// still measured on the full-resolution map.
-pub const ANALYSIS_FACE_SIZE: usize = 64;
+pub(crate) const ANALYSIS_FACE_SIZE: usize = 64;
 
 /// Most peaks considered per frame (the brightest residual maxima).
-pub const MAX_CANDIDATES: usize = 24;
+pub(crate) const MAX_CANDIDATES: usize = 24;
 
 impl DecomposeSettings {
     /// The defaults of `mode` at SH order `order`: every mode's rules start here.
@@ -138,7 +138,7 @@ impl DecomposeSettings {
     }
 
     /// The window actually applied to the SH part.
-    pub fn sh_window(&self) -> Window {
+    pub(crate) fn sh_window(&self) -> Window {
         self.window.unwrap_or(match self.mode {
             DecomposeMode::Thesis => Window::Hanning,
             DecomposeMode::Consistent => Window::None,

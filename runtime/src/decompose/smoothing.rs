@@ -8,7 +8,7 @@ use foundation::Rgb;
 use glam::Vec3;
 
 #[derive(Debug, Clone)]
-pub struct GaussianSmoothing {
+pub(crate) struct GaussianSmoothing {
     /// `row_starts[v]..row_starts[v + 1]` indexes `texels`/`weights` of vertex `v`.
     row_starts: Vec<u32>,
     texels: Vec<u32>,
@@ -18,7 +18,7 @@ pub struct GaussianSmoothing {
 impl GaussianSmoothing {
     /// Kernel `exp(-θ² / 2σ²)` around each of `points`, truncated at `3σ`, with weights that
     /// include each texel's solid angle and sum to 1.
-    pub fn new(geometry: &CubeGeometry, points: &[Vec3], sigma: f32) -> Self {
+    pub(crate) fn new(geometry: &CubeGeometry, points: &[Vec3], sigma: f32) -> Self {
         let mut row_starts = Vec::with_capacity(points.len() + 1);
         row_starts.push(0);
         let (mut texels, mut weights) = (Vec::new(), Vec::new());
@@ -55,7 +55,7 @@ impl GaussianSmoothing {
     }
 
     /// The smoothed map at each point.
-    pub fn apply(&self, map: &CubeMap, out: &mut Vec<Rgb>) {
+    pub(crate) fn apply(&self, map: &CubeMap, out: &mut Vec<Rgb>) {
         out.clear();
         let texels = map.texels();
         for v in 0..self.row_starts.len() - 1 {

@@ -39,7 +39,7 @@ fn display(c: Rgb, exposure: f32) -> [u8; 3] {
 }
 
 /// Tone-mapping exposure that puts the map's mean luminance at mid-grey.
-pub fn auto_exposure(map: &EnvMap) -> f32 {
+pub(crate) fn auto_exposure(map: &EnvMap) -> f32 {
     std::f32::consts::LN_2 / map.mean_luminance().max(1e-6)
 }
 

@@ -3,7 +3,7 @@
 /// Number of leading entries of `luminances` (sorted in decreasing order) to keep: entries are
 /// accepted while each one still adds more than `threshold` of the luminance accumulated so far
 /// (the thesis' FIND-ELBOW-POINT, with its read past the end fixed).
-pub fn weber_elbow(luminances: &[f32], threshold: f32) -> usize {
+pub(crate) fn weber_elbow(luminances: &[f32], threshold: f32) -> usize {
     let Some(&first) = luminances.first() else {
         return 0;
     };

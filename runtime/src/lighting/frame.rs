@@ -151,7 +151,7 @@ impl FrameLighting {
     /// The "SH + one sun" peer's lighting from a decomposition made with
     /// [`sh_sun::settings`]: the brightest light, shadowed, and the SH part cut to order 3,
     /// applied per pixel by the normal, unshadowed.
-    pub fn sh_sun(decomposition: &Decomposition) -> Self {
+    pub(crate) fn sh_sun(decomposition: &Decomposition) -> Self {
         let sh = decomposition.sh.with_order(sh_sun::SH_ORDER);
         Self {
             // Glossy surfaces reflect the same order-3 SH, convolved with their lobe.
@@ -166,7 +166,7 @@ impl FrameLighting {
 
     /// The lights as SH (delta functions of weight `power`): what the indirect transfer turns
     /// into their bounce light.
-    pub fn lights_sh(&self, order: usize) -> ShCoeffs<Rgb> {
+    pub(crate) fn lights_sh(&self, order: usize) -> ShCoeffs<Rgb> {
         let mut sh = ShCoeffs::zeros(order);
         if self.lights_indirect {
             for light in &self.lights {

@@ -9,7 +9,7 @@ use foundation::sh::rotation::ShRotation;
 use glam::{Mat3, Quat};
 
 /// `sh` of a function turned by `orientation`.
-pub fn rotate_sh(sh: &ShCoeffs<Rgb>, orientation: Quat) -> ShCoeffs<Rgb> {
+pub(crate) fn rotate_sh(sh: &ShCoeffs<Rgb>, orientation: Quat) -> ShCoeffs<Rgb> {
     if orientation == Quat::IDENTITY {
         return sh.clone();
     }
@@ -20,7 +20,7 @@ pub fn rotate_sh(sh: &ShCoeffs<Rgb>, orientation: Quat) -> ShCoeffs<Rgb> {
 
 /// A decomposition of a map turned by `orientation`: the same lights, turned, and the SH part
 /// rotated.
-pub fn rotate_decomposition(base: &Decomposition, orientation: Quat) -> Decomposition {
+pub(crate) fn rotate_decomposition(base: &Decomposition, orientation: Quat) -> Decomposition {
     Decomposition {
         sh: rotate_sh(&base.sh, orientation),
         lights: base

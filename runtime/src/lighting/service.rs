@@ -218,7 +218,7 @@ impl EnvironmentLighting {
     }
 
     /// Turns the map by any rotation (map frame → world).
-    pub fn set_orientation(&mut self, orientation: Quat) {
+    pub(crate) fn set_orientation(&mut self, orientation: Quat) {
         let orientation = if orientation.is_normalized() {
             orientation
         } else {
@@ -344,7 +344,7 @@ impl EnvironmentLighting {
     }
 
     /// The "SH + sun" peer's decomposition at the current orientation.
-    pub fn sh_sun(&mut self) -> Decomposition {
+    pub(crate) fn sh_sun(&mut self) -> Decomposition {
         if let Some(base) = &self.derived.sh_sun {
             return rotate_decomposition(base, self.orientation);
         }

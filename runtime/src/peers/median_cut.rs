@@ -23,7 +23,7 @@ pub enum MedianCutError {
 }
 
 /// Width the map is averaged down to before cutting (Debevec cuts maps of this order).
-pub const ANALYSIS_WIDTH: usize = 256;
+pub(crate) const ANALYSIS_WIDTH: usize = 256;
 
 /// A region of texels `[x0, x1) × [y0, y1)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -157,7 +157,7 @@ pub fn median_cut(map: &EnvMap, count: usize) -> Result<Vec<DirectionalLight>, M
 }
 
 /// The `2^levels` median-cut lights of `map` (see [`median_cut`]).
-pub fn median_cut_in_levels(map: &EnvMap, levels: u32) -> Vec<DirectionalLight> {
+pub(crate) fn median_cut_in_levels(map: &EnvMap, levels: u32) -> Vec<DirectionalLight> {
     let count = 1usize << levels.min(usize::BITS - 1);
     let table = EnergyTable::new(map);
     let mut regions = vec![Region {

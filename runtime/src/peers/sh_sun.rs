@@ -10,11 +10,11 @@
 use crate::decompose::{DecomposeMode, DecomposeSettings};
 
 /// Order of the SH irradiance (bands 0–2).
-pub const SH_ORDER: usize = 3;
+pub(crate) const SH_ORDER: usize = 3;
 
 /// The decomposition that finds the sun: consistent mode, one light, no Weber cut-off; the
 /// analysis (cube size, icosphere, smoothing) and order of `base`.
-pub fn settings(base: &DecomposeSettings) -> DecomposeSettings {
+pub(crate) fn settings(base: &DecomposeSettings) -> DecomposeSettings {
     DecomposeSettings {
         max_lights: 1,
         threshold: 0.0,

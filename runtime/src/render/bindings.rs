@@ -8,7 +8,7 @@ use wgpu::{SamplerBindingType, ShaderStages as Stages, TextureViewDimension as D
 
 /// What a binding holds, as the Rust side declares it.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Resource {
+pub(crate) enum Resource {
     Uniform,
     /// A uniform read at a dynamic offset, `size` bytes at a time.
     DynamicUniform {
@@ -31,7 +31,7 @@ pub enum Resource {
 /// One binding: the WGSL variable's name, the stages that read it and what it holds. Its
 /// number is its place in the group's list.
 #[derive(Debug, Clone, Copy)]
-pub struct Binding {
+pub(crate) struct Binding {
     pub name: &'static str,
     pub stages: Stages,
     pub resource: Resource,
@@ -39,7 +39,7 @@ pub struct Binding {
 
 /// One bind group of a shader.
 #[derive(Debug)]
-pub struct BindGroupDecl {
+pub(crate) struct BindGroupDecl {
     pub label: &'static str,
     pub shader: Shader,
     pub group: u32,
@@ -70,7 +70,7 @@ const FILTERABLE_ARRAY: Resource = Resource::Texture {
 const FILTERING: Resource = Resource::Sampler(SamplerBindingType::Filtering);
 
 /// `shaders/transfer.wgsl`: the per-vertex transfer pass.
-pub const TRANSFER: BindGroupDecl = BindGroupDecl {
+pub(crate) const TRANSFER: BindGroupDecl = BindGroupDecl {
     label: "transfer",
     shader: Shader::Transfer,
     group: 0,
@@ -100,7 +100,7 @@ pub const TRANSFER: BindGroupDecl = BindGroupDecl {
 };
 
 /// `shaders/geometry.wgsl`, group 0: the frame, the materials and the reflection maps.
-pub const PRT_FRAME: BindGroupDecl = BindGroupDecl {
+pub(crate) const PRT_FRAME: BindGroupDecl = BindGroupDecl {
     label: "prt pass frame",
     shader: Shader::Geometry,
     group: 0,
@@ -113,7 +113,7 @@ pub const PRT_FRAME: BindGroupDecl = BindGroupDecl {
 };
 
 /// `shaders/geometry.wgsl`, group 1: an object's albedo texture.
-pub const ALBEDO_TEXTURE: BindGroupDecl = BindGroupDecl {
+pub(crate) const ALBEDO_TEXTURE: BindGroupDecl = BindGroupDecl {
     label: "albedo texture",
     shader: Shader::Geometry,
     group: 1,
@@ -124,10 +124,10 @@ pub const ALBEDO_TEXTURE: BindGroupDecl = BindGroupDecl {
 };
 
 /// Bytes of one shadow view (`ShadowView` in `shaders/shadow.wgsl`: a light's view-projection).
-pub const SHADOW_VIEW_SIZE: u64 = 64;
+pub(crate) const SHADOW_VIEW_SIZE: u64 = 64;
 
 /// `shaders/shadow.wgsl`: one light's view, at a dynamic offset.
-pub const SHADOW_VIEW: BindGroupDecl = BindGroupDecl {
+pub(crate) const SHADOW_VIEW: BindGroupDecl = BindGroupDecl {
     label: "shadow view",
     shader: Shader::Shadow,
     group: 0,
@@ -141,7 +141,7 @@ pub const SHADOW_VIEW: BindGroupDecl = BindGroupDecl {
 };
 
 /// `shaders/lights.wgsl`: the G-buffer, the shadow maps and the environment.
-pub const LIGHTS: BindGroupDecl = BindGroupDecl {
+pub(crate) const LIGHTS: BindGroupDecl = BindGroupDecl {
     label: "light pass",
     shader: Shader::Lights,
     group: 0,
@@ -178,10 +178,10 @@ pub const LIGHTS: BindGroupDecl = BindGroupDecl {
 };
 
 /// Bytes of one prefilter job (`Job` in `shaders/prefilter.wgsl`).
-pub const PREFILTER_JOB_SIZE: u64 = 32;
+pub(crate) const PREFILTER_JOB_SIZE: u64 = 32;
 
 /// `shaders/prefilter.wgsl`: one face's job (at a dynamic offset) and the source cube.
-pub const PREFILTER: BindGroupDecl = BindGroupDecl {
+pub(crate) const PREFILTER: BindGroupDecl = BindGroupDecl {
     label: "prefilter",
     shader: Shader::Prefilter,
     group: 0,
@@ -199,7 +199,7 @@ pub const PREFILTER: BindGroupDecl = BindGroupDecl {
 };
 
 /// `shaders/display.wgsl`: tone mapping the renderer's image to a window.
-pub const DISPLAY: BindGroupDecl = BindGroupDecl {
+pub(crate) const DISPLAY: BindGroupDecl = BindGroupDecl {
     label: "display",
     shader: Shader::Display,
     group: 0,
@@ -211,7 +211,7 @@ pub const DISPLAY: BindGroupDecl = BindGroupDecl {
 
 /// Every declaration, for the test against the WGSL.
 #[cfg(test)]
-pub const ALL: [&BindGroupDecl; 7] = [
+pub(crate) const ALL: [&BindGroupDecl; 7] = [
     &TRANSFER,
     &PRT_FRAME,
     &ALBEDO_TEXTURE,
@@ -256,7 +256,7 @@ impl Resource {
 
 impl BindGroupDecl {
     /// The group's layout: binding `k` is the `k`-th declared.
-    pub fn layout(&self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    pub(crate) fn layout(&self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
         let entries: Vec<wgpu::BindGroupLayoutEntry> = self
             .bindings
             .iter()
@@ -276,7 +276,7 @@ impl BindGroupDecl {
 
     /// A bind group of `layout` (made by [`Self::layout`]) from resources given by their
     /// bindings' names, in the declared order.
-    pub fn bind_group(
+    pub(crate) fn bind_group(
         &self,
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,

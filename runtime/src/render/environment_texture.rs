@@ -10,7 +10,7 @@ const HALF_MAX: f32 = 65504.0;
 
 /// The map as a mipmapped Rgba16Float texture (filterable on every backend), its sampler
 /// (wrapping in azimuth) and its rotation about +Y.
-pub struct EnvironmentTexture {
+pub(crate) struct EnvironmentTexture {
     pub view: wgpu::TextureView,
     pub sampler: wgpu::Sampler,
     /// Radians.
@@ -19,7 +19,7 @@ pub struct EnvironmentTexture {
 
 /// The next mip level of a `width × height` equirectangular image: each texel the average of
 /// the 2 × 2 (or, along an odd side, 2 × 1 / 1 × 2 at the last texel) it covers.
-pub fn next_level(texels: &[Rgb], width: usize, height: usize) -> (Vec<Rgb>, usize, usize) {
+pub(crate) fn next_level(texels: &[Rgb], width: usize, height: usize) -> (Vec<Rgb>, usize, usize) {
     let (w, h) = ((width / 2).max(1), (height / 2).max(1));
     let mut out = Vec::with_capacity(w * h);
     for j in 0..h {
@@ -37,12 +37,12 @@ pub fn next_level(texels: &[Rgb], width: usize, height: usize) -> (Vec<Rgb>, usi
 }
 
 /// Every mip level of `map`, full resolution first.
-pub fn mip_chain(map: &EnvMap) -> Vec<(Vec<Rgb>, usize, usize)> {
+pub(crate) fn mip_chain(map: &EnvMap) -> Vec<(Vec<Rgb>, usize, usize)> {
     mip_chain_of(map.texels(), map.width(), map.height())
 }
 
 /// Every mip level of a `width × height` image, full resolution first.
-pub fn mip_chain_of(texels: &[Rgb], width: usize, height: usize) -> Vec<(Vec<Rgb>, usize, usize)> {
+pub(crate) fn mip_chain_of(texels: &[Rgb], width: usize, height: usize) -> Vec<(Vec<Rgb>, usize, usize)> {
     let mut levels = vec![(texels.to_vec(), width, height)];
     while let Some((texels, w, h)) = levels.last().filter(|l| l.1 > 1 || l.2 > 1) {
         let next = next_level(texels, *w, *h);
@@ -52,7 +52,7 @@ pub fn mip_chain_of(texels: &[Rgb], width: usize, height: usize) -> Vec<(Vec<Rgb
 }
 
 impl EnvironmentTexture {
-    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, map: &EnvMap, rotation: f32) -> Self {
+    pub(crate) fn new(device: &wgpu::Device, queue: &wgpu::Queue, map: &EnvMap, rotation: f32) -> Self {
         let texture = upload_mip_chain(device, queue, "environment", &mip_chain(map));
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("environment"),
@@ -72,7 +72,7 @@ impl EnvironmentTexture {
 }
 
 /// `texels` as Rgba16Float data (alpha 1), each channel clamped to `[0, HALF_MAX]`.
-pub fn rgba16f_texels(texels: &[Rgb]) -> Vec<half::f16> {
+pub(crate) fn rgba16f_texels(texels: &[Rgb]) -> Vec<half::f16> {
     texels
         .iter()
         .flat_map(|c| {
@@ -84,7 +84,7 @@ pub fn rgba16f_texels(texels: &[Rgb]) -> Vec<half::f16> {
 
 /// A mipmapped Rgba16Float texture (filterable on every backend) holding `levels`, full
 /// resolution first; values beyond the largest half float are clamped to it.
-pub fn upload_mip_chain(
+pub(crate) fn upload_mip_chain(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     label: &str,

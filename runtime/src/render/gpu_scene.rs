@@ -27,7 +27,7 @@ struct Vertex {
     uv: [f32; 2],
 }
 
-pub struct GpuScene {
+pub(crate) struct GpuScene {
     pub vertex_buffer: wgpu::Buffer,
     /// Per-vertex PRT radiance (vec4), written by the transfer pass, read as a vertex buffer.
     pub radiance_buffer: wgpu::Buffer,
@@ -50,7 +50,7 @@ pub struct GpuScene {
     pub materials: GpuMaterials,
 }
 
-pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+pub(crate) const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: std::mem::size_of::<Vertex>() as u64,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &wgpu::vertex_attr_array![
@@ -58,20 +58,20 @@ pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferL
     ],
 };
 
-pub const RADIANCE_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+pub(crate) const RADIANCE_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 16,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &wgpu::vertex_attr_array![3 => Float32x4],
 };
 
-pub const INDIRECT_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+pub(crate) const INDIRECT_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 16,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &wgpu::vertex_attr_array![7 => Float32x4],
 };
 
 impl GpuScene {
-    pub fn new(
+    pub(crate) fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         geometry: &SceneMesh,
@@ -155,7 +155,7 @@ impl GpuScene {
     }
 
     /// Uploads `lighting` and records the pass that recomputes every vertex's radiance.
-    pub fn update_radiance(
+    pub(crate) fn update_radiance(
         &self,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
@@ -172,14 +172,14 @@ impl GpuScene {
     }
 
     /// Draws every triangle from its vertices alone (shadow maps).
-    pub fn draw_depth_only(&self, pass: &mut wgpu::RenderPass) {
+    pub(crate) fn draw_depth_only(&self, pass: &mut wgpu::RenderPass) {
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         self.draw_triangles(pass);
     }
 
     /// Draws every triangle with its vertices' PRT radiance and its albedo texture (group 1)
     /// (the PRT pass).
-    pub fn draw_with_radiance(&self, pass: &mut wgpu::RenderPass) {
+    pub(crate) fn draw_with_radiance(&self, pass: &mut wgpu::RenderPass) {
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, self.radiance_buffer.slice(..));
         pass.set_vertex_buffer(2, self.materials.vertex_buffer.slice(..));

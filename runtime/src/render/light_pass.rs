@@ -12,7 +12,7 @@ use super::targets::{COLOR_FORMAT, Targets};
 use super::uniforms::FrameBuffers;
 
 /// What the light pass reads.
-pub struct LightPassInputs<'a> {
+pub(crate) struct LightPassInputs<'a> {
     pub buffers: &'a FrameBuffers,
     pub targets: &'a Targets,
     pub shadow_maps: &'a ShadowMaps,
@@ -21,7 +21,7 @@ pub struct LightPassInputs<'a> {
     pub materials: &'a wgpu::Buffer,
 }
 
-pub struct LightPass {
+pub(crate) struct LightPass {
     /// Indexed by `2 · shadowed + kernel from radius` (pipeline constants of the shader).
     pipelines: Vec<wgpu::RenderPipeline>,
     layout: wgpu::BindGroupLayout,
@@ -30,7 +30,7 @@ pub struct LightPass {
 }
 
 impl LightPass {
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub(crate) fn new(device: &wgpu::Device) -> Self {
         let layout = LIGHTS.layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("light pass"),
@@ -73,11 +73,11 @@ impl LightPass {
     }
 
     /// A texture the pass reads was re-created.
-    pub fn inputs_changed(&mut self) {
+    pub(crate) fn inputs_changed(&mut self) {
         self.bind_group = None;
     }
 
-    pub fn record(
+    pub(crate) fn record(
         &mut self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,

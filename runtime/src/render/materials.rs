@@ -27,7 +27,7 @@ struct MaterialVertex {
     visibility: [f32; 4],
 }
 
-pub const MATERIAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+pub(crate) const MATERIAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: std::mem::size_of::<MaterialVertex>() as u64,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &wgpu::vertex_attr_array![5 => Uint32, 6 => Float32x4],
@@ -35,7 +35,7 @@ pub const MATERIAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBuffe
 
 /// The distinct glossy materials of a set of objects, and each object's index (0: diffuse).
 #[derive(Debug, Clone, PartialEq)]
-pub struct MaterialTable {
+pub(crate) struct MaterialTable {
     /// Distinct glossy materials; table entry `i + 1`.
     pub glossy: Vec<Material>,
     /// Per object, its entry.
@@ -45,7 +45,7 @@ pub struct MaterialTable {
 }
 
 impl MaterialTable {
-    pub fn new(materials: &[Material]) -> Result<Self, InvalidSettings> {
+    pub(crate) fn new(materials: &[Material]) -> Result<Self, InvalidSettings> {
         let mut glossy: Vec<Material> = Vec::new();
         let mut shininess: Vec<f32> = Vec::new();
         let mut object_entries = Vec::with_capacity(materials.len());
@@ -101,7 +101,7 @@ impl MaterialTable {
 }
 
 /// The table and the per-vertex buffer on the GPU.
-pub struct GpuMaterials {
+pub(crate) struct GpuMaterials {
     pub uniform: wgpu::Buffer,
     pub vertex_buffer: wgpu::Buffer,
     pub table: MaterialTable,
@@ -113,7 +113,7 @@ pub struct GpuMaterials {
 impl GpuMaterials {
     /// `visibility`: per vertex, its bent normal (xyz) and unoccluded fraction (w) from the
     /// bake: the cone of directions it sees the sky in (`shaders/geometry.wgsl`).
-    pub fn new(
+    pub(crate) fn new(
         device: &wgpu::Device,
         geometry: &SceneMesh,
         visibility: Vec<[f32; 4]>,
@@ -145,7 +145,7 @@ impl GpuMaterials {
     }
 
     /// Uploads the table (call once after [`Self::new`] and after every change).
-    pub fn write(&self, queue: &wgpu::Queue) {
+    pub(crate) fn write(&self, queue: &wgpu::Queue) {
         queue.write_buffer(
             &self.uniform,
             0,
@@ -155,7 +155,7 @@ impl GpuMaterials {
 
     /// Gives the objects new materials (one per object); returns whether the shininess
     /// slots changed (the reflection maps must be prefiltered again).
-    pub fn set(
+    pub(crate) fn set(
         &mut self,
         queue: &wgpu::Queue,
         materials: &[Material],

@@ -55,9 +55,7 @@ use precompute::bake::Transfer;
 use prt_pass::{PrtPass, PrtPassInputs};
 use reflection_maps::ReflectionMaps;
 pub use shaders::{MAX_GPU_ORDER, MAX_LIGHTS};
-pub use shadow_fit::{
-    BoundingSphere, ShadowFit, ShadowSettings, shadow_matrix, shadow_texel_size, visible_region,
-};
+pub use shadow_fit::{BoundingSphere, ShadowFit, ShadowSettings};
 use shadow_maps::ShadowMaps;
 use targets::Targets;
 use uniforms::{FrameBuffers, FrameParameters, FrameUniform};
@@ -270,7 +268,7 @@ impl Renderer {
     }
 
     /// The linear HDR image of the last [`Self::render`] (Rgba16Float).
-    pub fn color_view(&self) -> &wgpu::TextureView {
+    pub(crate) fn color_view(&self) -> &wgpu::TextureView {
         &self.targets.color_view
     }
 

@@ -10,7 +10,7 @@ use super::shaders::Shader;
 /// texels (glossy reflections came out bluish and misplaced on llvmpipe). hprt binds every
 /// layered texture as a 2D array, so such a texture gets one spare layer that is never read or
 /// written; Vulkan and the other backends draw the same image with or without it.
-pub fn array_layer_count(width: u32, height: u32, layers: u32) -> u32 {
+pub(crate) fn array_layer_count(width: u32, height: u32, layers: u32) -> u32 {
     if layers > 1 && width == height && layers.is_multiple_of(6) {
         layers + 1
     } else {
@@ -20,7 +20,7 @@ pub fn array_layer_count(width: u32, height: u32, layers: u32) -> u32 {
 
 /// A 2D texture (or array of at least `size.2` layers, [`array_layer_count`]) with one mip
 /// level.
-pub fn texture(
+pub(crate) fn texture(
     device: &wgpu::Device,
     label: &str,
     size: (u32, u32, u32),
@@ -44,7 +44,7 @@ pub fn texture(
 }
 
 /// A colour attachment that is cleared to `clear` (or loaded when `None`) and stored.
-pub fn color_attachment(
+pub(crate) fn color_attachment(
     view: &wgpu::TextureView,
     clear: Option<wgpu::Color>,
 ) -> Option<wgpu::RenderPassColorAttachment<'_>> {
@@ -60,7 +60,7 @@ pub fn color_attachment(
 }
 
 /// A depth attachment cleared to the far plane (1) and stored.
-pub fn depth_attachment(
+pub(crate) fn depth_attachment(
     view: &wgpu::TextureView,
 ) -> Option<wgpu::RenderPassDepthStencilAttachment<'_>> {
     Some(wgpu::RenderPassDepthStencilAttachment {
@@ -74,7 +74,7 @@ pub fn depth_attachment(
 }
 
 /// Begins a render pass into `colors` (and `depth`).
-pub fn begin_pass<'e>(
+pub(crate) fn begin_pass<'e>(
     encoder: &'e mut wgpu::CommandEncoder,
     label: &str,
     colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
@@ -92,7 +92,7 @@ pub fn begin_pass<'e>(
 
 /// Primitives of the scene: triangles with both sides drawn (both sides of a triangle show
 /// its front, CONVENTIONS.md).
-pub fn two_sided_triangles() -> wgpu::PrimitiveState {
+pub(crate) fn two_sided_triangles() -> wgpu::PrimitiveState {
     wgpu::PrimitiveState {
         cull_mode: None,
         ..Default::default()
@@ -101,7 +101,7 @@ pub fn two_sided_triangles() -> wgpu::PrimitiveState {
 
 /// A depth test into a `format` target that keeps the nearest surface, with `bias` added to
 /// the depth written.
-pub fn nearest_depth(
+pub(crate) fn nearest_depth(
     format: wgpu::TextureFormat,
     bias: wgpu::DepthBiasState,
 ) -> Option<wgpu::DepthStencilState> {
@@ -115,7 +115,7 @@ pub fn nearest_depth(
 }
 
 /// A buffer the CPU writes each frame (`COPY_DST` added to `usage`).
-pub fn writable_buffer(
+pub(crate) fn writable_buffer(
     device: &wgpu::Device,
     label: &str,
     size: usize,
@@ -130,7 +130,7 @@ pub fn writable_buffer(
 }
 
 /// A pass drawn as one screen-covering triangle (`shaders/fullscreen.wgsl`) into one target.
-pub struct FullscreenPass<'a> {
+pub(crate) struct FullscreenPass<'a> {
     pub label: &'a str,
     pub module: &'a wgpu::ShaderModule,
     /// `None`: derived from the shader.
@@ -141,7 +141,7 @@ pub struct FullscreenPass<'a> {
 }
 
 impl FullscreenPass<'_> {
-    pub fn pipeline(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+    pub(crate) fn pipeline(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(self.label),
             layout: self.layout,

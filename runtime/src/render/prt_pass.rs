@@ -13,7 +13,7 @@ use super::targets::{
     ALBEDO_FORMAT, COLOR_FORMAT, DEPTH_COPY_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, Targets,
 };
 
-pub struct PrtPass {
+pub(crate) struct PrtPass {
     pipeline: wgpu::RenderPipeline,
     frame_layout: wgpu::BindGroupLayout,
     /// Made on first use after its inputs change (see [`Self::inputs_changed`]).
@@ -21,7 +21,7 @@ pub struct PrtPass {
 }
 
 /// What group 0 of the PRT pass binds.
-pub struct PrtPassInputs<'a> {
+pub(crate) struct PrtPassInputs<'a> {
     pub frame: &'a wgpu::Buffer,
     pub materials: &'a wgpu::Buffer,
     pub reflections: &'a ReflectionMaps,
@@ -29,7 +29,7 @@ pub struct PrtPassInputs<'a> {
 
 impl PrtPass {
     /// `texture_layout`: the scene's albedo textures (group 1, [`GpuScene::texture_layout`]).
-    pub fn new(device: &wgpu::Device, texture_layout: &wgpu::BindGroupLayout) -> Self {
+    pub(crate) fn new(device: &wgpu::Device, texture_layout: &wgpu::BindGroupLayout) -> Self {
         let module = Shader::Geometry.module(device);
         let frame_layout = PRT_FRAME.layout(device);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -76,11 +76,11 @@ impl PrtPass {
     }
 
     /// A resource group 0 binds was re-created.
-    pub fn inputs_changed(&mut self) {
+    pub(crate) fn inputs_changed(&mut self) {
         self.bind_group = None;
     }
 
-    pub fn record(
+    pub(crate) fn record(
         &mut self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,

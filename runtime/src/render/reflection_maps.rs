@@ -15,11 +15,11 @@ use crate::reflection::{ReflectedEnvironment, sh_reflection_map};
 use bytemuck::{Pod, Zeroable};
 use foundation::Rgb;
 
-pub const REFLECTION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub(crate) const REFLECTION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Uniform offsets must be multiples of the adapter's alignment, at most 256 bytes.
 const JOB_STRIDE: u64 = 256;
 /// Most shininess slots (the jobs buffer is sized for them).
-pub const MAX_SLOTS: usize = super::shaders::MAX_MATERIALS;
+pub(crate) const MAX_SLOTS: usize = super::shaders::MAX_MATERIALS;
 
 /// Matches `Job` in `shaders/prefilter.wgsl` ([`PREFILTER_JOB_SIZE`] bytes).
 #[repr(C)]
@@ -33,7 +33,7 @@ pub(super) struct Job {
     _pad: [f32; 3],
 }
 
-pub struct ReflectionMaps {
+pub(crate) struct ReflectionMaps {
     face_size: usize,
     geometry: CubeGeometry,
     texture: wgpu::Texture,
@@ -48,7 +48,7 @@ pub struct ReflectionMaps {
 
 impl ReflectionMaps {
     /// Black maps of `face_size` (one slot) until the first [`Self::update`].
-    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, face_size: usize) -> Self {
+    pub(crate) fn new(device: &wgpu::Device, queue: &wgpu::Queue, face_size: usize) -> Self {
         let module = Shader::Prefilter.module(device);
         let layout = PREFILTER.layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -93,13 +93,13 @@ impl ReflectionMaps {
         maps
     }
 
-    pub fn face_size(&self) -> usize {
+    pub(crate) fn face_size(&self) -> usize {
         self.face_size
     }
 
     /// Fills one slot per value of `shininess` from `environment`; returns whether the
     /// texture was re-created (bind groups reading [`Self::view`] must be remade).
-    pub fn update(
+    pub(crate) fn update(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,

@@ -9,16 +9,16 @@ pub const MAX_LIGHTS: usize = 32;
 /// Highest SH order the GPU lighting buffers hold; bakes of higher orders are CPU-only.
 pub const MAX_GPU_ORDER: usize = 8;
 /// SH coefficients per channel at [`MAX_GPU_ORDER`].
-pub const MAX_GPU_COEFFS: usize = MAX_GPU_ORDER * MAX_GPU_ORDER;
+pub(crate) const MAX_GPU_COEFFS: usize = MAX_GPU_ORDER * MAX_GPU_ORDER;
 /// Distinct glossy materials a scene may have (the materials' uniform array; entry 0 is the
 /// diffuse one).
-pub const MAX_MATERIALS: usize = 32;
+pub(crate) const MAX_MATERIALS: usize = 32;
 /// Invocations per workgroup of the per-vertex transfer pass.
-pub const TRANSFER_WORKGROUP: u32 = 64;
+pub(crate) const TRANSFER_WORKGROUP: u32 = 64;
 
 /// The shaders of `shaders/`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Shader {
+pub(crate) enum Shader {
     /// Per-vertex PRT radiance (compute).
     Transfer,
     /// The PRT pass writing the G-buffer.
@@ -74,7 +74,7 @@ impl Shader {
     }
 
     /// The complete WGSL source: constants, shared WGSL, the shader.
-    pub fn source(self) -> String {
+    pub(crate) fn source(self) -> String {
         let mut source = constants();
         for part in self.prelude() {
             source.push('\n');
@@ -86,9 +86,9 @@ impl Shader {
     }
 
     /// Entry point of the vertex stage of a full-screen pass.
-    pub const FULLSCREEN_VERTEX: &'static str = "vs_fullscreen";
+    pub(crate) const FULLSCREEN_VERTEX: &'static str = "vs_fullscreen";
 
-    pub fn module(self, device: &wgpu::Device) -> wgpu::ShaderModule {
+    pub(crate) fn module(self, device: &wgpu::Device) -> wgpu::ShaderModule {
         device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(self.file_name()),
             source: wgpu::ShaderSource::Wgsl(self.source().into()),

@@ -51,7 +51,7 @@ pub struct BoundingSphere {
 }
 
 impl BoundingSphere {
-    pub fn of_box(min: Vec3, max: Vec3) -> Self {
+    pub(crate) fn of_box(min: Vec3, max: Vec3) -> Self {
         Self {
             center: (min + max) * 0.5,
             radius: ((max - min) * 0.5).length().max(1e-6),
@@ -75,7 +75,7 @@ fn light_view(direction: Vec3, bounds: &BoundingSphere) -> Mat4 {
 /// World → shadow-map clip space for a light from `direction` (unit, toward the light): an
 /// orthographic view along the light fitted to the scene's bounding sphere, depth 0 at the
 /// sphere's side facing the light and 1 at the far side.
-pub fn shadow_matrix(direction: Vec3, bounds: &BoundingSphere) -> Mat4 {
+pub(crate) fn shadow_matrix(direction: Vec3, bounds: &BoundingSphere) -> Mat4 {
     let r = bounds.radius;
     let projection = glam::camera::rh::proj::directx::orthographic(-r, r, -r, r, 0.0, 2.0 * r);
     projection * light_view(direction, bounds)
@@ -98,7 +98,7 @@ const FIT_MARGIN_TEXELS: f32 = 36.0;
 
 impl ShadowFit {
     /// The map covering the whole scene.
-    pub fn whole_scene(direction: Vec3, bounds: &BoundingSphere, resolution: u32) -> Self {
+    pub(crate) fn whole_scene(direction: Vec3, bounds: &BoundingSphere, resolution: u32) -> Self {
         Self {
             matrix: shadow_matrix(direction, bounds),
             texel: shadow_texel_size(bounds, resolution),
@@ -111,7 +111,7 @@ impl ShadowFit {
     /// light (so every caster in front of a receiver is drawn) to the farthest visible receiver.
     /// Texel-aligned in the light's frame, so a moving camera does not make edges crawl. The
     /// whole-scene map when the view sees none of the box or more than the whole map holds.
-    pub fn to_view(
+    pub(crate) fn to_view(
         direction: Vec3,
         scene_box: (Vec3, Vec3),
         view_proj: Mat4,
@@ -180,7 +180,7 @@ fn edges() -> impl Iterator<Item = (usize, usize)> {
 /// `view_proj` (clip depth 0..1): every vertex of that convex solid (box corners inside the
 /// frustum, frustum corners inside the box, and where the edges of each cross the faces of the
 /// other). Empty when they do not meet.
-pub fn visible_region(scene_box: (Vec3, Vec3), view_proj: Mat4) -> Vec<Vec3> {
+pub(crate) fn visible_region(scene_box: (Vec3, Vec3), view_proj: Mat4) -> Vec<Vec3> {
     let (lo, hi) = scene_box;
     let slack = 1e-4 * (hi - lo).max_element().max(1e-6);
     let clip_planes = |p: Vec3| {
@@ -231,7 +231,7 @@ pub fn visible_region(scene_box: (Vec3, Vec3), view_proj: Mat4) -> Vec<Vec3> {
 }
 
 /// World-space size of one shadow-map texel.
-pub fn shadow_texel_size(bounds: &BoundingSphere, resolution: u32) -> f32 {
+pub(crate) fn shadow_texel_size(bounds: &BoundingSphere, resolution: u32) -> f32 {
     2.0 * bounds.radius / resolution as f32
 }
 

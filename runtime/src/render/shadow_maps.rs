@@ -101,7 +101,7 @@ impl Layers {
 }
 
 /// The shadow maps, their pass and how the light pass samples them.
-pub struct ShadowMaps {
+pub(crate) struct ShadowMaps {
     settings: ShadowSettings,
     pipeline: wgpu::RenderPipeline,
     view_layout: wgpu::BindGroupLayout,
@@ -111,7 +111,7 @@ pub struct ShadowMaps {
 }
 
 impl ShadowMaps {
-    pub fn new(device: &wgpu::Device, settings: ShadowSettings) -> Result<Self, RenderError> {
+    pub(crate) fn new(device: &wgpu::Device, settings: ShadowSettings) -> Result<Self, RenderError> {
         settings.validate()?;
         let view_layout = SHADOW_VIEW.layout(device);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -168,12 +168,12 @@ impl ShadowMaps {
         })
     }
 
-    pub fn settings(&self) -> ShadowSettings {
+    pub(crate) fn settings(&self) -> ShadowSettings {
         self.settings
     }
 
     /// Changes the settings; returns whether the maps were re-created (their bindings change).
-    pub fn set_settings(
+    pub(crate) fn set_settings(
         &mut self,
         device: &wgpu::Device,
         settings: ShadowSettings,
@@ -193,7 +193,7 @@ impl ShadowMaps {
     }
 
     /// Makes room for `lights` maps; returns whether the maps were re-created.
-    pub fn reserve(&mut self, device: &wgpu::Device, lights: usize) -> bool {
+    pub(crate) fn reserve(&mut self, device: &wgpu::Device, lights: usize) -> bool {
         if lights as u32 <= self.layers.count {
             return false;
         }
@@ -202,17 +202,17 @@ impl ShadowMaps {
         true
     }
 
-    pub fn array_view(&self) -> &wgpu::TextureView {
+    pub(crate) fn array_view(&self) -> &wgpu::TextureView {
         &self.layers.array_view
     }
 
-    pub fn depth_copy_array_view(&self) -> &wgpu::TextureView {
+    pub(crate) fn depth_copy_array_view(&self) -> &wgpu::TextureView {
         &self.layers.depth_copy_array_view
     }
 
     /// Records the shadow pass of every light whose matrix changed since its map was drawn
     /// (call [`Self::reserve`] first).
-    pub fn render_stale(
+    pub(crate) fn render_stale(
         &mut self,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,

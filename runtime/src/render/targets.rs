@@ -2,17 +2,17 @@
 
 use super::pass_helpers::texture;
 
-pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+pub(crate) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub(crate) const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub(crate) const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Depth copied into a colour target (split over two half floats, see `encode_depth` in
 /// `shaders/common.wgsl`), readable by the light pass on every backend: OpenGL can neither
 /// load from depth textures nor render to R32Float.
-pub const DEPTH_COPY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub(crate) const DEPTH_COPY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// The targets of one image size.
-pub struct Targets {
+pub(crate) struct Targets {
     pub width: u32,
     pub height: u32,
     /// Linear HDR radiance: the PRT pass writes it, the light pass adds to it.
@@ -25,7 +25,7 @@ pub struct Targets {
 }
 
 impl Targets {
-    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+    pub(crate) fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         use wgpu::TextureUsages as U;
         let attach = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING;
         let target = |label, format, usage| {

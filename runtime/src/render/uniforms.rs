@@ -14,7 +14,7 @@ use glam::Mat4;
 /// Matches `Frame` in `shaders/common.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-pub struct FrameUniform {
+pub(crate) struct FrameUniform {
     view_proj: [[f32; 4]; 4],
     inv_view_proj: [[f32; 4]; 4],
     viewport: [f32; 4],
@@ -32,7 +32,7 @@ pub struct FrameUniform {
 /// Matches `Light` in `shaders/common.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-pub struct LightUniform {
+pub(crate) struct LightUniform {
     direction: [f32; 4],
     power: [f32; 4],
     shadow_matrix: [[f32; 4]; 4],
@@ -41,7 +41,7 @@ pub struct LightUniform {
 }
 
 impl LightUniform {
-    pub fn shadow_matrix(&self) -> Mat4 {
+    pub(crate) fn shadow_matrix(&self) -> Mat4 {
         Mat4::from_cols_array_2d(&self.shadow_matrix)
     }
 }
@@ -49,7 +49,7 @@ impl LightUniform {
 /// Matches `Display` in `shaders/display.wgsl`: how the viewer shows the renderer's image.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-pub struct DisplayUniform {
+pub(crate) struct DisplayUniform {
     exposure: f32,
     /// 1: encode sRGB in the shader (the surface format is not an sRGB one).
     encode_srgb: u32,
@@ -57,7 +57,7 @@ pub struct DisplayUniform {
 }
 
 impl DisplayUniform {
-    pub fn new(exposure: f32, encode_srgb: bool) -> Self {
+    pub(crate) fn new(exposure: f32, encode_srgb: bool) -> Self {
         Self {
             exposure,
             encode_srgb: u32::from(encode_srgb),
@@ -67,7 +67,7 @@ impl DisplayUniform {
 }
 
 /// What the frame uniform is made of.
-pub struct FrameParameters<'a> {
+pub(crate) struct FrameParameters<'a> {
     pub camera: &'a Camera,
     /// World → clip space ([`camera_view_proj`]).
     pub view_proj: Mat4,
@@ -84,7 +84,7 @@ pub struct FrameParameters<'a> {
 }
 
 /// World → clip space of `camera`, its depth range fitted to the scene's bounding sphere.
-pub fn camera_view_proj(camera: &Camera, bounds: &BoundingSphere) -> Mat4 {
+pub(crate) fn camera_view_proj(camera: &Camera, bounds: &BoundingSphere) -> Mat4 {
     let distance = (camera.position - bounds.center).length();
     let near = (distance - bounds.radius).max(1e-3 * bounds.radius);
     let far = (distance + bounds.radius) * 1.01;
@@ -92,7 +92,7 @@ pub fn camera_view_proj(camera: &Camera, bounds: &BoundingSphere) -> Mat4 {
 }
 
 impl FrameUniform {
-    pub fn new(p: &FrameParameters) -> Self {
+    pub(crate) fn new(p: &FrameParameters) -> Self {
         let (w, h) = (p.camera.width as f32, p.camera.height as f32);
         let view_proj = p.view_proj;
         let (sin, cos) = p.environment_rotation.sin_cos();
@@ -125,7 +125,7 @@ fn irradiance_over_pi(sh: &ShCoeffs<Rgb>) -> [[f32; 4]; 9] {
 }
 
 /// Each light with its shadow map's placement (`fits[i]`) and filtering parameters.
-pub fn light_uniforms(lights: &[DirectionalLight], fits: &[ShadowFit]) -> Vec<LightUniform> {
+pub(crate) fn light_uniforms(lights: &[DirectionalLight], fits: &[ShadowFit]) -> Vec<LightUniform> {
     lights
         .iter()
         .zip(fits)
@@ -146,7 +146,7 @@ pub fn light_uniforms(lights: &[DirectionalLight], fits: &[ShadowFit]) -> Vec<Li
 }
 
 /// The uniform buffers.
-pub struct FrameBuffers {
+pub(crate) struct FrameBuffers {
     pub frame: wgpu::Buffer,
     /// A uniform buffer: every fragment reads the same light at each loop step, which software
     /// rasterizers handle far better than storage-buffer loads.
@@ -154,7 +154,7 @@ pub struct FrameBuffers {
 }
 
 impl FrameBuffers {
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub(crate) fn new(device: &wgpu::Device) -> Self {
         let uniform = wgpu::BufferUsages::UNIFORM;
         Self {
             frame: writable_buffer(device, "frame", size_of::<FrameUniform>(), uniform),
@@ -167,7 +167,7 @@ impl FrameBuffers {
         }
     }
 
-    pub fn write(&self, queue: &wgpu::Queue, frame: &FrameUniform, lights: &[LightUniform]) {
+    pub(crate) fn write(&self, queue: &wgpu::Queue, frame: &FrameUniform, lights: &[LightUniform]) {
         queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(frame));
         if !lights.is_empty() {
             queue.write_buffer(&self.lights, 0, bytemuck::cast_slice(lights));

@@ -36,13 +36,13 @@ const BACKGROUND_RADIUS: f32 = 30.0 * PI / 180.0;
 const MAX_SOURCE_RADIUS: f32 = 45.0 * PI / 180.0;
 
 /// The angular radius of the disc of solid angle `omega`.
-pub fn disc_radius(omega: f32) -> f32 {
+pub(crate) fn disc_radius(omega: f32) -> f32 {
     (1.0 - omega / (2.0 * PI)).clamp(-1.0, 1.0).acos()
 }
 
 /// What the map shows of the source behind one light: a core disc in a halo disc.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SourceShape {
+pub(crate) struct SourceShape {
     /// Angular radius of the core (the half-maximum region's disc), radians.
     pub radius: f32,
     /// Angular radius of the disc standing for the halo, radians (at least `radius`).
@@ -54,20 +54,20 @@ pub struct SourceShape {
 /// Measures the sources behind lights ([`Self::shapes`], [`Self::measure`]), keeping its
 /// tables and buffers from call to call: a changing map is measured every frame.
 #[derive(Default)]
-pub struct SourceMeter {
+pub(crate) struct SourceMeter {
     texels: Option<EquirectTexels>,
     scratch: Scratch,
 }
 
 impl SourceMeter {
-    pub fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Self::default()
     }
 
     /// The measured shape of the source behind each light `directions[k]` (unit, in the map's
     /// frame), searched from its peak within `cap_radius`; `None` where the map has no peak
     /// above its background there.
-    pub fn shapes(
+    pub(crate) fn shapes(
         &mut self,
         map: &EnvMap,
         directions: &[Vec3],
@@ -88,7 +88,7 @@ impl SourceMeter {
     /// Sets each light's angular radius, halo and core fraction (its directions in the map's
     /// frame) to the measured shape of its source, where the map has one; the others keep the
     /// decomposition's estimate.
-    pub fn measure(&mut self, map: &EnvMap, lights: &mut [crate::light::DirectionalLight]) {
+    pub(crate) fn measure(&mut self, map: &EnvMap, lights: &mut [crate::light::DirectionalLight]) {
         let Some(cap_radius) = lights.iter().map(|l| l.cap_radius).reduce(f32::max) else {
             return;
         };
