@@ -4,9 +4,9 @@
 mod bake_cache;
 mod cli;
 mod commands;
+mod env_sequence;
 mod maps;
 mod report;
-mod env_sequence;
 mod support;
 mod view;
 

@@ -14,9 +14,9 @@ use foundation::sh::ShCoeffs;
 use foundation::{Rgb, luminance};
 use glam::{Quat, Vec3};
 use reference::{self, EnvironmentLight, ReferenceSettings};
-use runtime::{ReflectedEnvironment, SharedCube, convolve_exact};
 use runtime::render::{FrameLighting, RenderMode};
 use runtime::{CubeGeometry, CubeMap, DecomposeSettings, EnvironmentLighting};
+use runtime::{ReflectedEnvironment, SharedCube, convolve_exact};
 use std::sync::Arc;
 
 fn glossy_sphere(albedo: Rgb, material: Material) -> SceneMesh {

@@ -30,9 +30,9 @@ pub struct CameraBasis {
 }
 
 /// Largest image side a camera may have.
-pub const MAX_IMAGE_SIDE: u32 = 16384;
+pub(crate) const MAX_IMAGE_SIDE: u32 = 16384;
 /// Most pixels of an image (8192², 1 GB as float RGBA): checked before any image is allocated.
-pub const MAX_IMAGE_PIXELS: u64 = 8192 * 8192;
+pub(crate) const MAX_IMAGE_PIXELS: u64 = 8192 * 8192;
 
 impl Camera {
     /// The same camera rendering `width × height` pixels.

@@ -4,7 +4,7 @@
 pub type Rgb = glam::Vec3;
 
 /// Rec.709 luminance weights.
-pub const LUMINANCE_WEIGHTS: Rgb = Rgb::new(0.2126, 0.7152, 0.0722);
+pub(crate) const LUMINANCE_WEIGHTS: Rgb = Rgb::new(0.2126, 0.7152, 0.0722);
 
 /// Luminance `Y = 0.2126 R + 0.7152 G + 0.0722 B`.
 #[inline]

@@ -9,6 +9,9 @@
 //! - ray casting ([`bvh`]), shared by the bake and the reference;
 //! - [`infra`]: atomic files, huge pages, prefetching, progress, named enums.
 
+// Every public item is reachable from the crate root: the API is what lib.rs exports.
+#![deny(unreachable_pub)]
+
 #[macro_use]
 pub mod infra;
 

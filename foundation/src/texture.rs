@@ -51,7 +51,11 @@ impl AlbedoTexture {
 /// vertex's barycentric weight there (the hat function with which a vertex value spreads over
 /// its triangles). Triangles are sampled on a regular barycentric grid fine enough for about one
 /// sample per texel (between 1 and 256² per triangle). Vertices of no triangle get the mean.
-pub(crate) fn vertex_average(texture: &AlbedoTexture, uvs: &[Vec2], triangles: &[[u32; 3]]) -> Vec<Rgb> {
+pub(crate) fn vertex_average(
+    texture: &AlbedoTexture,
+    uvs: &[Vec2],
+    triangles: &[[u32; 3]],
+) -> Vec<Rgb> {
     let mut sums = vec![DVec3::ZERO; uvs.len()];
     let mut weights = vec![0.0f64; uvs.len()];
     for tri in triangles {

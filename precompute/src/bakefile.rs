@@ -27,10 +27,10 @@ use foundation::infra::atomic_file::AtomicOutput;
 use foundation::sh::{self, num_coeffs};
 use std::path::{Path, PathBuf};
 
-pub const MAGIC: &[u8; 8] = b"HPRTBAKE";
+pub(crate) const MAGIC: &[u8; 8] = b"HPRTBAKE";
 /// 2: textured objects' vertices store transfer per unit texel value (count at 88).
-pub const VERSION: u32 = 2;
-pub const HEADER_SIZE: usize = 128;
+pub(crate) const VERSION: u32 = 2;
+pub(crate) const HEADER_SIZE: usize = 128;
 const SAMPLING_COSINE_HAMMERSLEY: u32 = 1;
 
 /// What a bake file's header says.

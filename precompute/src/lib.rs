@@ -5,5 +5,8 @@
 //! built, the [`bake`] traces rays from every vertex and sums the Neumann series, and the result
 //! is stored in a [`bakefile`].
 
+// Every public item is reachable from the crate root: the API is what lib.rs exports.
+#![deny(unreachable_pub)]
+
 pub mod bake;
 pub mod bakefile;

@@ -7,13 +7,16 @@
 //! Each pixel has its own random stream, seeded by the seed and the pixel index, so the image
 //! does not depend on the number of threads.
 
-mod light;
+// Every public item is reachable from the crate root: the API is what lib.rs exports.
+#![deny(unreachable_pub)]
+
 pub mod export;
 mod integrator;
+mod light;
 mod sampler;
 
-pub use light::EnvironmentLight;
 pub use integrator::{DirectVisibility, Integrator, PathEstimate, SurfacePoint};
+pub use light::EnvironmentLight;
 pub use sampler::{MAX_SOBOL_SAMPLES, PathSampler, PixelSampler, SamplerKind, SobolSampler};
 
 use foundation::bvh::SceneBvh;

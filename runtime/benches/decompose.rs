@@ -4,8 +4,8 @@
 //! lights under 1 ms on a 256 × 128 map.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use runtime::{analysis_map, median_cut};
 use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer, EnvironmentLighting};
+use runtime::{analysis_map, median_cut};
 use std::path::Path;
 
 fn bench(c: &mut Criterion) {

@@ -2,6 +2,9 @@
 //! lights ([`decompose`]); [`lighting`] is the one path from a map to a frame's lighting, which
 //! the [`render`]er draws through the baked transfer and shadow maps.
 
+// Every public item is reachable from the crate root: the API is what lib.rs exports.
+#![deny(unreachable_pub)]
+
 mod cubemap;
 mod decompose;
 mod light;

@@ -70,7 +70,11 @@ pub(crate) fn remainder_cube(
 
 /// `sh` convolved with the normalised lobe of `shininess`, evaluated at every texel of
 /// `geometry`: the prefiltered reflection map of an SH environment.
-pub(crate) fn sh_reflection_map(sh: &ShCoeffs<Rgb>, shininess: f32, geometry: &CubeGeometry) -> CubeMap {
+pub(crate) fn sh_reflection_map(
+    sh: &ShCoeffs<Rgb>,
+    shininess: f32,
+    geometry: &CubeGeometry,
+) -> CubeMap {
     let mut convolved = sh.clone();
     convolved.scale_bands(&phong_zonal(shininess, sh.order()));
     CubeMap::from_fn(geometry, |w| convolved.eval(w))

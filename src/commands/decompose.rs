@@ -8,8 +8,8 @@ use clap::Args;
 use foundation::envmap::Layout;
 use foundation::image_io::write_png_rgb8;
 use foundation::{Rgb, luminance};
-use runtime::{decomposition_picture, describe};
 use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
+use runtime::{decomposition_picture, describe};
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -4,8 +4,8 @@ use crate::bake_cache::load_bake;
 use crate::cli::{
     DecomposeOptions, EnvironmentArgs, ImageSizeArgs, RenderOptions, parse_positive, parse_vec3,
 };
-use crate::maps::{default_exposure, scene_rotation};
 use crate::env_sequence::{Sequence, lighting_at_frame};
+use crate::maps::{default_exposure, scene_rotation};
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;

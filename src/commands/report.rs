@@ -3,9 +3,9 @@
 
 use crate::bake_cache;
 use crate::cli::ReportOptions;
+use crate::env_sequence::Sequence;
 use crate::maps::maps_beside;
 use crate::report;
-use crate::env_sequence::Sequence;
 use crate::support::load_scene;
 use clap::Args;
 use foundation::scene::Scene;

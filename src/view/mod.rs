@@ -16,8 +16,8 @@ mod ui;
 mod window;
 
 use crate::bake_cache;
-use crate::maps::{maps_beside, scene_rotation};
 use crate::env_sequence::Sequence;
+use crate::maps::{maps_beside, scene_rotation};
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;

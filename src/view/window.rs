@@ -1,8 +1,8 @@
 //! The window's GPU side: the surface, the tone-mapping pass that shows the renderer's HDR
 //! image, egui's pass on top, and window screenshots.
 
-use runtime::render::{DisplayPass, capture_target, read_texture};
 use runtime::render::{Backend, GpuContext, Renderer};
+use runtime::render::{DisplayPass, capture_target, read_texture};
 use std::sync::Arc;
 use winit::window::Window;
 
@@ -94,8 +94,7 @@ impl WindowGpu {
         };
         let egui = &self.egui;
         self.display.record(
-            device,
-            &self.gpu.queue,
+            &self.gpu,
             encoder,
             target,
             background,

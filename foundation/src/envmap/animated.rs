@@ -3,8 +3,8 @@
 //! are the moving test cases of the temporal measurements; a sequence of map files needs
 //! nothing of this module.
 
-use crate::color::Rgb;
 use super::EnvMap;
+use crate::color::Rgb;
 use glam::Vec3;
 use std::f32::consts::PI;
 

@@ -2,8 +2,8 @@
 //! resampling to the one equirectangular form.
 
 use super::EnvMap;
-use super::faces::{ALL_FACES, CubeFace, horizontal_cross_cell, vertical_cross_cell};
 use super::error::EnvMapError;
+use super::faces::{ALL_FACES, CubeFace, horizontal_cross_cell, vertical_cross_cell};
 use super::files::RgbImage;
 use glam::Vec3;
 use std::path::Path;

@@ -1,8 +1,8 @@
 //! Reading HDR environment maps (OpenEXR, Radiance `.hdr`) in any of the supported layouts.
 
 use super::EnvMap;
-use super::faces::ALL_FACES;
 use super::error::EnvMapError;
+use super::faces::ALL_FACES;
 use super::files::{RgbImage, read_image};
 use super::layouts::{Layout, resample};
 use crate::color::Rgb;

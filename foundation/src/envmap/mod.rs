@@ -4,8 +4,8 @@
 
 pub mod animated;
 mod column;
-pub mod faces;
 mod error;
+pub mod faces;
 mod files;
 mod layouts;
 mod load;

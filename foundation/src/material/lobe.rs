@@ -77,8 +77,6 @@ pub fn phong_zonal(shininess: f32, order: usize) -> Vec<f32> {
     out
 }
 
-
-
 #[cfg(test)]
 mod tests {
     use super::*;

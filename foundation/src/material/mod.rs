@@ -56,7 +56,7 @@ impl Default for Material {
     "albedo + specular is {:.3?}: it must be at most 1 per channel (energy conservation)",
     sum.to_array()
 )]
-pub struct EnergyError {
+pub(crate) struct EnergyError {
     pub sum: Rgb,
 }
 

@@ -24,7 +24,7 @@ use triangle_mesh::merge_meshes;
 
 /// Reads a file, transparently decompressing `.gz`.
 /// Largest decompressed mesh file (a gzip file is read only this far).
-pub const MAX_MESH_BYTES: u64 = 4 << 30;
+pub(crate) const MAX_MESH_BYTES: u64 = 4 << 30;
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
     let bytes = std::fs::read(path).map_err(|cause| MeshError::Io {
@@ -81,7 +81,7 @@ pub struct LoadOptions {
 
 /// Most quads per side of a Bézier patch (`patch_segments`): 256² quads per patch, far past any
 /// use (the teapot needs 16), and bounded before anything is allocated.
-pub const MAX_PATCH_SEGMENTS: u32 = 256;
+pub(crate) const MAX_PATCH_SEGMENTS: u32 = 256;
 
 /// Whether `path` names a mesh or model file hprt reads (by its extension).
 pub fn is_mesh_file(path: &Path) -> bool {

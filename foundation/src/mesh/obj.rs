@@ -82,7 +82,10 @@ fn model_mesh(m: &tobj::Mesh) -> RawMesh {
 /// (sRGB) as its texture, texture coordinates flipped to glTF's top-left origin. `None` when
 /// the file names no material library, or one that defines no material, or one that cannot be
 /// read (with a warning): the scene's albedo applies to the whole file.
-pub(super) fn parse_obj_parts(path: &Path, bytes: &[u8]) -> Result<Option<Vec<ModelPart>>, MeshError> {
+pub(super) fn parse_obj_parts(
+    path: &Path,
+    bytes: &[u8],
+) -> Result<Option<Vec<ModelPart>>, MeshError> {
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut reader = std::io::BufReader::new(bytes);
     let (models, materials) = tobj::load_obj_buf(&mut reader, &load_options(), |p| {

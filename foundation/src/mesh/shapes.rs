@@ -55,7 +55,12 @@ pub fn box_mesh(min: Vec3, max: Vec3, segments: [u32; 3], skip: [bool; 6]) -> Tr
 
 /// A flat ring in the XZ plane around `center`, facing +Y: `segments[0]` quads across it and
 /// `segments[1]` around it. With `inner = 0` it is a disc.
-pub(crate) fn annulus_mesh(center: Vec3, inner: f32, outer: f32, segments: [u32; 2]) -> TriangleMesh {
+pub(crate) fn annulus_mesh(
+    center: Vec3,
+    inner: f32,
+    outer: f32,
+    segments: [u32; 2],
+) -> TriangleMesh {
     let (nr, na) = (segments[0].max(1) as usize, segments[1].max(3) as usize);
     let mut mesh = TriangleMesh::default();
     for i in 0..=nr {

@@ -52,8 +52,8 @@ pub struct Scene {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use super::build::transform_mesh;
+    use super::*;
     use crate::color::Rgb;
     use crate::material::Material;
     use crate::mesh::box_mesh;

@@ -11,9 +11,9 @@ use glam::Vec3;
 use std::path::{Path, PathBuf};
 
 /// The longest side of the model's bounding box, in scene units, once placed.
-pub const MODEL_SIZE: f32 = 2.0;
+pub(crate) const MODEL_SIZE: f32 = 2.0;
 /// Vertical field of view of the framing camera, in degrees.
-pub const FRAMING_FOV_DEG: f32 = 40.0;
+pub(crate) const FRAMING_FOV_DEG: f32 = 40.0;
 /// Where the camera looks from: right of, above and in front of the model (+Z is front).
 const VIEW_DIRECTION: Vec3 = Vec3::new(0.55, 0.45, 1.0);
 /// Half the ground slab's side, in bounding-sphere radii: long enough for the shadow of a sun
@@ -93,7 +93,7 @@ fn stem(path: &Path) -> String {
 /// How a model with bounds `lo..hi` is placed: scaled so its longest side is [`MODEL_SIZE`],
 /// centred over the origin, its lowest point on the ground (y = 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Placement {
+pub(crate) struct Placement {
     pub scale: f32,
     pub translate: Vec3,
     /// Bounding sphere of the placed model's box.
@@ -102,7 +102,7 @@ pub struct Placement {
 }
 
 impl Placement {
-    pub fn new(lo: Vec3, hi: Vec3) -> Self {
+    pub(crate) fn new(lo: Vec3, hi: Vec3) -> Self {
         let extent = hi - lo;
         let scale = MODEL_SIZE / extent.max_element();
         let mid = 0.5 * (lo + hi);
@@ -117,7 +117,7 @@ impl Placement {
 
     /// A 640 × 480 camera whose vertical field of view holds the bounding sphere with a 5%
     /// margin (the horizontal one, wider, then holds it too).
-    pub fn camera(&self) -> Camera {
+    pub(crate) fn camera(&self) -> Camera {
         let half_fov = (0.5 * FRAMING_FOV_DEG).to_radians();
         let distance = 1.05 * self.radius / half_fov.sin();
         Camera {

@@ -198,7 +198,6 @@ impl<C: Copy + Default> ShCoeffs<C> {
         &mut self.coeffs
     }
 
-
     /// The expansion cut (or zero-padded) to `order` bands.
     pub fn with_order(&self, order: usize) -> Self {
         let mut out = Self::zeros(order);

@@ -46,7 +46,11 @@ impl VertexNeighbours {
 /// Overwrites the transfer of `inside` vertices with the mean of their neighbours' (outside
 /// ones first, then ring by ring inward). Inside vertices with no path to an outside one keep
 /// a zero transfer.
-pub(crate) fn fill_inside(transfer: &mut TransferVectors, inside: &[bool], neighbours: &VertexNeighbours) {
+pub(crate) fn fill_inside(
+    transfer: &mut TransferVectors,
+    inside: &[bool],
+    neighbours: &VertexNeighbours,
+) {
     let stride = transfer.stride();
     let mut known: Vec<bool> = inside.iter().map(|i| !i).collect();
     let mut pending: Vec<usize> = (0..inside.len()).filter(|&v| inside[v]).collect();

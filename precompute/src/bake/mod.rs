@@ -13,8 +13,8 @@ mod transfer;
 mod visibility;
 
 pub use bounce::InterreflectionOperator;
-pub(crate) use inside::fill_inside;
 pub use inside::VertexNeighbours;
+pub(crate) use inside::fill_inside;
 pub use transfer::TransferVectors;
 pub use visibility::INSIDE_BACKFACE_FRACTION;
 

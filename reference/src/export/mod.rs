@@ -251,11 +251,11 @@ fn xml_escape(s: &str) -> String {
 
 /// The Mitsuba 3 plugin that reproduces hprt's surfaces (both sides show the front), registered
 /// as `thinsheet` when imported.
-pub const THIN_SHEET_PLUGIN: &str = include_str!("thinsheet.py");
+pub(crate) const THIN_SHEET_PLUGIN: &str = include_str!("thinsheet.py");
 
 /// The Mitsuba 3 plugin of hprt's glossy material (Lambert plus a normalised Phong lobe,
 /// CONVENTIONS.md, "Glossy materials"), registered as `hprtphong` when imported.
-pub const PHONG_PLUGIN: &str = include_str!("phong.py");
+pub(crate) const PHONG_PLUGIN: &str = include_str!("phong.py");
 
 /// Writes `dir/scene.xml`, `dir/thinsheet.py`, `dir/phong.py`, `dir/envmap.exr`, `dir/meshes/*.ply` and, for
 /// textured objects, `dir/textures/*.exr`.

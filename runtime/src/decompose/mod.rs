@@ -25,7 +25,6 @@ mod window;
 use crate::cubemap::{CubeGeometry, CubeMap};
 use crate::light::DirectionalLight;
 pub use decomposition::Decomposition;
-pub use visualize::{decomposition_picture, describe};
 use foundation::settings::InvalidSettings;
 use foundation::sh::ShCoeffs;
 use foundation::{Rgb, luminance};
@@ -36,6 +35,7 @@ pub(crate) use settings::{ANALYSIS_FACE_SIZE, MAX_CANDIDATES};
 pub use settings::{DecomposeError, DecomposeMode, DecomposeSettings};
 use smoothing::GaussianSmoothing;
 use std::f32::consts::PI;
+pub use visualize::{decomposition_picture, describe};
 pub use window::Window;
 
 /// Fixed-point iterations of the consistent mode's refit.

@@ -4,9 +4,8 @@
 
 use super::Renderer;
 use super::bindings::DISPLAY;
-use super::pass_helpers::{
-    FullscreenPass, begin_pass, color_attachment, texture, writable_buffer,
-};
+use super::gpu::GpuContext;
+use super::pass_helpers::{FullscreenPass, begin_pass, color_attachment, texture, writable_buffer};
 use super::shaders::Shader;
 use super::uniforms::DisplayUniform;
 
@@ -62,8 +61,7 @@ impl DisplayPass {
     /// `overlay` into the same pass.
     pub fn record(
         &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         target: &wgpu::TextureView,
         background: wgpu::Color,
@@ -72,10 +70,11 @@ impl DisplayPass {
     ) {
         if let Some((renderer, exposure)) = image {
             let uniform = DisplayUniform::new(exposure, self.encode_srgb);
-            queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+            gpu.queue
+                .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
             if self.bind_group.is_none() {
                 self.bind_group = Some(DISPLAY.bind_group(
-                    device,
+                    &gpu.device,
                     &self.layout,
                     &[
                         ("display", self.uniform.as_entire_binding()),

@@ -42,7 +42,11 @@ pub(crate) fn mip_chain(map: &EnvMap) -> Vec<(Vec<Rgb>, usize, usize)> {
 }
 
 /// Every mip level of a `width × height` image, full resolution first.
-pub(crate) fn mip_chain_of(texels: &[Rgb], width: usize, height: usize) -> Vec<(Vec<Rgb>, usize, usize)> {
+pub(crate) fn mip_chain_of(
+    texels: &[Rgb],
+    width: usize,
+    height: usize,
+) -> Vec<(Vec<Rgb>, usize, usize)> {
     let mut levels = vec![(texels.to_vec(), width, height)];
     while let Some((texels, w, h)) = levels.last().filter(|l| l.1 > 1 || l.2 > 1) {
         let next = next_level(texels, *w, *h);
@@ -52,7 +56,12 @@ pub(crate) fn mip_chain_of(texels: &[Rgb], width: usize, height: usize) -> Vec<(
 }
 
 impl EnvironmentTexture {
-    pub(crate) fn new(device: &wgpu::Device, queue: &wgpu::Queue, map: &EnvMap, rotation: f32) -> Self {
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        map: &EnvMap,
+        rotation: f32,
+    ) -> Self {
         let texture = upload_mip_chain(device, queue, "environment", &mip_chain(map));
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("environment"),

@@ -17,8 +17,8 @@
 //! every pass repeats.
 
 mod bindings;
-mod environment_texture;
 mod display_pass;
+mod environment_texture;
 mod error;
 mod gpu;
 mod gpu_scene;
@@ -36,10 +36,9 @@ mod transfer_pass;
 mod uniforms;
 
 use crate::lighting::ShTransfer;
+pub use display_pass::{DisplayPass, capture_target};
 use environment_texture::EnvironmentTexture;
 use error::checked;
-pub use display_pass::{DisplayPass, capture_target};
-pub use readback::read_texture;
 pub use error::{BakeMismatch, ReadbackError, RenderError};
 use foundation::Rgb;
 use foundation::camera::Camera;
@@ -53,6 +52,7 @@ use gpu_scene::GpuScene;
 use light_pass::{LightPass, LightPassInputs};
 use precompute::bake::Transfer;
 use prt_pass::{PrtPass, PrtPassInputs};
+pub use readback::read_texture;
 use reflection_maps::ReflectionMaps;
 pub use shaders::{MAX_GPU_ORDER, MAX_LIGHTS};
 pub use shadow_fit::{BoundingSphere, ShadowFit, ShadowSettings};

@@ -111,7 +111,10 @@ pub(crate) struct ShadowMaps {
 }
 
 impl ShadowMaps {
-    pub(crate) fn new(device: &wgpu::Device, settings: ShadowSettings) -> Result<Self, RenderError> {
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        settings: ShadowSettings,
+    ) -> Result<Self, RenderError> {
         settings.validate()?;
         let view_layout = SHADOW_VIEW.layout(device);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

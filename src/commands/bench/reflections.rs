@@ -28,9 +28,9 @@ pub struct BenchReflectionsArgs {
 }
 
 pub(super) fn bench_reflections(args: BenchReflectionsArgs) -> anyhow::Result<()> {
-    use runtime::{ReflectedEnvironment, SharedCube};
     use runtime::render::{GpuContext, RenderMode, Renderer};
     use runtime::{DecomposeSettings, EnvironmentLighting};
+    use runtime::{ReflectedEnvironment, SharedCube};
     let scene = load_scene(&args.scene)?;
     anyhow::ensure!(
         scene.geometry.is_glossy(),
