@@ -1,6 +1,6 @@
 // Glossy materials (CONVENTIONS.md, "Glossy materials"): the normalised Phong lobe, the mirror
 // direction, and cube maps stored as six layers of a 2D array (faces in the order +X, -X, +Y,
-// -Y, +Z, -Z, each read as `precompute/src/envmap/cube.rs` does: (forward, right, down)).
+// -Y, +Z, -Z, each read as `foundation/src/envmap/faces.rs` does: (forward, right, down)).
 
 struct Material {
     // k_s in rgb, shininess s in w (k_s = 0: diffuse).
