@@ -16,7 +16,7 @@ pub struct UnknownName {
 /// a variant's name, and `FromStr` / `Display` parse and print it.
 ///
 /// ```
-/// crate::named_enum! {
+/// foundation::named_enum! {
 ///     /// A colour.
 ///     pub enum Colour ("colour") {
 ///         Red = "red",
