@@ -201,9 +201,9 @@ fn shape_xml(o: &SceneObject, i: usize) -> String {
         // with repeat wrapping (Mitsuba's defaults, and hprt's reference).
         Some(_) => format!(
             r#"<texture type="bitmap" name="reflectance">
-                <string name="filename" value="textures/{}"/>
-                <boolean name="raw" value="true"/>
-            </texture>"#,
+                    <string name="filename" value="textures/{}"/>
+                    <boolean name="raw" value="true"/>
+                </texture>"#,
             texture_file_for(&o.name, i)
         ),
         None => format!(
@@ -215,27 +215,27 @@ fn shape_xml(o: &SceneObject, i: usize) -> String {
     let inner = if m.is_glossy() {
         format!(
             r#"<bsdf type="hprtphong">
-            {reflectance}
-            <rgb name="specular" value="{}, {}, {}"/>
-            <float name="exponent" value="{}"/>
-        </bsdf>"#,
+                {reflectance}
+                <rgb name="specular" value="{}, {}, {}"/>
+                <float name="exponent" value="{}"/>
+            </bsdf>"#,
             m.specular.x, m.specular.y, m.specular.z, m.shininess
         )
     } else {
         format!(
             r#"<bsdf type="diffuse">
-            {reflectance}
-        </bsdf>"#
+                {reflectance}
+            </bsdf>"#
         )
     };
     format!(
         r#"    <shape type="ply" id="{id}">
-    <string name="filename" value="meshes/{file}"/>
-    <boolean name="face_normals" value="false"/>
-    <bsdf type="$surface">
-        {inner}
-    </bsdf>
-</shape>
+        <string name="filename" value="meshes/{file}"/>
+        <boolean name="face_normals" value="false"/>
+        <bsdf type="$surface">
+            {inner}
+        </bsdf>
+    </shape>
 "#,
         id = xml_escape(&o.name),
         file = file_name_for(&o.name, i),
