@@ -17,6 +17,10 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Let glTF models read buffers and images outside their own folder (refused by default:
+    /// a model from elsewhere must not read other files of this machine).
+    #[arg(long, global = true)]
+    allow_outside_uris: bool,
 }
 
 #[derive(Subcommand)]
@@ -65,6 +69,7 @@ fn main() {
         std::process::exit(130);
     });
     let cli = Cli::parse();
+    foundation::mesh::set_allow_outside_uris(cli.allow_outside_uris);
     let result = match cli.command {
         Command::Demo(args) => commands::demo::run(args),
         Command::Report(args) => commands::report::run(args),

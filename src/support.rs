@@ -2,6 +2,7 @@
 //! the terminal progress bar.
 
 use anyhow::Context;
+use foundation::infra::limits::MAX_THREADS;
 use foundation::infra::progress::Progress;
 use foundation::scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -20,6 +21,10 @@ pub fn with_threads<T: Send>(
     match threads {
         None => Ok(f()),
         Some(0) => anyhow::bail!("--threads must be at least 1"),
+        Some(n) if n > MAX_THREADS => anyhow::bail!(
+            "--threads {n} is more than the {MAX_THREADS} hprt starts (this machine has {} cores)",
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        ),
         Some(n) => Ok(rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()

@@ -3,7 +3,44 @@
 //! albedo").
 
 use crate::color::Rgb;
+use crate::infra::limits::{MAX_TEXTURE_SIDE, MAX_TEXTURE_TEXELS};
 use glam::{DVec3, Vec2};
+
+/// An image file a texture cannot be made from.
+#[derive(Debug, thiserror::Error)]
+pub enum TextureError {
+    #[error("cannot decode the image: {0}")]
+    Decode(#[from] image::ImageError),
+    #[error("cannot read the image: {0}")]
+    Io(#[from] std::io::Error),
+    #[error(
+        "the image is {width}x{height}: hprt takes textures of at most {max_texels} texels \
+         and {max_side} per side (downscale it, e.g. to 4096x4096)",
+        max_texels = MAX_TEXTURE_TEXELS,
+        max_side = MAX_TEXTURE_SIDE
+    )]
+    TooLarge { width: u32, height: u32 },
+}
+
+/// Decodes an image file's bytes (PNG, JPEG, ...), refusing before decoding one whose header
+/// declares more than [`MAX_TEXTURE_TEXELS`] texels or a side over [`MAX_TEXTURE_SIDE`] (a
+/// small compressed file can declare gigabytes of pixels).
+pub(crate) fn decode_image(bytes: &[u8]) -> Result<image::DynamicImage, TextureError> {
+    let reader = || image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format();
+    let (width, height) = reader()?.into_dimensions()?;
+    let texels = u64::from(width) * u64::from(height);
+    if texels > MAX_TEXTURE_TEXELS || width.max(height) > MAX_TEXTURE_SIDE {
+        return Err(TextureError::TooLarge { width, height });
+    }
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
+    // RGBA at 16 bits a channel is the widest decoded form of such an image.
+    limits.max_alloc = Some(8 * MAX_TEXTURE_TEXELS + (64 << 20));
+    let mut reader = reader()?;
+    reader.limits(limits);
+    Ok(reader.decode()?)
+}
 
 /// A base colour texture, decoded from sRGB to linear RGB; rows from the top, so texture
 /// coordinate (0, 0) is the top-left corner of the image (glTF's convention).

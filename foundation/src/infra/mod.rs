@@ -3,6 +3,7 @@
 
 pub mod atomic_file;
 pub mod huge_pages;
+pub mod limits;
 #[macro_use]
 pub mod named_enum;
 pub mod prefetch;

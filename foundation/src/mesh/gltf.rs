@@ -4,10 +4,12 @@
 //! says is ignored, with one note per material.
 
 use super::error::MeshError;
+use super::gltf_sources::Sources;
 use super::triangle_mesh::RawMesh;
 use crate::color::Rgb;
-use crate::texture::AlbedoTexture;
+use crate::texture::{AlbedoTexture, decode_image};
 use glam::{Mat3, Mat4, Vec2, Vec3};
+use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use std::collections::HashMap;
 use std::path::Path;
@@ -40,7 +42,28 @@ const COMPRESSION_EXTENSIONS: [&str; 3] = [
     "KHR_mesh_quantization",
 ];
 
+/// Every triangle primitive of the model's default scene. What the checks before the `gltf`
+/// crate's reader miss cannot crash the program: a panic inside the crate becomes an error
+/// naming the file.
 pub(super) fn parse_gltf(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, MeshError> {
+    let quiet = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let result = std::panic::catch_unwind(|| read_gltf(path, bytes));
+    std::panic::set_hook(quiet);
+    result.unwrap_or_else(|panic| {
+        let message = panic
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        Err(MeshError::Invalid {
+            path: path.to_owned(),
+            message: format!("the glTF reader failed on this file ({message})"),
+        })
+    })
+}
+
+fn read_gltf(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, MeshError> {
     let invalid = |message: String| MeshError::Invalid {
         path: path.to_owned(),
         message,
@@ -60,9 +83,12 @@ pub(super) fn parse_gltf(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Me
     }
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice(bytes).map_err(|e| invalid(format!("invalid glTF: {e}")))?;
-    let base = path.parent().unwrap_or(Path::new("."));
-    let buffers = gltf::import_buffers(&document, Some(base), blob)
-        .map_err(|e| invalid(format!("cannot load its buffers: {e}")))?;
+    let base = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let sources = Sources { path, base };
+    let buffers = sources.buffers(&document, blob)?;
     let scene = document
         .default_scene()
         .or_else(|| document.scenes().next())
@@ -70,27 +96,30 @@ pub(super) fn parse_gltf(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Me
 
     let mut loader = Loader {
         path,
-        base,
+        sources,
         buffers: &buffers,
         textures: HashMap::new(),
         noted: Vec::new(),
         parts: Vec::new(),
     };
-    let mut stack: Vec<(gltf::Node, Mat4, usize)> =
-        scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
-    while let Some((node, parent, depth)) = stack.pop() {
-        // A node may not be its own ancestor (the spec forbids cycles; a malformed file
-        // could have one).
-        if depth > 256 {
-            return Err(invalid(
-                "the node hierarchy is deeper than 256 (a cycle?)".into(),
-            ));
+    // glTF's nodes form disjoint trees (glTF 2.0, 3.5.3): a node reached twice (listed twice,
+    // or the child of two parents) would be drawn twice, and shared children nested a few
+    // levels deep multiply into billions of instances.
+    let mut reached = vec![false; document.nodes().len()];
+    let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut reached[node.index()], true) {
+            return Err(invalid(format!(
+                "node {} is reached twice (listed twice in the scene, or the child of two \
+                 parents): glTF's nodes form trees",
+                node.index()
+            )));
         }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
             loader.mesh(&node, &mesh, &world)?;
         }
-        stack.extend(node.children().map(|c| (c, world, depth + 1)));
+        stack.extend(node.children().map(|c| (c, world)));
     }
     if loader.parts.is_empty() {
         return Err(MeshError::Empty {
@@ -103,7 +132,7 @@ pub(super) fn parse_gltf(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Me
 
 struct Loader<'a> {
     path: &'a Path,
-    base: &'a Path,
+    sources: Sources<'a>,
     buffers: &'a [gltf::buffer::Data],
     /// Decoded base colour textures by image index.
     textures: HashMap<usize, std::sync::Arc<AlbedoTexture>>,
@@ -147,9 +176,24 @@ impl Loader<'_> {
             }
             for (semantic, accessor) in primitive.attributes() {
                 self.check_accessor(&name, &format!("{semantic:?}"), &accessor)?;
+                check_type(&semantic, &accessor)
+                    .map_err(|m| self.invalid(format!("{name}: {m}")))?;
             }
             if let Some(indices) = primitive.indices() {
                 self.check_accessor(&name, "indices", &indices)?;
+                let index_type = matches!(
+                    indices.data_type(),
+                    DataType::U8 | DataType::U16 | DataType::U32
+                );
+                if !index_type || indices.dimensions() != Dimensions::Scalar {
+                    return Err(self.invalid(format!(
+                        "{name}: its indices (accessor {}) are {:?} {:?}; glTF indices are \
+                         unsigned integer scalars",
+                        indices.index(),
+                        indices.data_type(),
+                        indices.dimensions()
+                    )));
+                }
             }
             let reader = primitive.reader(|b| self.buffers.get(b.index()).map(|d| &d[..]));
             let positions: Vec<Vec3> = reader
@@ -238,6 +282,13 @@ impl Loader<'_> {
             .map_or(0, |b| b.len());
         let element = accessor.size();
         let stride = view.stride().unwrap_or(element);
+        if stride < element {
+            return Err(self.invalid(format!(
+                "{part}: {what} (accessor {}) has a byteStride of {stride}, less than its \
+                 {element}-byte elements",
+                accessor.index()
+            )));
+        }
         let needed = match accessor.count() {
             0 => 0,
             n => accessor.offset() + stride * (n - 1) + element,
@@ -296,13 +347,14 @@ impl Loader<'_> {
         if let Some(t) = self.textures.get(&image.index()) {
             return Ok(t.clone());
         }
-        let data = gltf::image::Data::from_source(image.source(), Some(self.base), self.buffers)
-            .map_err(|e| self.invalid(format!("image {}: cannot decode it: {e}", image.index())))?;
-        let texture = std::sync::Arc::new(decode_srgb(&data).ok_or_else(|| {
+        let bytes = self.sources.image_bytes(image, self.buffers)?;
+        let decoded = decode_image(&bytes)
+            .map_err(|e| self.invalid(format!("image {}: {e}", image.index())))?;
+        let texture = std::sync::Arc::new(decode_srgb(&decoded).ok_or_else(|| {
             self.invalid(format!(
                 "image {}: unsupported pixel format {:?} for a base colour",
                 image.index(),
-                data.format
+                decoded.color()
             ))
         })?);
         self.textures.insert(image.index(), texture.clone());
@@ -335,6 +387,30 @@ fn with_flat_normals(mesh: RawMesh) -> RawMesh {
         out.triangles.push([base, base + 1, base + 2]);
     }
     out
+}
+
+/// Refuses an attribute hprt reads whose type is not the one glTF gives it (the `gltf` crate's
+/// reader assumes it): positions and normals are float VEC3, texture coordinates VEC2 of float
+/// or normalised unsigned bytes or shorts.
+fn check_type(semantic: &gltf::Semantic, accessor: &gltf::Accessor) -> Result<(), String> {
+    let (data, dims) = (accessor.data_type(), accessor.dimensions());
+    let ok = match semantic {
+        gltf::Semantic::Positions | gltf::Semantic::Normals => {
+            data == DataType::F32 && dims == Dimensions::Vec3
+        }
+        gltf::Semantic::TexCoords(0) => {
+            dims == Dimensions::Vec2 && matches!(data, DataType::F32 | DataType::U8 | DataType::U16)
+        }
+        _ => true,
+    };
+    if ok {
+        Ok(())
+    } else {
+        Err(format!(
+            "its {semantic:?} (accessor {}) is {data:?} {dims:?}, not what glTF specifies",
+            accessor.index()
+        ))
+    }
 }
 
 /// Triangles of a triangle list, strip or fan.
@@ -383,22 +459,23 @@ fn ignored_properties(material: &gltf::Material) -> Vec<&'static str> {
 }
 
 /// 8- or 16-bit RGB(A) or grey pixels, sRGB-encoded, to linear RGB; `None` for other formats.
-fn decode_srgb(data: &gltf::image::Data) -> Option<AlbedoTexture> {
-    use gltf::image::Format;
-    let (channels, bytes_per_channel) = match data.format {
-        Format::R8 => (1, 1),
-        Format::R8G8 => (2, 1),
-        Format::R8G8B8 => (3, 1),
-        Format::R8G8B8A8 => (4, 1),
-        Format::R16 => (1, 2),
-        Format::R16G16 => (2, 2),
-        Format::R16G16B16 => (3, 2),
-        Format::R16G16B16A16 => (4, 2),
+fn decode_srgb(image: &image::DynamicImage) -> Option<AlbedoTexture> {
+    use image::DynamicImage as D;
+    let (channels, bytes_per_channel) = match image {
+        D::ImageLuma8(_) => (1, 1),
+        D::ImageLumaA8(_) => (2, 1),
+        D::ImageRgb8(_) => (3, 1),
+        D::ImageRgba8(_) => (4, 1),
+        D::ImageLuma16(_) => (1, 2),
+        D::ImageLumaA16(_) => (2, 2),
+        D::ImageRgb16(_) => (3, 2),
+        D::ImageRgba16(_) => (4, 2),
         _ => return None,
     };
+    let pixels = image.as_bytes();
     let texel_bytes = channels * bytes_per_channel;
-    let (width, height) = (data.width as usize, data.height as usize);
-    if width == 0 || height == 0 || data.pixels.len() < width * height * texel_bytes {
+    let (width, height) = (image.width() as usize, image.height() as usize);
+    if width == 0 || height == 0 || pixels.len() < width * height * texel_bytes {
         return None;
     }
     let channel = |texel: &[u8], c: usize| -> f32 {
@@ -407,8 +484,7 @@ fn decode_srgb(data: &gltf::image::Data) -> Option<AlbedoTexture> {
             _ => f32::from(u16::from_ne_bytes([texel[2 * c], texel[2 * c + 1]])) / 65535.0,
         }
     };
-    let texels = data
-        .pixels
+    let texels = pixels
         .chunks_exact(texel_bytes)
         .take(width * height)
         .map(|texel| {

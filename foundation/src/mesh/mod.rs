@@ -6,6 +6,7 @@ mod bpt;
 mod cleanup;
 mod error;
 mod gltf;
+mod gltf_sources;
 mod obj;
 mod ply;
 mod shapes;
@@ -15,49 +16,62 @@ pub use bpt::BezierPatch;
 pub use cleanup::{CleanupReport, MeshCleanup};
 pub use error::MeshError;
 pub use gltf::{ModelPart, PartMaterial};
+pub use gltf_sources::set_allow_outside_uris;
 pub(crate) use shapes::annulus_mesh;
 pub use shapes::{box_mesh, icosahedron, sphere_mesh, subdivide};
 pub use triangle_mesh::{RawMesh, TriangleMesh};
 
+use crate::infra::limits::{MAX_MESH_BYTES, ReadError, gunzip_limited, read_regular_file};
 use std::path::Path;
 use triangle_mesh::merge_meshes;
 
-/// Reads a file, transparently decompressing `.gz`.
-/// Largest decompressed mesh file (a gzip file is read only this far).
-pub(crate) const MAX_MESH_BYTES: u64 = 4 << 30;
-
+/// Reads a mesh file within [`MAX_MESH_BYTES`], transparently decompressing `.gz` (also within
+/// it). A gzipped PLY or GLB whose data does not begin with its format's magic is refused before
+/// it is expanded.
 fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
-    let bytes = std::fs::read(path).map_err(|cause| MeshError::Io {
+    let invalid = |message: String| MeshError::Invalid {
         path: path.to_owned(),
-        cause,
+        message,
+    };
+    let bytes = read_regular_file(path, MAX_MESH_BYTES).map_err(|e| match e {
+        ReadError::Io(cause) => MeshError::Io {
+            path: path.to_owned(),
+            cause,
+        },
+        other => invalid(other.to_string()),
     })?;
-    if path
+    if !path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("gz"))
     {
-        use std::io::Read;
-        let mut out = Vec::new();
-        // Read one byte past the limit to tell a file at the limit from one beyond it.
-        flate2::read::MultiGzDecoder::new(&bytes[..])
-            .take(MAX_MESH_BYTES + 1)
-            .read_to_end(&mut out)
-            .map_err(|e| MeshError::Invalid {
-                path: path.to_owned(),
-                message: format!("corrupt or truncated gzip data: {e}"),
-            })?;
-        if out.len() as u64 > MAX_MESH_BYTES {
-            return Err(MeshError::Invalid {
-                path: path.to_owned(),
-                message: format!(
-                    "the gzip data expands beyond {} GB, the largest mesh hprt reads",
-                    MAX_MESH_BYTES >> 30
-                ),
-            });
-        }
-        Ok(out)
-    } else {
-        Ok(bytes)
+        return Ok(bytes);
     }
+    let magic: &[u8] = match format_of(path) {
+        Some("ply") => b"ply",
+        Some("glb") => b"glTF",
+        _ => b"",
+    };
+    if !magic.is_empty() {
+        use std::io::Read;
+        let mut start = Vec::new();
+        let decoded = flate2::read::MultiGzDecoder::new(&bytes[..])
+            .take(magic.len() as u64)
+            .read_to_end(&mut start);
+        if decoded.is_err() || !start.starts_with(magic) {
+            return Err(invalid(format!(
+                "the gzip data is corrupt or not a {} file (which begins with {:?})",
+                format_of(path).unwrap_or_default().to_uppercase(),
+                String::from_utf8_lossy(magic)
+            )));
+        }
+    }
+    gunzip_limited(&bytes, MAX_MESH_BYTES).map_err(|e| match e {
+        ReadError::TooLarge { max, .. } => invalid(format!(
+            "the gzip data expands beyond {} MB, the largest mesh hprt reads",
+            max >> 20
+        )),
+        other => invalid(format!("corrupt or truncated gzip data: {other}")),
+    })
 }
 
 /// The mesh format, from the file name (ignoring a trailing `.gz`).

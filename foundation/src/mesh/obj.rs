@@ -4,7 +4,8 @@ use super::error::MeshError;
 use super::gltf::{ModelPart, PartMaterial};
 use super::triangle_mesh::{RawMesh, merge_meshes};
 use crate::color::Rgb;
-use crate::texture::AlbedoTexture;
+use crate::infra::limits::{MAX_SIDE_FILE_BYTES, read_regular_file};
+use crate::texture::{AlbedoTexture, decode_image};
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -88,21 +89,27 @@ pub(super) fn parse_obj_parts(
 ) -> Result<Option<Vec<ModelPart>>, MeshError> {
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut reader = std::io::BufReader::new(bytes);
+    let libraries = std::cell::RefCell::new(Libraries::default());
     let (models, materials) = tobj::load_obj_buf(&mut reader, &load_options(), |p| {
-        tobj::load_mtl(dir.join(p))
+        libraries.borrow_mut().load(dir, p)
     })
     .map_err(|e| syntax_error(path, bytes, e))?;
+    let libraries = libraries.into_inner();
     let materials = match materials {
         Ok(m) if !m.is_empty() => m,
         Ok(_) => return Ok(None),
-        Err(e) => {
+        Err(_) => {
             log::warn!(
-                "{}: cannot read its material library ({e}): its materials are ignored",
-                path.display()
+                "{}: cannot read its material library: {}; its materials are ignored",
+                path.display(),
+                libraries.failures.join("; ")
             );
             return Ok(None);
         }
     };
+    for material in &materials {
+        libraries.check_kd(material)?;
+    }
     let mut textures: HashMap<PathBuf, Arc<AlbedoTexture>> = HashMap::new();
     let mut parts = Vec::new();
     for model in &models {
@@ -149,12 +156,97 @@ pub(super) fn parse_obj_parts(
     Ok(Some(parts))
 }
 
+/// The material libraries an OBJ names, read as tobj asks for them: each `mtllib` line may name
+/// several files; each must be a regular file within [`MAX_SIDE_FILE_BYTES`]. Their text is kept
+/// to name the line of a bad value.
+#[derive(Default)]
+struct Libraries {
+    texts: Vec<(PathBuf, String)>,
+    /// Why each library that could not be read could not, naming it.
+    failures: Vec<String>,
+}
+
+impl Libraries {
+    /// The materials of the files named by one `mtllib` line, in order.
+    fn load(&mut self, dir: &Path, names: &Path) -> tobj::MTLLoadResult {
+        let names = names.to_string_lossy();
+        let mut all = Vec::new();
+        let mut by_name = None;
+        for name in names.split_whitespace() {
+            let file = dir.join(name);
+            let bytes = match read_regular_file(&file, MAX_SIDE_FILE_BYTES) {
+                Ok(bytes) => bytes,
+                Err(e) => {
+                    self.failures.push(format!("{}: {e}", file.display()));
+                    return Err(tobj::LoadError::OpenFileFailed);
+                }
+            };
+            let (materials, names) = tobj::load_mtl_buf(&mut &bytes[..]).inspect_err(|e| {
+                self.failures.push(format!("{}: {e}", file.display()));
+            })?;
+            let offset = all.len();
+            all.extend(materials);
+            match &mut by_name {
+                None => by_name = Some(names),
+                Some(index) => index.extend(names.into_iter().map(|(k, v)| (k, v + offset))),
+            }
+            self.texts
+                .push((file, String::from_utf8_lossy(&bytes).into_owned()));
+        }
+        Ok((all, by_name.unwrap_or_default()))
+    }
+
+    /// Refuses a `Kd` that is not a finite, non-negative colour, naming its file and line.
+    fn check_kd(&self, material: &tobj::Material) -> Result<(), MeshError> {
+        let Some(kd) = material.diffuse else {
+            return Ok(());
+        };
+        if kd.iter().all(|c| c.is_finite() && *c >= 0.0) {
+            return Ok(());
+        }
+        let message = format!(
+            "material {}: Kd {kd:?} must be finite and non-negative",
+            material.name
+        );
+        for (file, text) in &self.texts {
+            if let Some(line) = kd_line(text, &material.name) {
+                return Err(MeshError::Syntax {
+                    path: file.clone(),
+                    line,
+                    message,
+                });
+            }
+        }
+        Err(MeshError::Invalid {
+            path: self.texts.first().map(|t| t.0.clone()).unwrap_or_default(),
+            message,
+        })
+    }
+}
+
+/// The line (1-based) of material `name`'s `Kd` in a `.mtl` file's text.
+fn kd_line(text: &str, name: &str) -> Option<usize> {
+    let mut in_material = false;
+    for (k, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("newmtl") => in_material = words.next() == Some(name),
+            Some("Kd") if in_material => return Some(k + 1),
+            _ => {}
+        }
+    }
+    None
+}
+
 /// An 8- or 16-bit image file as an sRGB-encoded albedo texture, decoded to linear RGB.
 pub(super) fn read_srgb_texture(path: &Path) -> Result<AlbedoTexture, MeshError> {
-    let image = image::open(path).map_err(|e| MeshError::Invalid {
+    let invalid = |message: String| MeshError::Invalid {
         path: path.to_owned(),
-        message: format!("cannot read the texture: {e}"),
-    })?;
+        message,
+    };
+    let bytes = read_regular_file(path, MAX_SIDE_FILE_BYTES)
+        .map_err(|e| invalid(format!("cannot read the texture: {e}")))?;
+    let image = decode_image(&bytes).map_err(|e| invalid(format!("texture: {e}")))?;
     let rgb = image.to_rgb32f();
     // to_rgb32f only rescales the stored values: they are still sRGB-encoded.
     Ok(AlbedoTexture {

@@ -5,6 +5,7 @@ use super::description::*;
 use super::geometry::SceneMesh;
 use super::{Scene, SceneError};
 use crate::color::Rgb;
+use crate::infra::limits::MAX_SCENE_TRIANGLES;
 use crate::material::{MAX_SHININESS, Material, check_energy};
 use crate::mesh::{
     self, LoadOptions, MeshCleanup, MeshError, TriangleMesh, annulus_mesh, box_mesh,
@@ -74,8 +75,8 @@ impl Scene {
                     .or(part.albedo)
                     .ok_or_else(|| {
                         invalid(format!(
-                            "{name}: give it an albedo = [r, g, b] (only glTF models carry \
-                             their own)"
+                            "{name}: give it an albedo = [r, g, b] (its file gives it no \
+                             material hprt can read)"
                         ))
                     })?;
                 let part_name = match single {
@@ -84,6 +85,13 @@ impl Scene {
                 };
                 let world = transform_mesh(&part.mesh, &object.transform.matrix())
                     .ok_or_else(|| invalid(format!("{name}: the transform is singular")))?;
+                let total = geometry.mesh.triangle_count() + world.triangle_count();
+                if total > MAX_SCENE_TRIANGLES {
+                    return Err(invalid(format!(
+                        "{part_name}: the scene would hold {total} triangles, more than the \
+                         {MAX_SCENE_TRIANGLES} hprt takes"
+                    )));
+                }
                 if material.is_glossy() {
                     check_energy(albedo, material.specular)
                         .map_err(|m| invalid(format!("{part_name}: {m}")))?;
@@ -183,6 +191,11 @@ pub(super) enum SpecError {
     BoxSegments([u32; 3]),
     #[error("unknown box face {0:?} in skip_faces (use {faces:?})", faces = BOX_FACES)]
     BoxFace(String),
+    #[error(
+        "the object would have {0} triangles, more than the {max} a scene may hold",
+        max = MAX_SCENE_TRIANGLES
+    )]
+    TooManyTriangles(u64),
     #[error("annulus radii {inner} .. {outer} must satisfy 0 <= inner < outer")]
     AnnulusRadii { inner: f32, outer: f32 },
     #[error("annulus segments {0:?} must be at least [1, 3] and at most 4096")]
@@ -273,6 +286,11 @@ fn box_object(b: &BoxSpec) -> Result<TriangleMesh, ObjectError> {
     }
     if b.segments.iter().any(|&s| s == 0 || s > 4096) {
         return Err(SpecError::BoxSegments(b.segments).into());
+    }
+    let [x, y, z] = b.segments.map(u64::from);
+    let triangles = 4 * (x * y + y * z + z * x);
+    if triangles > MAX_SCENE_TRIANGLES as u64 {
+        return Err(SpecError::TooManyTriangles(triangles).into());
     }
     let mut skip = [false; 6];
     for face in &b.skip_faces {

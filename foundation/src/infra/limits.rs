@@ -1,0 +1,124 @@
+//! The sizes hprt accepts from files, each checked before anything of that size is allocated
+//! (CONVENTIONS.md, "Limits"), and reading a file within them.
+//!
+//! Every limit keeps a hostile or broken file from taking more than about a gigabyte of memory
+//! while staying well above what real scenes use; each constant says why it is where it is.
+
+use std::io::Read;
+use std::path::Path;
+
+/// Largest mesh or model file, and the most a gzipped mesh may expand to: a binary PLY of
+/// 30 million triangles fits, and reading the bytes stays under a gigabyte.
+pub const MAX_MESH_BYTES: u64 = 1 << 30;
+
+/// Largest file a model names beside itself (an OBJ's `.mtl`, a glTF's buffers and images).
+pub const MAX_SIDE_FILE_BYTES: u64 = 1 << 30;
+
+/// Most texels of one texture: textures are kept as linear f32 RGB (12 bytes a texel, 200 MB
+/// here) plus their mipmaps on the GPU, so a 4096² texture is the largest that stays within
+/// the memory budget; downscale larger ones.
+pub const MAX_TEXTURE_TEXELS: u64 = 4096 * 4096;
+
+/// Longest side of a texture (a long, thin texture is still bounded by its texel count).
+pub const MAX_TEXTURE_SIDE: u32 = 16_384;
+
+/// Most triangles a scene may hold after instancing: the bake's tables take about a kilobyte
+/// per vertex at order 5, so this many triangles is already tens of gigabytes of bake.
+pub const MAX_SCENE_TRIANGLES: usize = 50_000_000;
+
+/// Most worker threads `--threads` may ask for: far above any machine's cores, low enough that
+/// spawning them cannot exhaust the process's resources.
+pub const MAX_THREADS: usize = 1024;
+
+/// Why a file could not be read within a limit.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadError {
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    #[error("not a regular file (a device, a folder or a pipe cannot be read as one)")]
+    NotAFile,
+    #[error("{size} bytes, more than the {max} bytes hprt reads from such a file")]
+    TooLarge { size: u64, max: u64 },
+}
+
+/// The bytes of the regular file at `path`, refused before reading when it is not a regular
+/// file (`/dev/zero`, a folder, a FIFO) or larger than `max` bytes.
+pub fn read_regular_file(path: &Path, max: u64) -> Result<Vec<u8>, ReadError> {
+    let metadata = std::fs::metadata(path)?;
+    if !metadata.is_file() {
+        return Err(ReadError::NotAFile);
+    }
+    if metadata.len() > max {
+        return Err(ReadError::TooLarge {
+            size: metadata.len(),
+            max,
+        });
+    }
+    let mut bytes = Vec::with_capacity(metadata.len() as usize);
+    // The file may grow while it is read: never read past the limit.
+    std::fs::File::open(path)?
+        .take(max + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > max {
+        return Err(ReadError::TooLarge {
+            size: bytes.len() as u64,
+            max,
+        });
+    }
+    Ok(bytes)
+}
+
+/// The expansion of gzip data, refused once it passes `max` bytes (a small file can expand to
+/// gigabytes).
+pub fn gunzip_limited(bytes: &[u8], max: u64) -> Result<Vec<u8>, ReadError> {
+    let mut out = Vec::new();
+    flate2::read::MultiGzDecoder::new(bytes)
+        .take(max + 1)
+        .read_to_end(&mut out)?;
+    if out.len() as u64 > max {
+        return Err(ReadError::TooLarge {
+            size: out.len() as u64,
+            max,
+        });
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn devices_folders_and_large_files_are_refused_before_reading() {
+        assert!(matches!(
+            read_regular_file(Path::new("/dev/zero"), 1 << 20),
+            Err(ReadError::NotAFile)
+        ));
+        let dir = tempfile::tempdir().unwrap();
+        assert!(matches!(
+            read_regular_file(dir.path(), 1 << 20),
+            Err(ReadError::NotAFile)
+        ));
+        let file = dir.path().join("f");
+        std::fs::write(&file, [7u8; 100]).unwrap();
+        assert!(matches!(
+            read_regular_file(&file, 99),
+            Err(ReadError::TooLarge { size: 100, max: 99 })
+        ));
+        assert_eq!(read_regular_file(&file, 100).unwrap().len(), 100);
+    }
+
+    #[test]
+    fn a_gzip_bomb_stops_at_the_limit() {
+        use std::io::Write;
+        let mut encoder = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+        encoder.write_all(&vec![b' '; 1 << 22]).unwrap();
+        let gz = encoder.finish().unwrap();
+        assert!(gz.len() < 1 << 14);
+        assert!(matches!(
+            gunzip_limited(&gz, 1 << 20),
+            Err(ReadError::TooLarge { .. })
+        ));
+        assert_eq!(gunzip_limited(&gz, 1 << 22).unwrap().len(), 1 << 22);
+    }
+}
