@@ -71,7 +71,7 @@ impl Switch {
 #[derive(Args, Clone, Debug)]
 pub struct DecomposeOptions {
     /// SH order of the polynomial part (default: 5, or the bake's order when rendering).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_sh_order)]
     pub order: Option<usize>,
     /// Weber fraction: keep lights while each adds more than this share of the luminance of
     /// the brighter ones.
@@ -209,7 +209,7 @@ pub struct ReportOptions {
     pub target_noise: Option<NoiseTarget>,
     /// With --target-noise: stop before a pass that would end after this many seconds of
     /// rendering one map's reference.
-    #[arg(long, value_parser = parse_positive_f64)]
+    #[arg(long, value_parser = parse_positive_f64, requires = "target_noise")]
     pub reference_time_limit: Option<f64>,
     /// Weber thresholds of the error-against-threshold plot.
     #[arg(long, num_args = 1.., default_values_t = [0.0, 0.02, 0.05, 0.1, 0.2, 0.4])]
@@ -257,6 +257,16 @@ pub fn parse_vec3(text: &str) -> Result<glam::Vec3, String> {
         [x, y, z] => Ok(glam::Vec3::new(x, y, z)),
         _ => Err(format!("expected three numbers \"x,y,z\", got {text:?}")),
     }
+}
+
+/// An SH order hprt supports (1 to `foundation::sh::MAX_ORDER`).
+pub fn parse_sh_order(text: &str) -> Result<usize, String> {
+    let order: usize = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("expected a whole number, got {text:?}"))?;
+    foundation::sh::check_order(order).map_err(|e| e.to_string())?;
+    Ok(order)
 }
 
 /// A finite number above zero, in double precision.

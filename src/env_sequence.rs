@@ -40,10 +40,17 @@ struct SunSpec {
     from: [f32; 2],
     /// ... and at the last.
     to: [f32; 2],
-    angular_radius_deg: f32,
+    angular_radius_deg: toml::Spanned<f32>,
     /// `∫ L dω` of the disc above the base map, RGB.
-    power: [f32; 3],
+    power: toml::Spanned<[f32; 3]>,
 }
+
+/// Smallest angular radius of a sequence's sun: below it the disc falls between the texels of
+/// any map (a texel of an 8192-wide map spans 0.044°) and its radiance overflows.
+const MIN_SUN_RADIUS_DEG: f32 = 0.01;
+/// Largest power per channel of a sequence's sun: the real sun's is about 1e5 in the units of
+/// a map whose sky is near 1; a thousand times more still leaves room in single precision.
+const MAX_SUN_POWER: f32 = 1e8;
 
 /// Where a sequence's frames come from.
 pub enum Sequence {
@@ -68,6 +75,9 @@ impl Sequence {
         } else {
             Self::from_file(path)?
         };
+        if let Self::Files(paths) = &sequence {
+            check_frames(paths)?;
+        }
         anyhow::ensure!(
             (1..=MAX_FRAMES).contains(&sequence.len()),
             "{}: a sequence has 1 to {MAX_FRAMES} frames, this one {}",
@@ -109,25 +119,14 @@ impl Sequence {
             });
         }
         let s = spec.sun.expect("one of the four is given");
-        anyhow::ensure!(
-            s.angular_radius_deg > 0.0 && s.angular_radius_deg <= 45.0,
-            "{}: angular_radius_deg must be in (0, 45], got {}",
-            path.display(),
-            s.angular_radius_deg
-        );
-        anyhow::ensure!(
-            s.power.iter().all(|p| p.is_finite() && *p >= 0.0)
-                && s.from.iter().chain(&s.to).all(|a| a.is_finite()),
-            "{}: the sun's power and angles must be finite (power not negative)",
-            path.display()
-        );
+        check_sun(path, &text, &s)?;
         Ok(Self::Sun {
             base: load_map(&resolve(&s.base), None)?.map,
             arc: SunArc {
                 from: direction_of(s.from[0], s.from[1]),
                 to: direction_of(s.to[0], s.to[1]),
-                angular_radius: s.angular_radius_deg.to_radians(),
-                power: glam::Vec3::from_array(s.power),
+                angular_radius: s.angular_radius_deg.get_ref().to_radians(),
+                power: glam::Vec3::from_array(*s.power.get_ref()),
             },
             frames: s.frames,
         })
@@ -184,6 +183,11 @@ pub fn lighting_at_frame(
     rotation_deg: f32,
     last: usize,
 ) -> anyhow::Result<runtime::EnvironmentLighting> {
+    anyhow::ensure!(
+        last < sequence.len(),
+        "--frame {last}: the sequence has frames 0 to {}",
+        sequence.len() - 1
+    );
     let mut lighting = runtime::EnvironmentLighting::new(&sequence.frame(0)?, settings)?;
     lighting.enable_tracking(Some(runtime::TrackingSettings::default()))?;
     lighting.set_rotation(rotation_deg);
@@ -197,6 +201,45 @@ pub fn lighting_at_frame(
 }
 
 /// The `.exr` and `.hdr` files of `folder`, sorted by name.
+/// Refuses a sun whose radius or power is out of range, naming the file and line.
+fn check_sun(path: &Path, text: &str, s: &SunSpec) -> anyhow::Result<()> {
+    let line =
+        |span: std::ops::Range<usize>| text[..span.start.min(text.len())].lines().count().max(1);
+    let radius = *s.angular_radius_deg.get_ref();
+    anyhow::ensure!(
+        (MIN_SUN_RADIUS_DEG..=45.0).contains(&radius),
+        "{}: line {}: angular_radius_deg must be in [{MIN_SUN_RADIUS_DEG}, 45], got {radius}",
+        path.display(),
+        line(s.angular_radius_deg.span())
+    );
+    let power = *s.power.get_ref();
+    anyhow::ensure!(
+        power
+            .iter()
+            .all(|p| p.is_finite() && (0.0..=MAX_SUN_POWER).contains(p)),
+        "{}: line {}: the sun's power {power:?} must be finite, not negative and at most \
+         {MAX_SUN_POWER:e} per channel",
+        path.display(),
+        line(s.power.span())
+    );
+    anyhow::ensure!(
+        s.from.iter().chain(&s.to).all(|a| a.is_finite()),
+        "{}: the sun's from and to angles must be finite",
+        path.display()
+    );
+    Ok(())
+}
+
+/// Checks that every frame file is there and readable as a map header, before any frame is
+/// rendered (a missing last frame must not cost the whole sequence's work first).
+fn check_frames(paths: &[PathBuf]) -> anyhow::Result<()> {
+    for (k, path) in paths.iter().enumerate() {
+        foundation::envmap::read_size(path)
+            .map_err(|e| anyhow::anyhow!("frame {k} of the sequence cannot be read: {e}"))?;
+    }
+    Ok(())
+}
+
 fn maps_in(folder: &Path) -> anyhow::Result<Vec<PathBuf>> {
     let mut maps: Vec<PathBuf> = std::fs::read_dir(folder)
         .with_context(|| format!("cannot read the folder {}", folder.display()))?

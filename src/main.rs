@@ -6,6 +6,7 @@ mod cli;
 mod commands;
 mod env_sequence;
 mod maps;
+mod outputs;
 mod report;
 mod support;
 mod view;

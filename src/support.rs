@@ -42,33 +42,6 @@ pub fn create_folder(dir: &Path) -> anyhow::Result<()> {
         .with_context(|| format!("cannot create the folder {}", dir.display()))
 }
 
-/// Refuses two outputs of one command at the same file (`(option, path)` pairs).
-pub fn distinct_outputs(outputs: &[(&str, Option<&Path>)]) -> anyhow::Result<()> {
-    let key = |p: &Path| {
-        let dir = p
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_owned());
-        (dir, p.file_name().map(|n| n.to_owned()))
-    };
-    let given: Vec<(&str, &Path)> = outputs
-        .iter()
-        .filter_map(|(option, path)| path.map(|p| (*option, p)))
-        .collect();
-    for (i, (a, pa)) in given.iter().enumerate() {
-        for (b, pb) in &given[i + 1..] {
-            if key(pa) == key(pb) {
-                anyhow::bail!(
-                    "{a} and {b} name the same file {}: give each output its own path",
-                    pb.display()
-                );
-            }
-        }
-    }
-    Ok(())
-}
-
 /// Median of a non-empty sample.
 pub fn median(mut xs: Vec<f64>) -> f64 {
     xs.sort_by(f64::total_cmp);

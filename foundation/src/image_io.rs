@@ -134,6 +134,10 @@ use image::ImageEncoder;
 
 /// Tone maps with `exposure` and writes an sRGB PNG.
 pub fn write_png(path: &Path, image: &RgbImageF32, exposure: f32) -> Result<(), ImageError> {
+    check_finite(image, "PNG").map_err(|e| ImageError::Write {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })?;
     write_png_rgb8(
         path,
         image.width,
@@ -152,9 +156,28 @@ pub fn write_exr(path: &Path, image: &RgbImageF32) -> Result<(), ImageError> {
     write_atomic(path, &bytes).map_err(|e| error(e.to_string()))
 }
 
-/// The OpenEXR file of an image, in memory (32-bit float RGB, ZIP compression).
+/// Refuses an image with a NaN or infinite pixel: such an image is a failed computation, and
+/// written it would look like a result (a NaN becomes black in a PNG).
+pub fn check_finite(image: &RgbImageF32, format: &'static str) -> Result<(), EncodeError> {
+    let bad = image.pixels.iter().filter(|p| !p.is_finite()).count();
+    if bad > 0 {
+        return Err(EncodeError {
+            format,
+            message: format!(
+                "{bad} of its {} pixels are NaN or infinite: a failed computation is not \
+                 written as an image",
+                image.pixels.len()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The OpenEXR file of an image, in memory (32-bit float RGB, ZIP compression); refused when
+/// a pixel is not finite.
 pub fn exr_bytes(image: &RgbImageF32) -> Result<Vec<u8>, EncodeError> {
     use exr::prelude::*;
+    check_finite(image, "EXR")?;
     let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
         let c = image.get(p.x(), p.y());
         (c.x, c.y, c.z)

@@ -1,6 +1,7 @@
 //! `hprt bake`: the offline transfer bake.
 
 use crate::bake_cache::print_bake_stats;
+use crate::outputs::{check_outputs, scene_inputs};
 use crate::support::{TerminalProgress, load_scene, with_threads};
 use anyhow::Context;
 use clap::Args;
@@ -52,6 +53,7 @@ pub fn settings_for(scene: &Scene, args: &BakeArgs) -> anyhow::Result<BakeSettin
 pub fn run(args: BakeArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let settings = settings_for(&scene, &args)?;
+    check_outputs(&scene_inputs(&scene, &[]), &[("-o", Some(&args.output))])?;
     // Fail on an unwritable destination before spending minutes baking.
     let output = AtomicOutput::create(&args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;

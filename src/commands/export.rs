@@ -1,10 +1,11 @@
 //! `hprt export`: the scene as hprt sees it, for Mitsuba 3.
 
 use crate::cli::{EnvironmentArgs, ImageSizeArgs};
+use crate::outputs::{check_folder_output, scene_inputs};
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
-use reference::export::{ExportSettings, export_mitsuba, mitsuba_max_depth};
+use reference::export::{ExportSettings, export_files, export_mitsuba, mitsuba_max_depth};
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -31,6 +32,12 @@ pub fn run(args: ExportArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let env = args.environment.choose(&scene)?;
     let camera = args.size.camera(&scene)?;
+    check_folder_output(
+        &scene_inputs(&scene, &[Some(&env.path)]),
+        "-o",
+        &args.output,
+        &export_files(&args.output, &scene.geometry),
+    )?;
     let settings = ExportSettings {
         camera,
         rotation_deg: env.rotation_deg,

@@ -2,14 +2,15 @@
 
 use crate::cli::{EnvironmentArgs, ImageSizeArgs};
 use crate::maps::default_exposure;
+use crate::outputs::{check_outputs, scene_inputs};
 use crate::support::{TerminalProgress, load_scene, with_threads};
 use anyhow::Context;
 use clap::Args;
 use foundation::bvh::SceneBvh;
-use foundation::image_io::{RgbImageF32, exr_bytes, write_exr, write_png};
-use foundation::infra::atomic_file::AtomicOutput;
+use foundation::image_io::{RgbImageF32, exr_bytes, png_bytes, to_display_rgb8};
+use foundation::infra::atomic_file::{AtomicOutput, commit_all};
 use reference::{self, EnvironmentLight, ReferenceImage, ReferenceSettings, SamplerKind};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Args)]
 pub struct ReferenceArgs {
@@ -49,23 +50,15 @@ pub struct ReferenceArgs {
     pub aux: Option<PathBuf>,
 }
 
-/// Writes a single-channel image as grey EXR and PNG.
-pub fn write_grey(
-    dir: &Path,
-    name: &str,
-    width: usize,
-    height: usize,
-    values: &[f32],
-) -> anyhow::Result<()> {
+/// A single-channel image as grey EXR and PNG files' bytes.
+fn grey_files(width: usize, height: usize, values: &[f32]) -> anyhow::Result<[Vec<u8>; 2]> {
     let image = RgbImageF32::from_grey(width, height, values);
-    write_exr(&dir.join(format!("{name}.exr")), &image)?;
     // Linear 0..1 shown directly (exposure chosen so that tonemap(1) is near white).
     let rgb: Vec<u8> = values
         .iter()
         .flat_map(|v| [(v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8; 3])
         .collect();
-    foundation::image_io::write_png_rgb8(&dir.join(format!("{name}.png")), width, height, &rgb)?;
-    Ok(())
+    Ok([exr_bytes(&image)?, png_bytes(&rgb, width, height)?])
 }
 
 pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
@@ -77,14 +70,34 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
         ..ReferenceSettings::new(args.spp, args.bounces, args.seed)
     };
     settings.validate()?;
-    crate::support::distinct_outputs(&[
-        ("-o", Some(&args.output)),
+    let inputs = scene_inputs(&scene, &[Some(&env.path)]);
+    let aux: Vec<PathBuf> = args
+        .aux
+        .iter()
+        .flat_map(|dir| {
+            ["coverage", "visibility"]
+                .into_iter()
+                .flat_map(move |name| ["exr", "png"].map(|ext| dir.join(format!("{name}.{ext}"))))
+        })
+        .collect();
+    let mut outputs = vec![
+        ("-o", Some(args.output.as_path())),
         ("--png", args.png.as_deref()),
-    ])?;
-    let output = AtomicOutput::create(&args.output)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    ];
+    outputs.extend(aux.iter().map(|p| ("--aux", Some(p.as_path()))));
+    check_outputs(&inputs, &outputs)?;
     if let Some(dir) = &args.aux {
         crate::support::create_folder(dir)?;
+    }
+    // Every output is opened before the render, so an unwritable one fails first, and all are
+    // written together at the end, or none.
+    let mut files = Vec::new();
+    for (_, path) in &outputs {
+        if let Some(path) = path {
+            let output = AtomicOutput::create(path)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            files.push(output);
+        }
     }
     println!(
         "{}: {}x{}, {} spp, {} bounces, lit by {} rotated {}°",
@@ -102,21 +115,24 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
         let progress = TerminalProgress::new("rendering rows");
         reference::render(&scene.geometry, &bvh, &light, &camera, &settings, &progress)
     })?;
-    let exr = exr_bytes(&image.radiance)?;
-    output
-        .commit(&exr)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
     let exposure = args
         .exposure
         .unwrap_or_else(|| default_exposure(&env.loaded.map));
-    if let Some(png) = &args.png {
-        write_png(png, &image.radiance, exposure)?;
+    let mut bytes = vec![exr_bytes(&image.radiance).context("the render failed")?];
+    if args.png.is_some() {
+        let (w, h) = (image.radiance.width, image.radiance.height);
+        bytes.push(png_bytes(
+            &to_display_rgb8(&image.radiance, exposure),
+            w,
+            h,
+        )?);
     }
-    if let Some(dir) = &args.aux {
+    if args.aux.is_some() {
         let (w, h) = (camera.width as usize, camera.height as usize);
-        write_grey(dir, "coverage", w, h, &image.coverage)?;
-        write_grey(dir, "visibility", w, h, &image.visibility)?;
+        bytes.extend(grey_files(w, h, &image.coverage)?);
+        bytes.extend(grey_files(w, h, &image.visibility)?);
     }
+    commit_all(files.into_iter().zip(bytes).collect()).context("cannot write the outputs")?;
     let megapixel_samples = camera.width as f64 * camera.height as f64 * settings.spp as f64 / 1e6;
     println!(
         "rendered in {:.2} s: {:.2} M rays/s, {:.3} s per megapixel per sample; wrote {}",

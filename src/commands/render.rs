@@ -6,11 +6,12 @@ use crate::cli::{
 };
 use crate::env_sequence::{Sequence, lighting_at_frame};
 use crate::maps::{default_exposure, scene_rotation};
+use crate::outputs::{check_outputs, scene_inputs};
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
-use foundation::image_io::{RgbImageF32, exr_bytes, png_bytes, to_display_rgb8};
-use foundation::infra::atomic_file::AtomicOutput;
+use foundation::image_io::{RgbImageF32, check_finite, exr_bytes, png_bytes, to_display_rgb8};
+use foundation::infra::atomic_file::{AtomicOutput, commit_all};
 use runtime::render::{GpuContext, Renderer};
 use runtime::{DecomposeMode, EnvironmentLighting};
 use std::path::PathBuf;
@@ -70,10 +71,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     camera.target = args.camera_target.unwrap_or(camera.target);
     camera.fov_y_deg = args.fov.unwrap_or(camera.fov_y_deg);
     camera.validate()?;
-    crate::support::distinct_outputs(&[
-        ("-o", Some(&args.output)),
-        ("--exr", args.exr.as_deref()),
-    ])?;
+    let inputs = scene_inputs(&scene, &[Some(&args.bake), args.environment.env.as_deref()]);
+    check_outputs(
+        &inputs,
+        &[("-o", Some(&args.output)), ("--exr", args.exr.as_deref())],
+    )?;
     let output = AtomicOutput::create(&args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     let exr_output = match &args.exr {
@@ -130,18 +132,17 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let exposure = args
         .exposure
         .unwrap_or_else(|| default_exposure(lighting.map()));
+    check_finite(&image, "PNG").context("the render failed")?;
     let png = png_bytes(
         &to_display_rgb8(&image, exposure),
         image.width,
         image.height,
     )?;
-    output
-        .commit(&png)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    let mut outputs = vec![(output, png)];
     if let Some(exr) = exr_output {
-        let bytes = exr_bytes(&image)?;
-        exr.commit(&bytes).context("cannot write the EXR")?;
+        outputs.push((exr, exr_bytes(&image)?));
     }
+    commit_all(outputs).context("cannot write the outputs")?;
     println!(
         "{} mode, {} light(s), {} {:.2} ms; wrote {}",
         args.render.mode.name(),

@@ -5,9 +5,12 @@ use crate::bake_cache;
 use crate::cli::ReportOptions;
 use crate::env_sequence::Sequence;
 use crate::maps::maps_beside;
+use crate::outputs::{check_folder_spares_inputs, scene_inputs};
 use crate::report;
 use crate::support::load_scene;
+use anyhow::Context;
 use clap::Args;
+use foundation::infra::atomic_file::AtomicFolder;
 use foundation::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -63,20 +66,30 @@ pub(crate) fn write_report(
         );
     }
     anyhow::ensure!(!envs.is_empty(), "no environment maps to report on");
+    let mut inputs = scene_inputs(scene, &[options.bake.as_deref()]);
+    inputs.extend(envs.iter().map(PathBuf::as_path));
+    check_folder_spares_inputs(&inputs, "-o", output)?;
     let (bake_path, transfer) = bake_cache::bake_for(scene, options.bake.as_deref())?;
     let camera = options.size.camera(scene)?;
     let settings = options.report_settings(&camera, &transfer);
-    let report = report::run_report(scene, &transfer, &bake_path, envs, &settings, output)?;
+    // Written beside the destination and moved into place at the end: an interrupted or
+    // failed report leaves the previous one untouched, and nothing new.
+    let folder = AtomicFolder::create(output)
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    let report = report::run_report(scene, &transfer, &bake_path, envs, &settings, folder.path())?;
     report::print_summary(&report, scene.geometry.is_glossy());
-    println!("\nwrote {}", output.join("report.html").display());
     let failed = report
         .maps
         .iter()
         .filter(|m| m.status == report::MapStatus::Failed)
         .count();
     if failed == report.maps.len() {
-        anyhow::bail!("every map failed; see the messages above");
+        anyhow::bail!("every map failed; see the messages above (nothing written)");
     }
+    folder
+        .commit()
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    println!("\nwrote {}", output.join("report.html").display());
     Ok(())
 }
 
@@ -88,12 +101,19 @@ fn write_sequence_report(
     out: &Path,
 ) -> anyhow::Result<()> {
     let sequence = Sequence::load(sequence_path)?;
+    check_folder_spares_inputs(
+        &scene_inputs(scene, &[options.bake.as_deref(), Some(sequence_path)]),
+        "-o",
+        out,
+    )?;
     let (_, transfer) = bake_cache::bake_for(scene, options.bake.as_deref())?;
     let camera = options.size.camera(scene)?;
     let settings = report::ReportSettings {
         thresholds: Vec::new(),
         ..options.report_settings(&camera, &transfer)
     };
+    let folder =
+        AtomicFolder::create(out).with_context(|| format!("cannot write {}", out.display()))?;
     report::sequence::write_sequence_report(
         scene,
         &sequence,
@@ -101,6 +121,11 @@ fn write_sequence_report(
         &transfer,
         camera,
         &settings,
-        out,
-    )
+        folder.path(),
+    )?;
+    folder
+        .commit()
+        .with_context(|| format!("cannot write {}", out.display()))?;
+    println!("\nwrote {}", out.join("report.html").display());
+    Ok(())
 }

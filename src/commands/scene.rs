@@ -1,6 +1,7 @@
 //! `hprt scene init`: the scene a bare model gets (placed, framed, on a ground slab), written
 //! as a scene file to edit.
 
+use crate::outputs::check_outputs;
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use foundation::infra::atomic_file::write_atomic;
@@ -46,6 +47,7 @@ fn init(args: SceneInitArgs) -> anyhow::Result<()> {
         "{}: not a model file (expected .gltf, .glb, .obj, .ply or .bpt)",
         args.model.display()
     );
+    check_outputs(&[&args.model], &[("-o", Some(&args.output))])?;
     anyhow::ensure!(
         args.force || !args.output.exists(),
         "{} exists: pass --force to replace it",

@@ -296,6 +296,28 @@ fn render_pass(
     }
 }
 
+/// The cached reference at `paths`, if there is a readable one.
+fn cached(paths: &CachePaths, key: &str, glossy: bool) -> Option<ReferenceImages> {
+    if !paths.meta.exists() {
+        return None;
+    }
+    match paths.load(glossy) {
+        Ok(images) => Some(images),
+        Err(e) => {
+            log::warn!("the cached reference {key} is unreadable ({e:#}); rendering it again");
+            None
+        }
+    }
+}
+
+/// The most samples per half a reference takes with `sampler`.
+fn sample_limit(sampler: SamplerKind) -> u32 {
+    match sampler {
+        SamplerKind::Sobol => MAX_SOBOL_SAMPLES,
+        SamplerKind::Independent => u32::MAX / 2,
+    }
+}
+
 /// The reference `request` asks for: from the cache, continued from it, or rendered (then
 /// cached). `best_error` gives the best method's mean error against a reference, for a
 /// target relative to it.
@@ -309,21 +331,8 @@ pub(crate) fn reference_images(
 ) -> anyhow::Result<ReferenceImages> {
     let key = reference_key(scene, camera, map, rotation_deg, request)?;
     let paths = CachePaths::new(&key);
-    let mut current = if paths.meta.exists() {
-        match paths.load(scene.geometry.is_glossy()) {
-            Ok(images) => Some(images),
-            Err(e) => {
-                log::warn!("the cached reference {key} is unreadable ({e:#}); rendering it again");
-                None
-            }
-        }
-    } else {
-        None
-    };
-    let limit = match request.sampler {
-        SamplerKind::Sobol => MAX_SOBOL_SAMPLES,
-        SamplerKind::Independent => u32::MAX / 2,
-    };
+    let mut current = cached(&paths, &key, scene.geometry.is_glossy());
+    let limit = sample_limit(request.sampler);
     let start = Instant::now();
     let mut seconds_per_sample = None;
     let view = std::cell::OnceCell::new();
@@ -362,18 +371,29 @@ pub(crate) fn reference_images(
             };
             let floor = images.noise(request.exposure).mean;
             let n = images.samples_per_half;
-            if floor <= target || n >= limit {
+            if floor <= target {
                 break;
             }
-            // Noise falls at least as 1/√n: the samples that should reach the target.
-            let needed = (f64::from(n) * (floor / target).powi(2)).ceil();
+            if n >= limit {
+                log::warn!(
+                    "reference: the target noise {target:.5} was missed: the noise floor is \
+                     {floor:.5} at 2 × {n} spp, the most samples the reference takes"
+                );
+                break;
+            }
+            // Noise falls at least as 1/√n: the samples that should reach the target, at most
+            // the sampler's limit (a target far below the noise would predict ages).
+            let needed = (f64::from(n) * (floor / target).powi(2))
+                .ceil()
+                .min(f64::from(limit));
             let next = (2 * n).min(limit);
             if let (Some(max), Some(per_sample)) = (request.max_seconds, seconds_per_sample) {
                 let elapsed = start.elapsed().as_secs_f64();
                 if elapsed + per_sample * f64::from(next - n) > max {
-                    println!(
-                        "reference: noise floor {floor:.5} above the target {target:.5} at 2 × {n} \
-                         spp; the next pass would end after the {max} s limit"
+                    log::warn!(
+                        "reference: the target noise {target:.5} was missed: the noise floor is \
+                         {floor:.5} at 2 × {n} spp, and the next pass would end after the \
+                         {max} s limit"
                     );
                     break;
                 }

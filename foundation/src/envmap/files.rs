@@ -174,3 +174,37 @@ pub(crate) fn check_size(path: &Path, width: usize, height: usize) -> Result<(),
         }),
     }
 }
+
+/// The size an environment map file declares, read from its header alone (a cheap check that
+/// a file is there and is a map before any work depends on it).
+pub fn read_size(path: &Path) -> Result<(usize, usize), EnvMapError> {
+    let decode = |message: String| EnvMapError::Decode {
+        path: path.to_owned(),
+        message,
+    };
+    let is_exr = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !path.is_file() {
+        return Err(EnvMapError::Io {
+            path: path.to_owned(),
+            cause: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+        });
+    }
+    if is_exr {
+        let meta =
+            exr::meta::MetaData::read_from_file(path, false).map_err(|e| decode(e.to_string()))?;
+        let size = meta
+            .headers
+            .first()
+            .map(|h| h.layer_size)
+            .ok_or_else(|| decode("the file has no layer".into()))?;
+        return Ok((size.width(), size.height()));
+    }
+    let (w, h) = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| decode(e.to_string()))?
+        .into_dimensions()
+        .map_err(|e| decode(e.to_string()))?;
+    Ok((w as usize, h as usize))
+}

@@ -13,6 +13,7 @@ mod mapping;
 pub mod sampling;
 
 pub use error::EnvMapError;
+pub use files::read_size;
 pub use layouts::Layout;
 pub use load::{LoadedEnvMap, MIN_MAP_WIDTH, load};
 use mapping::v_of_direction;

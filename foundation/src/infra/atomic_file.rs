@@ -32,7 +32,11 @@ static PARTIALS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new
 pub fn remove_partials() {
     if let Ok(partials) = PARTIALS.lock() {
         for path in partials.iter() {
-            let _ = std::fs::remove_file(path);
+            if path.is_dir() {
+                let _ = std::fs::remove_dir_all(path);
+            } else {
+                let _ = std::fs::remove_file(path);
+            }
         }
     }
 }
@@ -145,6 +149,30 @@ impl AtomicOutput {
     }
 }
 
+/// Writes several outputs all or none: every temporary file is written and synced first, and
+/// only then are they moved into place, so a failure while writing leaves none of them.
+pub fn commit_all(outputs: Vec<(AtomicOutput, Vec<u8>)>) -> Result<(), std::io::Error> {
+    let mut ready = Vec::with_capacity(outputs.len());
+    for (mut output, bytes) in outputs {
+        if let Some(Target::Temporary(temp)) = &mut output.target {
+            temp.write_all(&bytes)?;
+            temp.as_file().sync_all()?;
+        }
+        ready.push((output, bytes));
+    }
+    for (mut output, bytes) in ready {
+        match output.target.take() {
+            None => {}
+            Some(Target::Direct(mut file)) => file.write_all(&bytes)?,
+            Some(Target::Temporary(temp)) => {
+                forget_partial(temp.path());
+                temp.persist(&output.path).map_err(|e| e.error)?;
+            }
+        }
+    }
+    Ok(())
+}
+
 fn forget_partial(path: &Path) {
     if let Ok(mut partials) = PARTIALS.lock() {
         partials.retain(|p| p != path);
@@ -162,6 +190,84 @@ impl Drop for AtomicOutput {
 /// Writes `bytes` to `path` atomically.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), std::io::Error> {
     AtomicOutput::create(path)?.commit(bytes)
+}
+
+/// A folder of outputs (a report) written in full beside its destination and moved into place
+/// at the end: an interrupted or failed run leaves the previous folder as it was and nothing
+/// new, never a mix of old and new files.
+pub struct AtomicFolder {
+    temporary: PathBuf,
+    destination: PathBuf,
+    committed: bool,
+}
+
+impl AtomicFolder {
+    /// An empty temporary folder beside `destination` (whose parent is made if missing).
+    pub fn create(destination: &Path) -> Result<Self, std::io::Error> {
+        let name = destination
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "output".into());
+        let parent = match destination.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        std::fs::create_dir_all(parent)?;
+        if destination.exists() && !destination.is_dir() {
+            return Err(std::io::Error::other(format!(
+                "{} is a file; name a folder to write",
+                destination.display()
+            )));
+        }
+        let temporary = parent.join(format!(".{name}.{}.partial", std::process::id()));
+        if temporary.exists() {
+            std::fs::remove_dir_all(&temporary)?;
+        }
+        std::fs::create_dir(&temporary)?;
+        if let Ok(mut partials) = PARTIALS.lock() {
+            partials.push(temporary.clone());
+        }
+        Ok(Self {
+            temporary,
+            destination: destination.to_owned(),
+            committed: false,
+        })
+    }
+
+    /// Where to write the outputs until [`Self::commit`].
+    pub fn path(&self) -> &Path {
+        &self.temporary
+    }
+
+    /// Replaces the destination (if any) by the finished folder.
+    pub fn commit(mut self) -> Result<(), std::io::Error> {
+        let old = self.temporary.with_extension("old");
+        let had_old = self.destination.exists();
+        if had_old {
+            std::fs::rename(&self.destination, &old)?;
+        }
+        if let Err(e) = std::fs::rename(&self.temporary, &self.destination) {
+            if had_old {
+                let _ = std::fs::rename(&old, &self.destination);
+            }
+            return Err(e);
+        }
+        self.committed = true;
+        forget_partial(&self.temporary);
+        if had_old {
+            std::fs::remove_dir_all(&old)?;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for AtomicFolder {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_dir_all(&self.temporary);
+            forget_partial(&self.temporary);
+        }
+    }
 }
 
 #[cfg(test)]

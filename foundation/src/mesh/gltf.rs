@@ -174,27 +174,7 @@ impl Loader<'_> {
                 );
                 continue;
             }
-            for (semantic, accessor) in primitive.attributes() {
-                self.check_accessor(&name, &format!("{semantic:?}"), &accessor)?;
-                check_type(&semantic, &accessor)
-                    .map_err(|m| self.invalid(format!("{name}: {m}")))?;
-            }
-            if let Some(indices) = primitive.indices() {
-                self.check_accessor(&name, "indices", &indices)?;
-                let index_type = matches!(
-                    indices.data_type(),
-                    DataType::U8 | DataType::U16 | DataType::U32
-                );
-                if !index_type || indices.dimensions() != Dimensions::Scalar {
-                    return Err(self.invalid(format!(
-                        "{name}: its indices (accessor {}) are {:?} {:?}; glTF indices are \
-                         unsigned integer scalars",
-                        indices.index(),
-                        indices.data_type(),
-                        indices.dimensions()
-                    )));
-                }
-            }
+            self.check_primitive(&name, &primitive)?;
             let reader = primitive.reader(|b| self.buffers.get(b.index()).map(|d| &d[..]));
             let positions: Vec<Vec3> = reader
                 .read_positions()
@@ -256,6 +236,31 @@ impl Loader<'_> {
                 mesh: raw,
                 material: Some(material),
             });
+        }
+        Ok(())
+    }
+
+    /// Checks every accessor of a primitive before the `gltf` crate's reader touches it.
+    fn check_primitive(&self, name: &str, primitive: &gltf::Primitive) -> Result<(), MeshError> {
+        for (semantic, accessor) in primitive.attributes() {
+            self.check_accessor(name, &format!("{semantic:?}"), &accessor)?;
+            check_type(&semantic, &accessor).map_err(|m| self.invalid(format!("{name}: {m}")))?;
+        }
+        if let Some(indices) = primitive.indices() {
+            self.check_accessor(name, "indices", &indices)?;
+            let index_type = matches!(
+                indices.data_type(),
+                DataType::U8 | DataType::U16 | DataType::U32
+            );
+            if !index_type || indices.dimensions() != Dimensions::Scalar {
+                return Err(self.invalid(format!(
+                    "{name}: its indices (accessor {}) are {:?} {:?}; glTF indices are \
+                     unsigned integer scalars",
+                    indices.index(),
+                    indices.data_type(),
+                    indices.dimensions()
+                )));
+            }
         }
         Ok(())
     }

@@ -47,66 +47,7 @@ impl Scene {
         }
         let mut geometry = SceneMesh::default();
         for (index, object) in file.objects.iter().enumerate() {
-            let name = object
-                .name
-                .clone()
-                .unwrap_or_else(|| format!("#{}", index + 1));
-            if let Some(albedo) = object.albedo
-                && !albedo.iter().all(|a| (0.0..1.0).contains(a))
-            {
-                return Err(invalid(format!(
-                    "{name}: albedo {albedo:?} must be in [0, 1) per channel"
-                )));
-            }
-            let material = object_material(object).map_err(|m| invalid(format!("{name}: {m}")))?;
-            let parts = load_object_parts(dir, object).map_err(|e| match e {
-                ObjectError::Mesh(cause) => SceneError::Mesh {
-                    scene: path.to_owned(),
-                    object: name.clone(),
-                    cause,
-                },
-                ObjectError::Spec(m) => invalid(format!("{name}: {m}")),
-            })?;
-            let single = parts.len() == 1;
-            for part in parts {
-                let albedo = object
-                    .albedo
-                    .map(Rgb::from)
-                    .or(part.albedo)
-                    .ok_or_else(|| {
-                        invalid(format!(
-                            "{name}: give it an albedo = [r, g, b] (its file gives it no \
-                             material hprt can read)"
-                        ))
-                    })?;
-                let part_name = match single {
-                    true => name.clone(),
-                    false => format!("{name}/{}", part.name),
-                };
-                let world = transform_mesh(&part.mesh, &object.transform.matrix())
-                    .ok_or_else(|| invalid(format!("{name}: the transform is singular")))?;
-                let total = geometry.mesh.triangle_count() + world.triangle_count();
-                if total > MAX_SCENE_TRIANGLES {
-                    return Err(invalid(format!(
-                        "{part_name}: the scene would hold {total} triangles, more than the \
-                         {MAX_SCENE_TRIANGLES} hprt takes"
-                    )));
-                }
-                if material.is_glossy() {
-                    check_energy(albedo, material.specular)
-                        .map_err(|m| invalid(format!("{part_name}: {m}")))?;
-                }
-                // An albedo in the scene file replaces the model's material, texture included.
-                match (object.albedo, part.texture) {
-                    (None, Some(texture)) => {
-                        geometry.push_textured_object(part_name, &world, albedo, texture)
-                    }
-                    _ => geometry.push_object(part_name, &world, albedo),
-                }
-                if let Some(o) = geometry.objects.last_mut() {
-                    o.material = material;
-                }
-            }
+            add_object(&mut geometry, path, dir, index, object)?;
         }
         if let Some(env) = &file.environment
             && !env.rotation_deg.is_finite()
@@ -131,8 +72,91 @@ impl Scene {
             camera: file.camera,
             environment,
             bake: file.bake,
+            sources: std::iter::once(path.to_owned())
+                .chain(
+                    file.objects
+                        .iter()
+                        .filter_map(|o| o.mesh.as_ref().map(|m| dir.join(m))),
+                )
+                .collect(),
         })
     }
+}
+
+/// Loads `object` (the `index`-th of the scene file at `path`), checks its material and
+/// transform, and adds its parts to `geometry`.
+fn add_object(
+    geometry: &mut SceneMesh,
+    path: &Path,
+    dir: &Path,
+    index: usize,
+    object: &ObjectSpec,
+) -> Result<(), SceneError> {
+    let invalid = |message: String| SceneError::Invalid {
+        path: path.to_owned(),
+        message,
+    };
+    let name = object
+        .name
+        .clone()
+        .unwrap_or_else(|| format!("#{}", index + 1));
+    if let Some(albedo) = object.albedo
+        && !albedo.iter().all(|a| (0.0..1.0).contains(a))
+    {
+        return Err(invalid(format!(
+            "{name}: albedo {albedo:?} must be in [0, 1) per channel"
+        )));
+    }
+    let material = object_material(object).map_err(|m| invalid(format!("{name}: {m}")))?;
+    let parts = load_object_parts(dir, object).map_err(|e| match e {
+        ObjectError::Mesh(cause) => SceneError::Mesh {
+            scene: path.to_owned(),
+            object: name.clone(),
+            cause,
+        },
+        ObjectError::Spec(m) => invalid(format!("{name}: {m}")),
+    })?;
+    let single = parts.len() == 1;
+    for part in parts {
+        let albedo = object
+            .albedo
+            .map(Rgb::from)
+            .or(part.albedo)
+            .ok_or_else(|| {
+                invalid(format!(
+                    "{name}: give it an albedo = [r, g, b] (its file gives it no \
+                     material hprt can read)"
+                ))
+            })?;
+        let part_name = match single {
+            true => name.clone(),
+            false => format!("{name}/{}", part.name),
+        };
+        let world = transform_mesh(&part.mesh, &object.transform.matrix())
+            .ok_or_else(|| invalid(format!("{name}: the transform is singular")))?;
+        let total = geometry.mesh.triangle_count() + world.triangle_count();
+        if total > MAX_SCENE_TRIANGLES {
+            return Err(invalid(format!(
+                "{part_name}: the scene would hold {total} triangles, more than the \
+                 {MAX_SCENE_TRIANGLES} hprt takes"
+            )));
+        }
+        if material.is_glossy() {
+            check_energy(albedo, material.specular)
+                .map_err(|m| invalid(format!("{part_name}: {m}")))?;
+        }
+        // An albedo in the scene file replaces the model's material, texture included.
+        match (object.albedo, part.texture) {
+            (None, Some(texture)) => {
+                geometry.push_textured_object(part_name, &world, albedo, texture)
+            }
+            _ => geometry.push_object(part_name, &world, albedo),
+        }
+        if let Some(o) = geometry.objects.last_mut() {
+            o.material = material;
+        }
+    }
+    Ok(())
 }
 
 /// The specular lobe an object asks for (its energy is checked against each part's albedo).

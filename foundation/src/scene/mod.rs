@@ -48,6 +48,8 @@ pub struct Scene {
     /// Default environment, its path resolved relative to the scene file.
     pub environment: Option<EnvironmentSpec>,
     pub bake: BakeSettings,
+    /// Every file the scene was read from: the scene file (or model) and each object's mesh.
+    pub sources: Vec<PathBuf>,
 }
 
 #[cfg(test)]

@@ -50,6 +50,20 @@ pub fn scene_file_for_model(
             message: "the model has no extent (no finite, distinct vertex positions)".into(),
         });
     }
+    // Placing the model scales it to MODEL_SIZE: the scale must stay a usable transform in
+    // single precision (its determinant normal), or the model is too small or too large.
+    let size = extent.max_element();
+    let scale = MODEL_SIZE / size;
+    if !(scale.powi(3).is_normal() && (lo.abs().max(hi.abs()) * scale).is_finite()) {
+        let what = if scale > 1.0 { "small" } else { "large" };
+        return Err(SceneError::Invalid {
+            path: model.to_owned(),
+            message: format!(
+                "the model is {size:e} units across, too {what} to scale to {MODEL_SIZE} units in \
+                 single precision; rescale it (or place it in a scene file with its own transform)"
+            ),
+        });
+    }
     let placement = Placement::new(lo, hi);
     let mut objects = vec![ObjectSpec {
         name: Some(stem(model)),

@@ -257,6 +257,19 @@ pub(crate) const THIN_SHEET_PLUGIN: &str = include_str!("thinsheet.py");
 /// CONVENTIONS.md, "Glossy materials"), registered as `hprtphong` when imported.
 pub(crate) const PHONG_PLUGIN: &str = include_str!("phong.py");
 
+/// Every file [`export_mitsuba`] writes into `dir` for `geometry`.
+pub fn export_files(dir: &Path, geometry: &SceneMesh) -> Vec<PathBuf> {
+    let objects = geometry.objects.iter().enumerate();
+    let meshes = objects
+        .clone()
+        .map(|(i, o)| dir.join("meshes").join(file_name_for(&o.name, i)));
+    let textures = objects
+        .filter(|(_, o)| o.texture.is_some())
+        .map(|(i, o)| dir.join("textures").join(texture_file_for(&o.name, i)));
+    let fixed = ["envmap.exr", "thinsheet.py", "phong.py", "scene.xml"].map(|f| dir.join(f));
+    meshes.chain(textures).chain(fixed).collect()
+}
+
 /// Writes `dir/scene.xml`, `dir/thinsheet.py`, `dir/phong.py`, `dir/envmap.exr`, `dir/meshes/*.ply` and, for
 /// textured objects, `dir/textures/*.exr`.
 pub fn export_mitsuba(

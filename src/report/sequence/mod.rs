@@ -94,7 +94,6 @@ pub fn write_sequence_report(
     let report = summarise(scene, sequence_path, settings, frames, &run.light_changes);
     write_outputs(&report, &gif_frames, camera.width * 3, camera.height, out)?;
     print_summary(&report);
-    println!("\nwrote {}", out.join("report.html").display());
     Ok(())
 }
 

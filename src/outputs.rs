@@ -1,0 +1,138 @@
+//! What a command writes: never over what it reads (an output that is, or links to, one of its
+//! inputs is refused before anything runs), and never two outputs at one file.
+
+use foundation::scene::Scene;
+use std::path::{Path, PathBuf};
+
+/// One output of a command: the option that names it and its path.
+pub type Output<'a> = (&'a str, Option<&'a Path>);
+
+/// Refuses `outputs` that name the same file, or that are (or link to) any of `inputs`.
+pub fn check_outputs(inputs: &[&Path], outputs: &[Output]) -> anyhow::Result<()> {
+    let given: Vec<(&str, &Path)> = outputs
+        .iter()
+        .filter_map(|(option, path)| path.map(|p| (*option, p)))
+        .collect();
+    for (i, (a, pa)) in given.iter().enumerate() {
+        for (b, pb) in &given[i + 1..] {
+            if same_file(pa, pb) {
+                anyhow::bail!(
+                    "{a} and {b} name the same file {}: give each output its own path",
+                    pb.display()
+                );
+            }
+        }
+    }
+    for (option, output) in &given {
+        if let Some(input) = inputs.iter().find(|input| same_file(output, input)) {
+            anyhow::bail!(
+                "{option} {} is {}, which this command reads: writing it would destroy the \
+                 input; give the output another path",
+                output.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a folder output that would write over an input: `files` are the files the command
+/// writes into it.
+pub fn check_folder_output(
+    inputs: &[&Path],
+    option: &str,
+    folder: &Path,
+    files: &[PathBuf],
+) -> anyhow::Result<()> {
+    for file in files {
+        if let Some(input) = inputs.iter().find(|input| same_file(file, input)) {
+            anyhow::bail!(
+                "{option} {}: the command would write {} over {}, which it reads; give the \
+                 output another folder",
+                folder.display(),
+                file.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Refuses an output folder that holds any of `inputs` (a report replaces its whole folder).
+pub fn check_folder_spares_inputs(
+    inputs: &[&Path],
+    option: &str,
+    folder: &Path,
+) -> anyhow::Result<()> {
+    let Ok(folder_real) = folder.canonicalize() else {
+        return Ok(()); // not there yet: it holds nothing
+    };
+    for input in inputs {
+        if input
+            .canonicalize()
+            .is_ok_and(|input| input.starts_with(&folder_real))
+        {
+            anyhow::bail!(
+                "{option} {}: the folder holds {}, which this command reads, and is replaced \
+                 by the output; give the output another folder",
+                folder.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// What a command reads of a scene (its file and meshes), with the command's `other` inputs.
+pub fn scene_inputs<'a>(scene: &'a Scene, other: &[Option<&'a Path>]) -> Vec<&'a Path> {
+    let environment = scene.environment.as_ref().map(|e| e.map.as_path());
+    scene
+        .sources
+        .iter()
+        .map(PathBuf::as_path)
+        .chain(other.iter().flatten().copied())
+        .chain(environment)
+        .collect()
+}
+
+/// Whether two paths name the same file: the same inode when both exist (links included),
+/// else the same name in the same folder.
+fn same_file(a: &Path, b: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    if let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+        return ma.dev() == mb.dev() && ma.ino() == mb.ino();
+    }
+    let key = |p: &Path| {
+        let dir = p
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_owned());
+        (dir, p.file_name().map(|n| n.to_owned()))
+    };
+    key(a) == key(b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_over_inputs_are_refused_through_links_too() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("map.exr");
+        std::fs::write(&input, b"x").unwrap();
+        let link = dir.path().join("link.exr");
+        std::os::unix::fs::symlink(&input, &link).unwrap();
+        let other = dir.path().join("out.exr");
+        assert!(check_outputs(&[&input], &[("-o", Some(&other))]).is_ok());
+        for output in [&input, &link] {
+            let e = check_outputs(&[&input], &[("-o", Some(output))]).unwrap_err();
+            assert!(e.to_string().contains("which this command reads"), "{e}");
+        }
+        let e = check_outputs(&[], &[("-o", Some(&other)), ("--png", Some(&other))]).unwrap_err();
+        assert!(e.to_string().contains("name the same file"), "{e}");
+        let e = check_folder_spares_inputs(&[&input], "-o", dir.path()).unwrap_err();
+        assert!(e.to_string().contains("holds"), "{e}");
+    }
+}
