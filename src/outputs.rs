@@ -47,7 +47,7 @@ pub fn check_folder_output(
     for file in files {
         if let Some(input) = inputs.iter().find(|input| same_file(file, input)) {
             anyhow::bail!(
-                "{option} {}: the command would write {} over {}, which it reads; give the \
+                "{option} {}: the command would write {} over {}, which this command reads; give the \
                  output another folder",
                 folder.display(),
                 file.display(),
