@@ -218,3 +218,124 @@ fn mutated_bakes_never_crash_the_program() {
         .to_vec()
     });
 }
+
+/// The chunks of a binary glTF: its JSON document and its binary chunk.
+fn split_glb(glb: &[u8]) -> (serde_json::Value, Vec<u8>) {
+    let word = |at: usize| u32::from_le_bytes(glb[at..at + 4].try_into().unwrap()) as usize;
+    let json_len = word(12);
+    let json = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let bin_at = 20 + json_len;
+    let bin = glb[bin_at + 8..bin_at + 8 + word(bin_at)].to_vec();
+    (json, bin)
+}
+
+fn join_glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
+    let mut text = json.to_string().into_bytes();
+    while text.len() % 4 != 0 {
+        text.push(b' ');
+    }
+    let mut bin = bin.to_vec();
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let total = 12 + 8 + text.len() + 8 + bin.len();
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((text.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(text);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out
+}
+
+/// One structural mutation of a glTF document: a count, offset, length or stride made large,
+/// small or odd; a component type or element type changed; a URI made hostile; a node made
+/// to repeat; a material's texture pointed elsewhere.
+fn mutate_gltf(m: &mut Mutator, doc: &mut serde_json::Value) {
+    use serde_json::json;
+    let pick =
+        |m: &mut Mutator, v: &serde_json::Value| v.as_array().map_or(0, |a| m.below(a.len()));
+    let numbers = [0u64, 1, 3, 4, 7, 1 << 20, u32::MAX as u64, 1 << 40];
+    let number = |m: &mut Mutator| json!(numbers[m.below(numbers.len())]);
+    match m.below(8) {
+        0 => {
+            let i = pick(m, &doc["accessors"]);
+            let key = ["count", "byteOffset", "bufferView"][m.below(3)];
+            doc["accessors"][i][key] = number(m);
+        }
+        1 => {
+            let i = pick(m, &doc["accessors"]);
+            doc["accessors"][i]["componentType"] =
+                json!([5120, 5121, 5122, 5123, 5125, 5126, 1][m.below(7)]);
+        }
+        2 => {
+            let i = pick(m, &doc["accessors"]);
+            doc["accessors"][i]["type"] =
+                json!(["SCALAR", "VEC2", "VEC3", "VEC4", "MAT4"][m.below(5)]);
+        }
+        3 => {
+            let i = pick(m, &doc["bufferViews"]);
+            let key = ["byteOffset", "byteLength", "byteStride", "buffer"][m.below(4)];
+            doc["bufferViews"][i][key] = number(m);
+        }
+        4 => {
+            doc["buffers"][0]["byteLength"] = number(m);
+        }
+        5 => {
+            let uri = [
+                "%FF%FE.bin",
+                "../../../../etc/passwd",
+                "/dev/zero",
+                "file:///dev/zero",
+                "data:application/octet-stream;base64,@@@",
+                "missing.bin",
+                "http://x/y",
+            ][m.below(7)];
+            if m.below(2) == 0 {
+                doc["buffers"][0]["uri"] = json!(uri);
+            } else if doc["images"].is_array() {
+                doc["images"][0] = json!({"uri": uri});
+            }
+        }
+        6 => {
+            let n = doc["nodes"].as_array().map_or(1, Vec::len);
+            doc["scenes"][0]["nodes"] = json!(vec![m.below(n); 1 + m.below(1000)]);
+        }
+        _ => {
+            if doc["images"].is_array() {
+                doc["images"][0]["bufferView"] = number(m);
+            }
+        }
+    }
+}
+
+/// Mutations of the bundled textured model, structural (the document's numbers, types and
+/// URIs) and of its bytes, loaded as a model under the memory limit: never a crash.
+#[test]
+fn mutated_gltf_models_never_crash_the_program() {
+    let glb = std::fs::read(repo().join("scenes/models/crate.glb")).unwrap();
+    let (json, bin) = split_glb(&glb);
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = Mutator(7);
+    let start = std::time::Instant::now();
+    for case in 0..48 {
+        let mut doc = json.clone();
+        for _ in 0..1 + m.below(3) {
+            mutate_gltf(&mut m, &mut doc);
+        }
+        let mut bytes = join_glb(&doc, &bin);
+        if case % 4 == 3 {
+            bytes = m.mutate(&bytes);
+        }
+        std::fs::write(dir.path().join("input.glb"), &bytes).unwrap();
+        assert_survives(
+            dir.path(),
+            &["scene", "init", "input.glb", "-o", "out.toml", "--force"],
+            &format!("glb case {case}"),
+        );
+    }
+    assert!(start.elapsed().as_secs() < 120, "{:?}", start.elapsed());
+}

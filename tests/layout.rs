@@ -188,3 +188,25 @@ fn backticked_repo_paths(line: &str) -> Vec<String> {
         })
         .collect()
 }
+
+/// Every limit in `foundation/src/infra/limits.rs` is listed, with why, in CONVENTIONS.md.
+#[test]
+fn every_limit_is_documented() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let limits = std::fs::read_to_string(root.join("foundation/src/infra/limits.rs")).unwrap();
+    let conventions = std::fs::read_to_string(root.join("CONVENTIONS.md")).unwrap();
+    let names: Vec<&str> = limits
+        .lines()
+        .filter_map(|l| l.strip_prefix("pub const "))
+        .filter_map(|l| l.split(':').next())
+        .collect();
+    assert!(names.len() >= 5, "{names:?}");
+    let missing: Vec<&&str> = names
+        .iter()
+        .filter(|n| !conventions.contains(&format!("`{n}`")))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "limits missing from CONVENTIONS.md: {missing:?}"
+    );
+}

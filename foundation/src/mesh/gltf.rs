@@ -294,11 +294,16 @@ impl Loader<'_> {
                 accessor.index()
             )));
         }
+        // Checked: a hostile count or offset must not wrap around to a small number.
         let needed = match accessor.count() {
-            0 => 0,
-            n => accessor.offset() + stride * (n - 1) + element,
+            0 => Some(0),
+            n => stride
+                .checked_mul(n - 1)
+                .and_then(|s| s.checked_add(accessor.offset()))
+                .and_then(|s| s.checked_add(element)),
         };
-        if needed > view.length() || view.offset() + view.length() > buffer_len {
+        let view_end = view.offset().checked_add(view.length());
+        if needed.is_none_or(|n| n > view.length()) || view_end.is_none_or(|end| end > buffer_len) {
             return Err(self.invalid(format!(
                 "{part}: {what} reaches past the end of its buffer (accessor {})",
                 accessor.index()
