@@ -8,3 +8,14 @@ pub mod limits;
 pub mod named_enum;
 pub mod prefetch;
 pub mod progress;
+
+/// Logs `message` as a warning unless this process already has: a file read twice (a model
+/// measured, then loaded) must not repeat its warnings.
+pub fn warn_once(message: String) {
+    static SAID: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+    let mut said = SAID.lock().unwrap_or_else(|e| e.into_inner());
+    if !said.contains(&message) {
+        log::warn!("{message}");
+        said.push(message);
+    }
+}

@@ -326,11 +326,11 @@ impl Loader<'_> {
             self.noted.push(material.index());
             let ignored = ignored_properties(material);
             if !ignored.is_empty() {
-                log::warn!(
+                crate::infra::warn_once(format!(
                     "{}: {name}: hprt renders the base colour only; ignored: {}",
                     self.path.display(),
                     ignored.join(", ")
-                );
+                ));
             }
         }
         let texture = match pbr.base_color_texture() {

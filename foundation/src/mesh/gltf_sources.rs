@@ -58,7 +58,7 @@ impl Sources<'_> {
                     buffer.length()
                 )));
             }
-            while data.len() % 4 != 0 {
+            while !data.len().is_multiple_of(4) {
                 data.push(0);
             }
             out.push(gltf::buffer::Data(data));

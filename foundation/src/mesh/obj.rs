@@ -99,11 +99,11 @@ pub(super) fn parse_obj_parts(
         Ok(m) if !m.is_empty() => m,
         Ok(_) => return Ok(None),
         Err(_) => {
-            log::warn!(
+            crate::infra::warn_once(format!(
                 "{}: cannot read its material library: {}; its materials are ignored",
                 path.display(),
                 libraries.failures.join("; ")
-            );
+            ));
             return Ok(None);
         }
     };

@@ -16,7 +16,7 @@ use crate::maps::{default_exposure, scene_rotation};
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::envmap::animated::SunDisc;
-use foundation::image_io::RgbImageF32;
+use foundation::image_io::{RgbImageF32, check_finite};
 use foundation::luminance;
 use foundation::scene::Scene;
 use output::{print_summary, side_by_side, write_outputs};
@@ -139,6 +139,9 @@ impl SequenceRun {
             self.renderer.set_lighting(&frame.lighting)?;
             self.renderer.render()?;
             let image = self.renderer.read_back()?;
+            // Statistics over NaN pixels would read as numbers: refuse the frame instead.
+            check_finite(&image, "frame")
+                .map_err(|e| anyhow::anyhow!("frame {k}, {}: {e}", method.name()))?;
             let s = error_stats(&image, &reference.radiance, &masks, exposure);
             let y = tonemapped_luminance(&image, exposure);
             let temporal_error = self.previous.as_ref().map(|(reference_before, before)| {
