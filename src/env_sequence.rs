@@ -88,7 +88,7 @@ impl Sequence {
     }
 
     fn from_file(path: &Path) -> anyhow::Result<Self> {
-        let text = std::fs::read_to_string(path)
+        let text = foundation::infra::limits::read_text_file(path)
             .with_context(|| format!("cannot read the sequence {}", path.display()))?;
         let spec: SequenceFile = toml::from_str(&text)
             .with_context(|| format!("{}: not a valid sequence file", path.display()))?;

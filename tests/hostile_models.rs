@@ -339,6 +339,34 @@ fn sizes_a_scene_implies_are_bounded_before_allocation() {
     );
     assert_clean_failure(&out, &["--threads 100000", "1024"]);
     assert!(!d.join("b.bake").exists());
+
+    // Devices are never read as scene, bake or sequence files.
+    for args in [
+        vec!["bake", "/dev/zero", "-o", "b.bake"],
+        vec!["decompose", "/dev/zero", "-o", "l.json"],
+        vec!["report", "/dev/zero", "-o", "rep"],
+    ] {
+        let out = hprt_limited(d, &args);
+        assert_clean_failure(&out, &["/dev/zero"]);
+    }
+    let teapot = scene_path("teapot.toml");
+    let out = hprt_limited(
+        d,
+        &["render", &teapot, "--bake", "/dev/zero", "-o", "x.png"],
+    );
+    assert_clean_failure(&out, &["/dev/zero", "not a regular file"]);
+    let out = hprt_limited(
+        d,
+        &[
+            "report",
+            &teapot,
+            "--env-sequence",
+            "/dev/zero",
+            "-o",
+            "rep",
+        ],
+    );
+    assert_clean_failure(&out, &["/dev/zero", "not a regular file"]);
 }
 
 fn scene_path(name: &str) -> String {

@@ -24,6 +24,7 @@
 
 use crate::bake::{BakeSettings, RAY_OFFSET_FRACTION, Transfer, TransferVectors};
 use foundation::infra::atomic_file::AtomicOutput;
+use foundation::infra::limits::{MAX_BAKE_BYTES, ReadError, read_regular_file};
 use foundation::sh::{self, num_coeffs};
 use std::path::{Path, PathBuf};
 
@@ -196,9 +197,12 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<(BakeHeader, Transfer), BakeF
 
 /// Reads and verifies a bake file (magic, version, size, checksum).
 pub fn read(path: &Path) -> Result<(BakeHeader, Transfer), BakeFileError> {
-    let bytes = std::fs::read(path).map_err(|cause| BakeFileError::Io {
+    let bytes = read_regular_file(path, MAX_BAKE_BYTES).map_err(|e| BakeFileError::Io {
         path: path.to_owned(),
-        cause,
+        cause: match e {
+            ReadError::Io(cause) => cause,
+            other => std::io::Error::other(other.to_string()),
+        },
     })?;
     decode(path, &bytes)
 }

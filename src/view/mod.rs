@@ -119,7 +119,7 @@ fn open_bake(scene: &Scene, path: Option<&Path>) -> anyhow::Result<BakeState> {
 fn read_script(path: Option<&Path>) -> anyhow::Result<VecDeque<script::Command>> {
     Ok(match path {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
+            let text = foundation::infra::limits::read_text_file(path)
                 .with_context(|| format!("cannot read {}", path.display()))?;
             script::parse(path, &text)?.into()
         }

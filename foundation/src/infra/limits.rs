@@ -14,6 +14,14 @@ pub const MAX_MESH_BYTES: u64 = 1 << 30;
 /// Largest file a model names beside itself (an OBJ's `.mtl`, a glTF's buffers and images).
 pub const MAX_SIDE_FILE_BYTES: u64 = 1 << 30;
 
+/// Largest text file hprt reads (a scene, a sequence, a viewer script): thousands of times
+/// the largest real one.
+pub const MAX_TEXT_BYTES: u64 = 64 << 20;
+
+/// Largest bake file: more than any machine here could hold in memory; the check is there to
+/// refuse devices and runaway files, not real bakes.
+pub const MAX_BAKE_BYTES: u64 = 64 << 30;
+
 /// Most texels of one texture: textures are kept as linear f32 RGB (12 bytes a texel, 200 MB
 /// here) plus their mipmaps on the GPU, so a 4096² texture is the largest that stays within
 /// the memory budget; downscale larger ones.
@@ -66,6 +74,17 @@ pub fn read_regular_file(path: &Path, max: u64) -> Result<Vec<u8>, ReadError> {
         });
     }
     Ok(bytes)
+}
+
+/// The text of the regular file at `path`, within [`MAX_TEXT_BYTES`].
+pub fn read_text_file(path: &Path) -> Result<String, ReadError> {
+    let bytes = read_regular_file(path, MAX_TEXT_BYTES)?;
+    String::from_utf8(bytes).map_err(|_| {
+        ReadError::Io(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "not UTF-8 text",
+        ))
+    })
 }
 
 /// The expansion of gzip data, refused once it passes `max` bytes (a small file can expand to

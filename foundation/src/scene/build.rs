@@ -5,7 +5,7 @@ use super::description::*;
 use super::geometry::SceneMesh;
 use super::{Scene, SceneError};
 use crate::color::Rgb;
-use crate::infra::limits::MAX_SCENE_TRIANGLES;
+use crate::infra::limits::{MAX_SCENE_TRIANGLES, ReadError, read_text_file};
 use crate::material::{MAX_SHININESS, Material, check_energy};
 use crate::mesh::{
     self, LoadOptions, MeshCleanup, MeshError, TriangleMesh, annulus_mesh, box_mesh,
@@ -18,9 +18,15 @@ use std::sync::Arc;
 impl Scene {
     /// Loads a scene file and every mesh it names.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|cause| SceneError::Io {
-            path: path.to_owned(),
-            cause,
+        let text = read_text_file(path).map_err(|e| match e {
+            ReadError::Io(cause) => SceneError::Io {
+                path: path.to_owned(),
+                cause,
+            },
+            other => SceneError::Invalid {
+                path: path.to_owned(),
+                message: other.to_string(),
+            },
         })?;
         let file: SceneFile = toml::from_str(&text).map_err(|e| SceneError::Parse {
             path: path.to_owned(),
