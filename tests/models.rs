@@ -296,7 +296,10 @@ fn malformed_and_unsupported_files_fail_clearly_without_output() {
         serde_json::to_vec(&document(one_node(), Some("nowhere.bin"))).unwrap(),
     )
     .unwrap();
-    cases.push((missing_buffer, vec!["missing.gltf", "buffers"]));
+    cases.push((
+        missing_buffer,
+        vec!["missing.gltf", "buffer 0", "nowhere.bin"],
+    ));
 
     for (path, needles) in cases {
         // The library says what is wrong, naming the file.

@@ -490,5 +490,5 @@ fn sequence_report_measures_every_frame_over_time() {
         )
     };
     assert!(render("4").status.success());
-    assert_clean_failure(&render("5"), &["past the sequence's last frame"]);
+    assert_clean_failure(&render("5"), &["--frame 5", "frames 0 to 4"]);
 }

@@ -215,7 +215,7 @@ impl AtomicFolder {
         std::fs::create_dir_all(parent)?;
         if destination.exists() && !destination.is_dir() {
             return Err(std::io::Error::other(format!(
-                "{} is a file; name a folder to write",
+                "{} exists and is not a folder",
                 destination.display()
             )));
         }
