@@ -7,11 +7,10 @@ mod common;
 
 use common::*;
 use std::path::Path;
-use std::process::Command;
 
 /// Address-space limit of each run, in KiB (the program with its GPU-free commands needs a few
 /// hundred MB; an allocation of a declared size would need far more).
-const MEMORY_LIMIT_KIB: u64 = 3 * 1024 * 1024;
+const FUZZ_MEMORY_LIMIT_KIB: u64 = 3 * 1024 * 1024;
 const CASES_PER_FORMAT: usize = 24;
 
 /// A small deterministic generator (PCG-like LCG), so every run tries the same cases.
@@ -70,17 +69,7 @@ impl Mutator {
 
 /// Runs `hprt ARGS` in `dir` under the memory limit; asserts it ended cleanly.
 fn assert_survives(dir: &Path, args: &[&str], case: &str) {
-    let command = format!("ulimit -v {MEMORY_LIMIT_KIB}; exec \"$0\" \"$@\"",);
-    let out = Command::new("sh")
-        .arg("-c")
-        .arg(command)
-        .arg(env!("CARGO_BIN_EXE_hprt"))
-        .args(args)
-        .current_dir(dir)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .env("HPRT_CACHE", dir.join("cache"))
-        .output()
-        .expect("sh runs");
+    let out = hprt_limited_to(dir, args, FUZZ_MEMORY_LIMIT_KIB);
     let err = String::from_utf8_lossy(&out.stderr);
     match out.status.code() {
         Some(0) | Some(1) => {}
@@ -229,28 +218,6 @@ fn split_glb(glb: &[u8]) -> (serde_json::Value, Vec<u8>) {
     (json, bin)
 }
 
-fn join_glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
-    let mut text = json.to_string().into_bytes();
-    while !text.len().is_multiple_of(4) {
-        text.push(b' ');
-    }
-    let mut bin = bin.to_vec();
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
-    }
-    let total = 12 + 8 + text.len() + 8 + bin.len();
-    let mut out = b"glTF".to_vec();
-    out.extend(2u32.to_le_bytes());
-    out.extend((total as u32).to_le_bytes());
-    out.extend((text.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(text);
-    out.extend((bin.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(bin);
-    out
-}
-
 /// One structural mutation of a glTF document: a count, offset, length or stride made large,
 /// small or odd; a component type or element type changed; a URI made hostile; a node made
 /// to repeat; a material's texture pointed elsewhere.
@@ -316,8 +283,8 @@ fn mutate_gltf(m: &mut Mutator, doc: &mut serde_json::Value) {
 /// URIs) and of its bytes, loaded as a model under the memory limit: never a crash.
 #[test]
 fn mutated_gltf_models_never_crash_the_program() {
-    let glb = std::fs::read(repo().join("scenes/models/crate.glb")).unwrap();
-    let (json, bin) = split_glb(&glb);
+    let original = std::fs::read(repo().join("scenes/models/crate.glb")).unwrap();
+    let (json, bin) = split_glb(&original);
     let dir = tempfile::tempdir().unwrap();
     let mut m = Mutator(7);
     let start = std::time::Instant::now();
@@ -326,7 +293,7 @@ fn mutated_gltf_models_never_crash_the_program() {
         for _ in 0..1 + m.below(3) {
             mutate_gltf(&mut m, &mut doc);
         }
-        let mut bytes = join_glb(&doc, &bin);
+        let mut bytes = glb(&doc, &bin);
         if case % 4 == 3 {
             bytes = m.mutate(&bytes);
         }

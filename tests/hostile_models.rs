@@ -7,24 +7,7 @@ mod common;
 
 use common::*;
 use std::path::Path;
-use std::process::{Command, Output};
-
-/// Address space of each run (KiB): "peak memory under 1 GB".
-const MEMORY_LIMIT_KIB: u64 = 1024 * 1024;
-
-/// `hprt ARGS` in `dir` under the memory limit.
-fn hprt_limited(dir: &Path, args: &[&str]) -> Output {
-    Command::new("sh")
-        .arg("-c")
-        .arg(format!("ulimit -v {MEMORY_LIMIT_KIB}; exec \"$0\" \"$@\""))
-        .arg(env!("CARGO_BIN_EXE_hprt"))
-        .args(args)
-        .current_dir(dir)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .env("HPRT_CACHE", dir.join("cache"))
-        .output()
-        .expect("sh runs")
-}
+use std::process::Output;
 
 /// One triangle: 36 bytes of positions, then 12 of u32 indices.
 fn triangle_bytes() -> Vec<u8> {

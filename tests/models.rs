@@ -70,30 +70,6 @@ fn document(nodes: Value, buffer_uri: Option<&str>) -> Value {
     })
 }
 
-/// A GLB container: the JSON chunk (space-padded) and the binary chunk (zero-padded).
-fn glb(document: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut json = serde_json::to_vec(document).unwrap();
-    while !json.len().is_multiple_of(4) {
-        json.push(b' ');
-    }
-    let mut bin = bin.to_vec();
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
-    }
-    let total = 12 + 8 + json.len() + 8 + bin.len();
-    let mut out = Vec::new();
-    out.extend(b"glTF");
-    out.extend(2u32.to_le_bytes());
-    out.extend((total as u32).to_le_bytes());
-    out.extend((json.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(json);
-    out.extend((bin.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(bin);
-    out
-}
-
 /// Writes `name.gltf` with its buffer in `name.bin`.
 fn write_gltf(dir: &Path, name: &str, nodes: Value) -> PathBuf {
     let bin = format!("{name}.bin");

@@ -254,3 +254,49 @@ pub fn plane_facing(centre: Vec3, normal: Vec3) -> foundation::mesh::TriangleMes
         uvs: Vec::new(),
     }
 }
+
+/// A GLB container: the JSON chunk (space-padded) and the binary chunk (zero-padded).
+pub fn glb(document: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
+    let mut json = serde_json::to_vec(document).unwrap();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let mut bin = bin.to_vec();
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut out = Vec::new();
+    out.extend(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((json.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(json);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out
+}
+
+/// Address space of a run under [`hprt_limited`] (KiB): hostile inputs must not need more.
+pub const MEMORY_LIMIT_KIB: u64 = 1024 * 1024;
+
+/// `hprt ARGS` in `dir` under an address-space limit of `limit_kib` (`ulimit -v`).
+pub fn hprt_limited_to(dir: &Path, args: &[&str], limit_kib: u64) -> Output {
+    Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {limit_kib}; exec \"$0\" \"$@\""))
+        .arg(env!("CARGO_BIN_EXE_hprt"))
+        .args(args)
+        .current_dir(dir)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .env("HPRT_CACHE", dir.join("cache"))
+        .output()
+        .expect("sh runs")
+}
+
+/// `hprt ARGS` in `dir` under [`MEMORY_LIMIT_KIB`].
+pub fn hprt_limited(dir: &Path, args: &[&str]) -> Output {
+    hprt_limited_to(dir, args, MEMORY_LIMIT_KIB)
+}
