@@ -26,12 +26,22 @@ impl WindowGpu {
         let size = window.inner_size();
         let capabilities = surface.get_capabilities(&gpu.adapter);
         // egui wants a gamma-space (non-sRGB) target; the display pass encodes sRGB itself.
+        let (Some(&first_format), Some(&alpha_mode)) = (
+            capabilities.formats.first(),
+            capabilities.alpha_modes.first(),
+        ) else {
+            anyhow::bail!(
+                "the graphics adapter ({}) cannot present to this window (it offers no surface \
+                 format); try --backend gl or vulkan, or `hprt render` without a window",
+                gpu.description()
+            );
+        };
         let format = capabilities
             .formats
             .iter()
             .copied()
             .find(|f| !f.is_srgb())
-            .unwrap_or(capabilities.formats[0]);
+            .unwrap_or(first_format);
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             format,
@@ -40,7 +50,7 @@ impl WindowGpu {
             height: size.height.max(1),
             present_mode: wgpu::PresentMode::AutoNoVsync,
             desired_maximum_frame_latency: 2,
-            alpha_mode: capabilities.alpha_modes[0],
+            alpha_mode,
             view_formats: vec![],
         };
         let mut config = config;
