@@ -134,28 +134,18 @@ impl AtomicOutput {
     }
 
     /// Writes `bytes` and moves the file into place.
-    pub fn commit(mut self, bytes: &[u8]) -> Result<(), std::io::Error> {
-        match self.target.take() {
-            None => Ok(()),
-            Some(Target::Direct(mut file)) => file.write_all(bytes),
-            Some(Target::Temporary(mut temp)) => {
-                forget_partial(temp.path());
-                temp.write_all(bytes)?;
-                temp.as_file().sync_all()?;
-                temp.persist(&self.path).map_err(|e| e.error)?;
-                Ok(())
-            }
-        }
+    pub fn commit(self, bytes: &[u8]) -> Result<(), std::io::Error> {
+        commit_all(vec![(self, bytes)])
     }
 }
 
 /// Writes several outputs all or none: every temporary file is written and synced first, and
 /// only then are they moved into place, so a failure while writing leaves none of them.
-pub fn commit_all(outputs: Vec<(AtomicOutput, Vec<u8>)>) -> Result<(), std::io::Error> {
+pub fn commit_all<B: AsRef<[u8]>>(outputs: Vec<(AtomicOutput, B)>) -> Result<(), std::io::Error> {
     let mut ready = Vec::with_capacity(outputs.len());
     for (mut output, bytes) in outputs {
         if let Some(Target::Temporary(temp)) = &mut output.target {
-            temp.write_all(&bytes)?;
+            temp.write_all(bytes.as_ref())?;
             temp.as_file().sync_all()?;
         }
         ready.push((output, bytes));
@@ -163,7 +153,7 @@ pub fn commit_all(outputs: Vec<(AtomicOutput, Vec<u8>)>) -> Result<(), std::io::
     for (mut output, bytes) in ready {
         match output.target.take() {
             None => {}
-            Some(Target::Direct(mut file)) => file.write_all(&bytes)?,
+            Some(Target::Direct(mut file)) => file.write_all(bytes.as_ref())?,
             Some(Target::Temporary(temp)) => {
                 forget_partial(temp.path());
                 temp.persist(&output.path).map_err(|e| e.error)?;
