@@ -1,6 +1,8 @@
 //! What a command writes: never over what it reads (an output that is, or links to, one of its
 //! inputs is refused before anything runs), and never two outputs at one file.
 
+use anyhow::Context;
+use foundation::infra::atomic_file::{AtomicOutput, commit_all};
 use foundation::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -34,6 +36,23 @@ pub fn check_outputs(inputs: &[&Path], outputs: &[Output]) -> anyhow::Result<()>
         }
     }
     Ok(())
+}
+
+/// Opens every given output (in order) before the work that fills them, so an unwritable one
+/// fails first; [`write_outputs`] then writes them all together, or none.
+pub fn open_outputs(outputs: &[Output]) -> anyhow::Result<Vec<AtomicOutput>> {
+    outputs
+        .iter()
+        .filter_map(|(_, path)| *path)
+        .map(|path| {
+            AtomicOutput::create(path).with_context(|| format!("cannot write {}", path.display()))
+        })
+        .collect()
+}
+
+/// Writes `bytes` into the outputs [`open_outputs`] opened, in the same order, all or none.
+pub fn write_outputs(files: Vec<AtomicOutput>, bytes: Vec<Vec<u8>>) -> anyhow::Result<()> {
+    commit_all(files.into_iter().zip(bytes).collect()).context("cannot write the outputs")
 }
 
 /// Refuses a folder output that would write over an input: `files` are the files the command

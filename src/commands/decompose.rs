@@ -2,13 +2,11 @@
 
 use crate::cli::DecomposeOptions;
 use crate::maps::load_map;
-use crate::outputs::check_outputs;
+use crate::outputs::{check_outputs, open_outputs, write_outputs};
 use crate::support::median;
-use anyhow::Context;
 use clap::Args;
 use foundation::envmap::Layout;
 use foundation::image_io::png_bytes;
-use foundation::infra::atomic_file::{AtomicOutput, commit_all};
 use foundation::{Rgb, luminance};
 use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
 use runtime::{decomposition_picture, describe};
@@ -80,19 +78,12 @@ pub fn run(args: DecomposeArgs) -> anyhow::Result<()> {
         .options
         .settings(args.mode, DecomposeSettings::default().order);
     settings.validate()?;
-    check_outputs(
-        &[&args.env],
-        &[("-o", Some(&args.output)), ("--png", args.png.as_deref())],
-    )?;
-    // Both outputs are opened first, so an unwritable one fails before anything is written.
-    let output = AtomicOutput::create(&args.output)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
-    let png_output = match &args.png {
-        Some(p) => {
-            Some(AtomicOutput::create(p).with_context(|| format!("cannot write {}", p.display()))?)
-        }
-        None => None,
-    };
+    let outputs = [
+        ("-o", Some(args.output.as_path())),
+        ("--png", args.png.as_deref()),
+    ];
+    check_outputs(&[&args.env], &outputs)?;
+    let files = open_outputs(&outputs)?;
     if args.repeat == 0 {
         anyhow::bail!("--repeat must be at least 1");
     }
@@ -135,12 +126,12 @@ pub fn run(args: DecomposeArgs) -> anyhow::Result<()> {
         decomposition_ms_all: times,
     };
     let text = serde_json::to_string_pretty(&json)?;
-    let mut files = vec![(output, text.into_bytes())];
-    if let Some(png) = png_output {
+    let mut bytes = vec![text.into_bytes()];
+    if args.png.is_some() {
         let picture = decomposition_picture(&loaded.map, args.rotate.to_radians(), &result, 1024);
-        files.push((png, png_bytes(&picture.rgb, picture.width, picture.height)?));
+        bytes.push(png_bytes(&picture.rgb, picture.width, picture.height)?);
     }
-    commit_all(files).context("cannot write the outputs")?;
+    write_outputs(files, bytes)?;
     println!(
         "{}: {} light(s) carrying {:.1}% of the power ({}); decomposed in {:.3} ms (median of {})",
         args.env.display(),

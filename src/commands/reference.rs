@@ -2,13 +2,12 @@
 
 use crate::cli::{EnvironmentArgs, ImageSizeArgs};
 use crate::maps::default_exposure;
-use crate::outputs::{check_outputs, scene_inputs};
+use crate::outputs::{check_outputs, open_outputs, scene_inputs, write_outputs};
 use crate::support::{TerminalProgress, load_scene, with_threads};
 use anyhow::Context;
 use clap::Args;
 use foundation::bvh::SceneBvh;
 use foundation::image_io::{RgbImageF32, exr_bytes, png_bytes, to_display_rgb8};
-use foundation::infra::atomic_file::{AtomicOutput, commit_all};
 use reference::{self, EnvironmentLight, ReferenceImage, ReferenceSettings, SamplerKind};
 use std::path::PathBuf;
 
@@ -89,16 +88,7 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
     if let Some(dir) = &args.aux {
         crate::support::create_folder(dir)?;
     }
-    // Every output is opened before the render, so an unwritable one fails first, and all are
-    // written together at the end, or none.
-    let mut files = Vec::new();
-    for (_, path) in &outputs {
-        if let Some(path) = path {
-            let output = AtomicOutput::create(path)
-                .with_context(|| format!("cannot write {}", path.display()))?;
-            files.push(output);
-        }
-    }
+    let files = open_outputs(&outputs)?;
     println!(
         "{}: {}x{}, {} spp, {} bounces, lit by {} rotated {}°",
         scene.name,
@@ -132,7 +122,7 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
         bytes.extend(grey_files(w, h, &image.coverage)?);
         bytes.extend(grey_files(w, h, &image.visibility)?);
     }
-    commit_all(files.into_iter().zip(bytes).collect()).context("cannot write the outputs")?;
+    write_outputs(files, bytes)?;
     let megapixel_samples = camera.width as f64 * camera.height as f64 * settings.spp as f64 / 1e6;
     println!(
         "rendered in {:.2} s: {:.2} M rays/s, {:.3} s per megapixel per sample; wrote {}",

@@ -6,12 +6,11 @@ use crate::cli::{
 };
 use crate::env_sequence::{Sequence, lighting_at_frame};
 use crate::maps::{default_exposure, scene_rotation};
-use crate::outputs::{check_outputs, scene_inputs};
+use crate::outputs::{check_outputs, open_outputs, scene_inputs, write_outputs};
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
 use foundation::image_io::{RgbImageF32, check_finite, exr_bytes, png_bytes, to_display_rgb8};
-use foundation::infra::atomic_file::{AtomicOutput, commit_all};
 use runtime::render::{GpuContext, Renderer};
 use runtime::{DecomposeMode, EnvironmentLighting};
 use std::path::PathBuf;
@@ -72,18 +71,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     camera.fov_y_deg = args.fov.unwrap_or(camera.fov_y_deg);
     camera.validate()?;
     let inputs = scene_inputs(&scene, &[Some(&args.bake), args.environment.env.as_deref()]);
-    check_outputs(
-        &inputs,
-        &[("-o", Some(&args.output)), ("--exr", args.exr.as_deref())],
-    )?;
-    let output = AtomicOutput::create(&args.output)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
-    let exr_output = match &args.exr {
-        Some(p) => {
-            Some(AtomicOutput::create(p).with_context(|| format!("cannot write {}", p.display()))?)
-        }
-        None => None,
-    };
+    let outputs = [
+        ("-o", Some(args.output.as_path())),
+        ("--exr", args.exr.as_deref()),
+    ];
+    check_outputs(&inputs, &outputs)?;
+    let files = open_outputs(&outputs)?;
     let settings = args
         .decompose
         .settings(args.decompose_mode, transfer.settings.order);
@@ -138,11 +131,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         image.width,
         image.height,
     )?;
-    let mut outputs = vec![(output, png)];
-    if let Some(exr) = exr_output {
-        outputs.push((exr, exr_bytes(&image)?));
+    let mut bytes = vec![png];
+    if args.exr.is_some() {
+        bytes.push(exr_bytes(&image)?);
     }
-    commit_all(outputs).context("cannot write the outputs")?;
+    write_outputs(files, bytes)?;
     println!(
         "{} mode, {} light(s), {} {:.2} ms; wrote {}",
         args.render.mode.name(),
