@@ -43,6 +43,15 @@ impl ShSunPeer {
             decomposer: Decomposer::new(sh_sun::settings(settings))?,
         })
     }
+
+    /// Follows new decomposition settings; the decomposer is rebuilt only when the settings
+    /// it derives from them change (a new threshold or mode leaves it as it is).
+    fn follow(&mut self, settings: &DecomposeSettings) -> Result<(), DecomposeError> {
+        if self.decomposer.settings() != &sh_sun::settings(settings) {
+            *self = Self::new(settings)?;
+        }
+        Ok(())
+    }
 }
 
 /// The median-cut lights of one map, cut in some number of levels.
@@ -147,7 +156,7 @@ impl EnvironmentLighting {
             return Ok(());
         }
         self.decomposer = Decomposer::new(self.decomposer_settings(&settings))?;
-        self.sh_sun = ShSunPeer::new(&settings)?;
+        self.sh_sun.follow(&settings)?;
         if settings.face_size != self.source.face_size() {
             self.source = CubeSource::new(&self.map, settings.face_size);
         }
