@@ -61,34 +61,20 @@ impl Icosphere {
         }
     }
 
-    /// Follows steepest ascent of `values` from every vertex; returns the local maxima
-    /// reached (each once, in increasing vertex order).
+    /// The local maxima of `values`, in increasing vertex order: the vertices no neighbour
+    /// exceeds. These are exactly where steepest ascent ends, from whichever vertex it starts
+    /// (an ascent leaves a vertex only for a strictly greater neighbour), so no chain has to
+    /// be followed.
     pub(crate) fn hill_climb_maxima(&self, values: &[f32]) -> Vec<u32> {
-        let n = self.vertices.len();
-        // Uphill successor of each vertex (itself at a maximum), then follow the chains.
-        let successor: Vec<u32> = (0..n as u32)
-            .map(|v| {
-                self.neighbours[v as usize]
+        (0..self.vertices.len() as u32)
+            .filter(|&v| {
+                let value = values[v as usize];
+                // Without early exit: which neighbour is greater is not predictable.
+                !self.neighbours[v as usize]
                     .iter()
-                    .copied()
-                    .fold(v, |best, m| {
-                        if values[m as usize] > values[best as usize] {
-                            m
-                        } else {
-                            best
-                        }
-                    })
+                    .fold(false, |greater, &m| greater | (values[m as usize] > value))
             })
-            .collect();
-        let mut is_peak = vec![false; n];
-        for start in 0..n {
-            let mut v = start;
-            while successor[v] as usize != v {
-                v = successor[v] as usize;
-            }
-            is_peak[v] = true;
-        }
-        (0..n as u32).filter(|&v| is_peak[v as usize]).collect()
+            .collect()
     }
 }
 

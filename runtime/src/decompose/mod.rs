@@ -30,7 +30,7 @@ use foundation::sh::ShCoeffs;
 use foundation::{Rgb, luminance};
 use glam::Vec3;
 use icosphere::Icosphere;
-use projection::{BasisColumns, ShProjector};
+use projection::{BasisColumns, MemberBasis, ShProjector};
 pub(crate) use settings::{ANALYSIS_FACE_SIZE, MAX_CANDIDATES};
 pub use settings::{DecomposeError, DecomposeMode, DecomposeSettings};
 use smoothing::GaussianSmoothing;
@@ -75,7 +75,7 @@ pub struct Decomposer {
     ring: Vec<u32>,
     cap: Vec<u32>,
     owner: Vec<(u16, f32)>,
-    member_basis: Vec<f32>,
+    member_basis: MemberBasis,
 }
 
 impl Decomposer {
@@ -112,7 +112,7 @@ impl Decomposer {
                     e.to_string(),
                 ))
             })?,
-            member_basis: Vec::new(),
+            member_basis: MemberBasis::new(settings.order),
             detection_window: DETECTION_WINDOW.factors(settings.order),
             sh_window: settings.sh_window().factors(settings.order),
             settings,
@@ -347,35 +347,6 @@ impl Decomposer {
         (sh, lights)
     }
 
-    /// `P = SH(map) − SH(excess)`: `full` less the projection of `excess` at the texels
-    /// `members` (their basis values in `member_basis`). Channel by channel over the
-    /// coefficients, each coefficient's sum in member order: the same floats as subtracting
-    /// member after member from the expansion.
-    fn without_excess(
-        &self,
-        full: &ShCoeffs<Rgb>,
-        excess: &[Rgb],
-        members: &[u32],
-    ) -> ShCoeffs<Rgb> {
-        let n = full.as_slice().len();
-        let channel = |c: fn(&Rgb) -> f32| full.as_slice().iter().map(c).collect::<Vec<f32>>();
-        let mut sums = [channel(|c| c.x), channel(|c| c.y), channel(|c| c.z)];
-        for ((e, &t), y) in excess
-            .iter()
-            .zip(members)
-            .zip(self.member_basis.chunks_exact(n))
-        {
-            // Adding −(e Δω) Y subtracts e Δω Y exactly.
-            projection::accumulate(
-                &mut sums,
-                -(*e * self.geometry.solid_angles()[t as usize]),
-                y,
-            );
-        }
-        let [r, g, b] = sums;
-        ShProjector::collect(r, g, b)
-    }
-
     /// For caps of radius R around `centres`: the excess `max(0, L − P)` of the map over the SH
     /// part `P`, where `P` is refitted to the map minus that excess (a few fixed-point steps).
     /// Texels in several caps belong to the nearest centre. Returns the final `P` and one light
@@ -404,31 +375,32 @@ impl Decomposer {
             }
         }
         let texels = map.texels();
-        // SH basis at the cap texels, evaluated once per frame.
-        let n = self.basis.num_coeffs();
-        self.member_basis.resize(members.len() * n, 0.0);
-        // At the analysis resolution the projector has the basis at every texel already.
+        // SH basis at the cap texels, once per frame. At the analysis resolution the
+        // projector has the basis at every texel already.
         let table = self
             .downsample
             .is_empty()
             .then(|| self.projector.texel_basis());
-        for (row, &t) in self.member_basis.chunks_exact_mut(n).zip(&members) {
-            match table {
-                Some(table) => row.copy_from_slice(table.row(t as usize)),
-                None => self.basis.eval(self.geometry.directions()[t as usize], row),
-            }
-        }
+        self.member_basis
+            .set(&members, table, &self.basis, self.geometry.directions());
         let mut sh = full.clone();
         let mut excess: Vec<Rgb> = vec![Rgb::ZERO; members.len()];
+        let mut expansion = Vec::new();
+        let mut projected = Vec::new();
         for _ in 0..iterations {
-            for ((e, &t), y) in excess
-                .iter_mut()
-                .zip(&members)
-                .zip(self.member_basis.chunks_exact(n))
-            {
-                *e = (texels[t as usize] - sh.dot_basis(y)).max(Rgb::ZERO);
+            // P = SH(map) − SH(excess), P refitted to the map less the excess.
+            self.member_basis.eval_all(&sh, &mut expansion);
+            for ((e, &t), p) in excess.iter_mut().zip(&members).zip(&expansion) {
+                *e = (texels[t as usize] - *p).max(Rgb::ZERO);
             }
-            sh = self.without_excess(full, &excess, &members);
+            projected.clear();
+            projected.extend(
+                excess
+                    .iter()
+                    .zip(&members)
+                    .map(|(e, &t)| *e * self.geometry.solid_angles()[t as usize]),
+            );
+            sh = self.member_basis.subtract(full, &projected);
         }
         // Each light: power, luminance-weighted centroid and spread of its excess.
         let mut power = vec![Rgb::ZERO; centres.len()];

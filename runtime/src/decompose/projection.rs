@@ -22,7 +22,7 @@ impl BasisTable {
     pub(crate) fn new(order: usize, directions: &[Vec3]) -> Self {
         let basis = ShBasis::<f32>::new(order).expect("a supported SH order");
         let n = basis.num_coeffs();
-        let stride = n.next_multiple_of(LANES);
+        let stride = padded_stride(n);
         let mut values = vec![0.0; directions.len() * stride];
         for (d, row) in directions.iter().zip(values.chunks_exact_mut(stride)) {
             basis.eval(*d, &mut row[..n]);
@@ -34,15 +34,16 @@ impl BasisTable {
         }
     }
 
+    /// Row `i` with its zero padding ([`padded_stride`] values).
     #[inline]
-    pub(crate) fn row(&self, i: usize) -> &[f32] {
-        &self.values[i * self.stride..][..num_coeffs(self.order)]
+    fn padded_row(&self, i: usize) -> &[f32] {
+        &self.values[i * self.stride..][..self.stride]
     }
+}
 
-    /// Every row with its padding.
-    fn padded_rows(&self) -> std::slice::ChunksExact<'_, f32> {
-        self.values.chunks_exact(self.stride)
-    }
+/// Length of a padded basis row of `n` coefficients.
+fn padded_stride(n: usize) -> usize {
+    n.next_multiple_of(LANES)
 }
 
 /// SH basis values at a fixed set of directions, coefficient-major (`values[k · count + i] =
@@ -58,34 +59,56 @@ pub(crate) struct BasisColumns {
 impl BasisColumns {
     pub(crate) fn new(order: usize, directions: &[Vec3]) -> Self {
         let rows = BasisTable::new(order, directions);
-        let n = num_coeffs(order);
-        let count = directions.len();
-        let mut values = vec![0.0; n * count];
-        for i in 0..count {
-            for (k, y) in rows.row(i).iter().enumerate() {
-                values[k * count + i] = *y;
-            }
-        }
-        Self {
+        let mut columns = Self {
             order,
-            count,
-            values,
+            count: 0,
+            values: Vec::new(),
+        };
+        columns.set_rows(&rows.values, rows.stride);
+        columns
+    }
+
+    /// Makes the table that of the directions whose padded basis rows are `rows`.
+    fn set_rows(&mut self, rows: &[f32], stride: usize) {
+        let n = num_coeffs(self.order);
+        self.count = rows.len() / stride;
+        self.values.resize(n * self.count, 0.0);
+        // Column by column: the writes run in order, the reads stride over rows that stay
+        // in cache.
+        for (k, column) in self.values.chunks_exact_mut(self.count.max(1)).enumerate() {
+            for (y, row) in column.iter_mut().zip(rows.chunks_exact(stride)) {
+                *y = row[k];
+            }
         }
     }
 
     /// The value of `coeffs` at every direction (bands beyond the table's order ignored):
     /// the same floats as [`ShCoeffs::eval`] direction by direction.
     pub(crate) fn eval_all(&self, coeffs: &ShCoeffs<Rgb>, out: &mut Vec<Rgb>) {
+        self.eval_with(coeffs, out, self.count, |column, i| column[i]);
+    }
+
+    /// `count` values, the `i`-th with basis values `y(column_k, i)`, coefficient after
+    /// coefficient.
+    #[inline]
+    fn eval_with(
+        &self,
+        coeffs: &ShCoeffs<Rgb>,
+        out: &mut Vec<Rgb>,
+        count: usize,
+        y: impl Fn(&[f32], usize) -> f32,
+    ) {
         let n = num_coeffs(self.order.min(coeffs.order()));
-        let [mut r, mut g, mut b] = [0, 1, 2].map(|_| vec![0.0f32; self.count]);
+        let [mut r, mut g, mut b] = [0, 1, 2].map(|_| vec![0.0f32; count]);
         for (c, column) in coeffs.as_slice()[..n]
             .iter()
-            .zip(self.values.chunks_exact(self.count))
+            .zip(self.values.chunks_exact(self.count.max(1)))
         {
-            for (((r, g), b), y) in r.iter_mut().zip(&mut g).zip(&mut b).zip(column) {
-                *r += c.x * *y;
-                *g += c.y * *y;
-                *b += c.z * *y;
+            for (i, ((r, g), b)) in r.iter_mut().zip(&mut g).zip(&mut b).enumerate() {
+                let y = y(column, i);
+                *r += c.x * y;
+                *g += c.y * y;
+                *b += c.z * y;
             }
         }
         out.clear();
@@ -95,20 +118,6 @@ impl BasisColumns {
                 .zip(&b)
                 .map(|((r, g), b)| Rgb::new(*r, *g, *b)),
         );
-    }
-}
-
-/// `(r, g, b)[k] += l · basis[k]` for every k (each sum in the same order as a plain loop, so
-/// the same floats; over slices of one length, so that it vectorizes).
-#[inline]
-pub(super) fn accumulate(sums: &mut [Vec<f32>; 3], l: Rgb, basis: &[f32]) {
-    let n = basis.len();
-    let [r, g, b] = sums;
-    let (r, g, b) = (&mut r[..n], &mut g[..n], &mut b[..n]);
-    for k in 0..n {
-        r[k] += l.x * basis[k];
-        g[k] += l.y * basis[k];
-        b[k] += l.z * basis[k];
     }
 }
 
@@ -132,35 +141,176 @@ impl ShProjector {
         &self.table
     }
 
-    /// `SH(L)_k = Σ_t L_t Y_k(ω_t) Δω_t`.
+    /// `SH(L)_k = Σ_t L_t Y_k(ω_t) Δω_t`, each coefficient's sum taken texel after texel.
     pub(crate) fn project(&self, map: &CubeMap) -> ShCoeffs<Rgb> {
-        let n = num_coeffs(self.table.order);
-        let stride = self.table.stride;
-        let mut sums = [
-            vec![0.0f32; stride],
-            vec![0.0f32; stride],
-            vec![0.0f32; stride],
-        ];
-        let rows = self.table.padded_rows();
-        for ((c, d_omega), y) in map.texels().iter().zip(&self.solid_angles).zip(rows) {
-            let l = *c * *d_omega;
-            accumulate(&mut sums, l, y);
+        let table = &self.table;
+        let stride = table.stride;
+        let mut sums = RowSums::zeros(stride);
+        let mut weighted = [Rgb::ZERO; ROW_TILE];
+        for ((texels, d_omegas), rows) in map
+            .texels()
+            .chunks(ROW_TILE)
+            .zip(self.solid_angles.chunks(ROW_TILE))
+            .zip(table.values.chunks(ROW_TILE * stride))
+        {
+            let weighted = &mut weighted[..texels.len()];
+            for ((l, c), d_omega) in weighted.iter_mut().zip(texels).zip(d_omegas) {
+                *l = *c * *d_omega;
+            }
+            sums.add_rows(weighted, |i| &rows[i * stride..][..stride]);
         }
-        let [mut r, mut g, mut b] = sums;
-        for channel in [&mut r, &mut g, &mut b] {
-            channel.truncate(n);
+        sums.into_coeffs(table.order)
+    }
+}
+
+/// Rows of basis values taken at a time by [`RowSums::add_rows`]: a tile stays in the first
+/// cache level while each block of coefficients passes over it.
+const ROW_TILE: usize = 64;
+
+/// Running sums `S_k += Σ_i l_i Y_k(d_i)` over padded basis rows, per channel, by blocks of
+/// [`LANES`] coefficients: within a tile of rows a block's three channel sums stay in
+/// registers, so they do not go through memory at every row. Each coefficient's sum is still
+/// taken row after row (the same additions in the same order: the same floats as a plain loop).
+pub(crate) struct RowSums {
+    stride: usize,
+    blocks: Vec<[[f32; LANES]; 3]>,
+}
+
+impl RowSums {
+    fn zeros(stride: usize) -> Self {
+        Self {
+            stride,
+            blocks: vec![[[0.0; LANES]; 3]; stride / LANES],
         }
-        Self::collect(r, g, b)
     }
 
-    pub(super) fn collect(r: Vec<f32>, g: Vec<f32>, b: Vec<f32>) -> ShCoeffs<Rgb> {
-        let coeffs = r
+    /// Sums that start at `coeffs`.
+    fn starting_at(coeffs: &ShCoeffs<Rgb>) -> Self {
+        let mut sums = Self::zeros(padded_stride(coeffs.as_slice().len()));
+        for (k, c) in coeffs.as_slice().iter().enumerate() {
+            let block = &mut sums.blocks[k / LANES];
+            (
+                block[0][k % LANES],
+                block[1][k % LANES],
+                block[2][k % LANES],
+            ) = (c.x, c.y, c.z);
+        }
+        sums
+    }
+
+    /// Adds `weights[i] · row(i)` for each padded row, in order.
+    fn add_rows<'r>(&mut self, weights: &[Rgb], row: impl Fn(usize) -> &'r [f32] + Copy) {
+        for (tile, weights) in weights.chunks(ROW_TILE).enumerate() {
+            let rows = |i: usize| row(tile * ROW_TILE + i);
+            // Up to four blocks at once: twelve independent sums keep the adder busy, where
+            // one block's three would wait on each addition's latency.
+            let mut first = 0;
+            while first < self.blocks.len() {
+                let group = (self.blocks.len() - first).min(4);
+                match group {
+                    1 => self.add_to_group::<1>(first, weights, rows),
+                    2 => self.add_to_group::<2>(first, weights, rows),
+                    3 => self.add_to_group::<3>(first, weights, rows),
+                    _ => self.add_to_group::<4>(first, weights, rows),
+                }
+                first += group;
+            }
+        }
+    }
+
+    /// [`Self::add_rows`] for the `G` blocks from `first` on.
+    #[inline]
+    fn add_to_group<'r, const G: usize>(
+        &mut self,
+        first: usize,
+        weights: &[Rgb],
+        row: impl Fn(usize) -> &'r [f32],
+    ) {
+        let sums = &mut self.blocks[first..first + G];
+        let mut acc = [[[0.0f32; LANES]; 3]; G];
+        acc.copy_from_slice(sums);
+        for (i, l) in weights.iter().enumerate() {
+            let row = row(i);
+            for (g, [r, gr, b]) in acc.iter_mut().enumerate() {
+                let y = &row[(first + g) * LANES..][..LANES];
+                for k in 0..LANES {
+                    r[k] += l.x * y[k];
+                    gr[k] += l.y * y[k];
+                    b[k] += l.z * y[k];
+                }
+            }
+        }
+        sums.copy_from_slice(&acc);
+    }
+
+    fn into_coeffs(self, order: usize) -> ShCoeffs<Rgb> {
+        let coeffs = self
+            .blocks
             .iter()
-            .zip(&g)
-            .zip(&b)
-            .map(|((r, g), b)| Rgb::new(*r, *g, *b))
+            .flat_map(|[r, g, b]| (0..LANES).map(|k| Rgb::new(r[k], g[k], b[k])))
+            .take(num_coeffs(order))
             .collect();
         ShCoeffs::from_vec(coeffs).expect("n² coefficients")
+    }
+}
+
+/// SH basis values at a set of texels that changes from call to call (a frame's light caps),
+/// in both layouts: padded rows to project onto, columns to evaluate expansions at.
+#[derive(Debug, Clone)]
+pub(crate) struct MemberBasis {
+    order: usize,
+    rows: Vec<f32>,
+    columns: BasisColumns,
+}
+
+impl MemberBasis {
+    pub(crate) fn new(order: usize) -> Self {
+        Self {
+            order,
+            rows: Vec::new(),
+            columns: BasisColumns {
+                order,
+                count: 0,
+                values: Vec::new(),
+            },
+        }
+    }
+
+    /// Makes the set the texels `members`: their rows are copied from `table` when given (the
+    /// basis at every texel), else evaluated at `directions[t]`.
+    pub(crate) fn set(
+        &mut self,
+        members: &[u32],
+        table: Option<&BasisTable>,
+        basis: &ShBasis<f32>,
+        directions: &[Vec3],
+    ) {
+        let n = num_coeffs(self.order);
+        let stride = padded_stride(n);
+        self.rows.clear();
+        self.rows.resize(members.len() * stride, 0.0);
+        for (row, &t) in self.rows.chunks_exact_mut(stride).zip(members) {
+            match table {
+                Some(table) => row.copy_from_slice(table.padded_row(t as usize)),
+                None => basis.eval(directions[t as usize], &mut row[..n]),
+            }
+        }
+        self.columns.set_rows(&self.rows, stride);
+    }
+
+    /// `coeffs` less `Σ_i excess_i Y(d_i)` over the members, in member order (adding
+    /// `−excess_i Y` subtracts exactly).
+    pub(crate) fn subtract(&self, coeffs: &ShCoeffs<Rgb>, excess: &[Rgb]) -> ShCoeffs<Rgb> {
+        let mut sums = RowSums::starting_at(coeffs);
+        let negated: Vec<Rgb> = excess.iter().map(|e| -*e).collect();
+        let stride = sums.stride;
+        sums.add_rows(&negated, |i| &self.rows[i * stride..][..stride]);
+        sums.into_coeffs(self.order)
+    }
+
+    /// The value of `coeffs` at every member, as [`ShCoeffs::eval`] gives it.
+    pub(crate) fn eval_all(&self, coeffs: &ShCoeffs<Rgb>, out: &mut Vec<Rgb>) {
+        self.columns.eval_all(coeffs, out);
     }
 }
 

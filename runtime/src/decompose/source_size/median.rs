@@ -12,18 +12,60 @@ pub(super) fn order_key(v: f32) -> u32 {
 pub(super) const RADIX_LEVELS: [u32; 3] = [11, 11, 10];
 
 /// The counts of the keys' top [`RADIX_LEVELS`]`[0]` bits: the selection's first histogram,
-/// taken while the keys are gathered.
-pub(super) struct TopBits([u32; 1 << 11]);
+/// taken while the keys are gathered. Neighbouring texels mostly fall in one bin, so the keys
+/// are counted into [`TopBits::WAYS`] histograms in turn (summed at the end): increments of
+/// one bin then do not wait on each other.
+pub(super) struct TopBits {
+    ways: [[u32; 1 << 11]; TopBits::WAYS],
+}
 
 impl TopBits {
+    const WAYS: usize = 4;
+
     pub(super) fn new() -> Self {
-        Self([0; 1 << 11])
+        Self {
+            ways: [[0; 1 << 11]; Self::WAYS],
+        }
+    }
+
+    #[inline]
+    fn bin(key: u32) -> usize {
+        (key >> (32 - RADIX_LEVELS[0])) as usize
     }
 
     #[inline]
     pub(super) fn count(&mut self, key: u32) -> u32 {
-        self.0[(key >> (32 - RADIX_LEVELS[0])) as usize] += 1;
+        self.ways[0][Self::bin(key)] += 1;
         key
+    }
+
+    /// Appends the keys `values` to `out`, counting them: first the keys (a loop that
+    /// vectorizes), then their bins, key `i` into histogram `i mod WAYS`.
+    #[inline]
+    pub(super) fn extend(&mut self, out: &mut Vec<u32>, values: impl Iterator<Item = u32>) {
+        let start = out.len();
+        out.extend(values);
+        let keys = &out[start..];
+        let mut quads = keys.chunks_exact(Self::WAYS);
+        for quad in &mut quads {
+            for (way, key) in self.ways.iter_mut().zip(quad) {
+                way[Self::bin(*key)] += 1;
+            }
+        }
+        for key in quads.remainder() {
+            self.ways[0][Self::bin(*key)] += 1;
+        }
+    }
+
+    /// The counts, all histograms summed.
+    fn counts(&self) -> [u32; 1 << 11] {
+        let mut total = self.ways[0];
+        for way in &self.ways[1..] {
+            for (t, c) in total.iter_mut().zip(way) {
+                *t += c;
+            }
+        }
+        total
     }
 }
 
@@ -42,7 +84,7 @@ pub(super) fn median_of_keys(keys: &mut Vec<u32>, top: &TopBits) -> f32 {
         shift -= bits;
         let mut counts = [0u32; 1 << 11];
         if level == 0 {
-            counts = top.0;
+            counts = top.counts();
         } else {
             for k in keys.iter() {
                 counts[((k >> shift) & ((1 << bits) - 1)) as usize] += 1;

@@ -176,11 +176,7 @@ impl TexelTable<'_> {
                 column_range(centre_u, outer, w),
             );
             for (a, b) in inside.segments(w) {
-                out.extend(
-                    row[a..b]
-                        .iter()
-                        .map(|c| top.count(order_key(luminance(*c)))),
-                );
+                top.extend(out, row[a..b].iter().map(|c| order_key(luminance(*c))));
             }
             for band in near.minus(inside, w) {
                 for (a, b) in band.segments(w) {
