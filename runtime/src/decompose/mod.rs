@@ -224,7 +224,7 @@ impl Decomposer {
         );
         self.prepare_analysis(map);
         let full = self.projector.project(self.analysis_map(map));
-        let (_, lights) = self.extract(map, &full, centres, CONSISTENT_ITERATIONS);
+        let (_, lights) = self.extract(map, &full, centres, CONSISTENT_ITERATIONS, false);
         lights.iter().map(|l| l.power).collect()
     }
 
@@ -330,7 +330,7 @@ impl Decomposer {
     ) -> (ShCoeffs<Rgb>, Vec<DirectionalLight>) {
         let centres: Vec<Vec3> = peaks.iter().map(|p| p.direction).collect();
         // One refit step is enough to rank the candidates.
-        let (_, trial) = self.extract(map, full, &centres, 1);
+        let (_, trial) = self.extract(map, full, &centres, 1, false);
         let mut order: Vec<usize> = (0..trial.len())
             .filter(|&i| luminance(trial[i].power) > 0.0)
             .collect();
@@ -340,26 +340,16 @@ impl Decomposer {
             .iter()
             .map(|&i| centres[i])
             .collect();
-        let (mut sh, mut lights) = self.extract(map, full, &kept, CONSISTENT_ITERATIONS);
+        let (mut sh, mut lights) = self.extract(map, full, &kept, CONSISTENT_ITERATIONS, true);
         sh.scale_bands(&self.sh_window);
         lights.retain(|l| luminance(l.power) > 0.0);
         lights.sort_by(|a, b| luminance(b.power).total_cmp(&luminance(a.power)));
         (sh, lights)
     }
 
-    /// For caps of radius R around `centres`: the excess `max(0, L − P)` of the map over the SH
-    /// part `P`, where `P` is refitted to the map minus that excess (a few fixed-point steps).
-    /// Texels in several caps belong to the nearest centre. Returns the final `P` and one light
-    /// per centre.
-    fn extract(
-        &mut self,
-        map: &CubeMap,
-        full: &ShCoeffs<Rgb>,
-        centres: &[Vec3],
-        iterations: usize,
-    ) -> (ShCoeffs<Rgb>, Vec<DirectionalLight>) {
-        let radius = self.settings.radius_deg.to_radians();
-        // Assign cap texels to their nearest centre.
+    /// The texels within `radius` of any of `centres`, each once, in the order found; each
+    /// texel's nearest centre is left in `owner` (the caller resets it).
+    fn cap_members(&mut self, centres: &[Vec3], radius: f32) -> Vec<u32> {
         let mut members: Vec<u32> = Vec::new();
         for (i, c) in centres.iter().enumerate() {
             self.geometry.texels_within(*c, radius, &mut self.cap);
@@ -374,34 +364,87 @@ impl Decomposer {
                 }
             }
         }
+        members
+    }
+
+    /// The excess at each of `members` after `iterations` refits of the SH part, and that part
+    /// refitted to the last excess when `keep_sh` (else `full`).
+    fn refit(
+        &mut self,
+        map: &CubeMap,
+        full: &ShCoeffs<Rgb>,
+        members: &[u32],
+        iterations: usize,
+        keep_sh: bool,
+    ) -> (ShCoeffs<Rgb>, Vec<Rgb>) {
         let texels = map.texels();
-        // SH basis at the cap texels, once per frame. At the analysis resolution the
-        // projector has the basis at every texel already.
+        // At the analysis resolution the projector has the basis at every texel already.
         let table = self
             .downsample
             .is_empty()
             .then(|| self.projector.texel_basis());
+        if iterations == 1 && !keep_sh {
+            // One step from the full expansion and no refit: `full` at each member is all
+            // that is needed (the same floats as through the member basis).
+            let mut row = vec![0.0; self.basis.num_coeffs()];
+            let excess = members
+                .iter()
+                .map(|&t| {
+                    let y = match table {
+                        Some(table) => table.padded_row(t as usize),
+                        None => {
+                            self.basis
+                                .eval(self.geometry.directions()[t as usize], &mut row);
+                            &row
+                        }
+                    };
+                    (texels[t as usize] - full.dot_basis(y)).max(Rgb::ZERO)
+                })
+                .collect();
+            return (full.clone(), excess);
+        }
         self.member_basis
-            .set(&members, table, &self.basis, self.geometry.directions());
+            .set(members, table, &self.basis, self.geometry.directions());
         let mut sh = full.clone();
         let mut excess: Vec<Rgb> = vec![Rgb::ZERO; members.len()];
-        let mut expansion = Vec::new();
-        let mut projected = Vec::new();
-        for _ in 0..iterations {
+        let (mut expansion, mut projected) = (Vec::new(), Vec::new());
+        for step in 0..iterations {
             // P = SH(map) − SH(excess), P refitted to the map less the excess.
             self.member_basis.eval_all(&sh, &mut expansion);
-            for ((e, &t), p) in excess.iter_mut().zip(&members).zip(&expansion) {
+            for ((e, &t), p) in excess.iter_mut().zip(members).zip(&expansion) {
                 *e = (texels[t as usize] - *p).max(Rgb::ZERO);
+            }
+            if step + 1 == iterations && !keep_sh {
+                break;
             }
             projected.clear();
             projected.extend(
                 excess
                     .iter()
-                    .zip(&members)
+                    .zip(members)
                     .map(|(e, &t)| *e * self.geometry.solid_angles()[t as usize]),
             );
             sh = self.member_basis.subtract(full, &projected);
         }
+        (sh, excess)
+    }
+
+    /// For caps of radius R around `centres`: the excess `max(0, L − P)` of the map over the SH
+    /// part `P`, where `P` is refitted to the map minus that excess (a few fixed-point steps).
+    /// Texels in several caps belong to the nearest centre. Returns one light per centre and,
+    /// when `keep_sh`, the final `P` (else `full`: the callers that only rank or measure the
+    /// lights skip the last refit).
+    fn extract(
+        &mut self,
+        map: &CubeMap,
+        full: &ShCoeffs<Rgb>,
+        centres: &[Vec3],
+        iterations: usize,
+        keep_sh: bool,
+    ) -> (ShCoeffs<Rgb>, Vec<DirectionalLight>) {
+        let radius = self.settings.radius_deg.to_radians();
+        let members = self.cap_members(centres, radius);
+        let (sh, excess) = self.refit(map, full, &members, iterations, keep_sh);
         // Each light: power, luminance-weighted centroid and spread of its excess.
         let mut power = vec![Rgb::ZERO; centres.len()];
         let mut moment = vec![Vec3::ZERO; centres.len()];

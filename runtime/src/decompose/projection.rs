@@ -36,7 +36,7 @@ impl BasisTable {
 
     /// Row `i` with its zero padding ([`padded_stride`] values).
     #[inline]
-    fn padded_row(&self, i: usize) -> &[f32] {
+    pub(crate) fn padded_row(&self, i: usize) -> &[f32] {
         &self.values[i * self.stride..][..self.stride]
     }
 }

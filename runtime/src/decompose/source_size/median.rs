@@ -82,21 +82,18 @@ pub(super) fn median_of_keys(keys: &mut Vec<u32>, top: &TopBits) -> f32 {
     let mut prefix = 0u32;
     for (level, bits) in RADIX_LEVELS.into_iter().enumerate() {
         shift -= bits;
-        let mut counts = [0u32; 1 << 11];
-        if level == 0 {
-            counts = top.counts();
+        let counts = if level == 0 {
+            top.counts()
         } else {
-            for k in keys.iter() {
-                counts[((k >> shift) & ((1 << bits) - 1)) as usize] += 1;
-            }
-        }
+            digit_counts(keys, shift, bits)
+        };
         let mut digit = 0;
         while rank >= counts[digit] as usize {
             rank -= counts[digit] as usize;
             digit += 1;
         }
         prefix = prefix << bits | digit as u32;
-        keys.retain(|k| k >> shift == prefix);
+        keep_prefix(keys, shift, prefix);
         if keys.len() == 1 || shift == 0 {
             break;
         }
@@ -104,6 +101,42 @@ pub(super) fn median_of_keys(keys: &mut Vec<u32>, top: &TopBits) -> f32 {
     let key = keys[rank.min(keys.len() - 1)];
     // Undo `order_key`.
     f32::from_bits(if key >> 31 == 1 { key ^ 1 << 31 } else { !key })
+}
+
+/// How many `keys` have each value of the `bits` bits from `shift` up, counted into four
+/// histograms in turn (as [`TopBits`] does) and summed.
+fn digit_counts(keys: &[u32], shift: u32, bits: u32) -> [u32; 1 << 11] {
+    let mask = (1u32 << bits) - 1;
+    let digit = |k: &u32| ((k >> shift) & mask) as usize;
+    let mut ways = [[0u32; 1 << 11]; 4];
+    let mut quads = keys.chunks_exact(4);
+    for quad in &mut quads {
+        for (way, key) in ways.iter_mut().zip(quad) {
+            way[digit(key)] += 1;
+        }
+    }
+    for key in quads.remainder() {
+        ways[0][digit(key)] += 1;
+    }
+    let [mut total, rest @ ..] = ways;
+    for way in &rest {
+        for (t, c) in total.iter_mut().zip(way) {
+            *t += c;
+        }
+    }
+    total
+}
+
+/// Keeps the keys whose bits above `shift` are `prefix`, in order. Without a branch per key:
+/// every key is written at the end of those kept, which grows only when it matches.
+fn keep_prefix(keys: &mut Vec<u32>, shift: u32, prefix: u32) {
+    let mut kept = 0;
+    for i in 0..keys.len() {
+        let key = keys[i];
+        keys[kept] = key;
+        kept += usize::from(key >> shift == prefix);
+    }
+    keys.truncate(kept);
 }
 
 /// [`median_of_keys`] of keys not counted while gathered.
