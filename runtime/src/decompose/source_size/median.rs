@@ -85,6 +85,13 @@ pub(super) fn median_of_keys(keys: &mut Vec<u32>, top: &TopBits) -> f32 {
         let counts = if level == 0 {
             top.counts()
         } else {
+            // Flat regions leave many equal keys: then they are the answer.
+            let (low, high) = keys
+                .iter()
+                .fold((u32::MAX, 0), |(lo, hi), k| (lo.min(*k), hi.max(*k)));
+            if low == high {
+                break;
+            }
             digit_counts(keys, shift, bits)
         };
         let mut digit = 0;
@@ -93,7 +100,9 @@ pub(super) fn median_of_keys(keys: &mut Vec<u32>, top: &TopBits) -> f32 {
             digit += 1;
         }
         prefix = prefix << bits | digit as u32;
-        keep_prefix(keys, shift, prefix);
+        if (counts[digit] as usize) < keys.len() {
+            keep_prefix(keys, shift, prefix);
+        }
         if keys.len() == 1 || shift == 0 {
             break;
         }

@@ -165,6 +165,19 @@ fn the_median_is_the_middle_element_in_total_order() {
         );
     }
     assert_eq!(median_of(&mut Vec::new()), 0.0);
+    // Flat maps: all keys equal, or equal but for a few in the same top bin on either side
+    // (the selection stops early on equal keys, and keeps them all when a bin holds all).
+    for (len, odd) in [(1001usize, 0usize), (1001, 3), (4000, 499)] {
+        let mut values = vec![1.5f32; len];
+        for k in 0..odd {
+            values[k] = 1.5 + (k as f32 + 1.0) * 1e-6;
+            values[len - 1 - k] = 1.5 - (k as f32 + 1.0) * 1e-6;
+        }
+        let mut sorted = values.clone();
+        sorted.sort_by(f32::total_cmp);
+        let mut keys: Vec<u32> = values.iter().map(|v| order_key(*v)).collect();
+        assert_eq!(median_of(&mut keys).to_bits(), sorted[len / 2].to_bits());
+    }
 }
 
 /// The measurement as first written, by brute force: every texel tested with its own
