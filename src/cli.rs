@@ -11,7 +11,7 @@ use runtime::{DecomposeMode, DecomposeSettings, Window};
 use std::path::PathBuf;
 
 /// `--env`, `--layout`, `--rotate`: the map a command lights the scene with.
-#[derive(Args, Clone, Debug)]
+#[derive(Args, Clone, Debug, Default)]
 pub struct EnvironmentArgs {
     /// Environment map (default: the scene's).
     #[arg(long)]

@@ -10,6 +10,7 @@
 // Every public item is reachable from the crate root: the API is what lib.rs exports.
 #![deny(unreachable_pub)]
 
+pub mod composite;
 pub mod export;
 mod integrator;
 mod light;
@@ -88,8 +89,13 @@ pub struct ReferenceImage {
     /// The part of `radiance` reflected by the first surface's specular lobe (zero for
     /// diffuse surfaces and uncovered pixels).
     pub specular: RgbImageF32,
+    /// The triangle the pixel's centre sees, or [`NO_HIT`].
+    pub primary: Vec<u32>,
     pub stats: RenderStats,
 }
+
+/// Marks a pixel that sees no geometry in [`ReferenceImage::primary`].
+pub const NO_HIT: u32 = u32::MAX;
 
 #[derive(Debug, Clone, Copy, Default, serde::Serialize)]
 pub struct RenderStats {
@@ -108,9 +114,15 @@ pub(crate) fn stream(seed: u64, index: u64) -> Pcg32 {
     Pcg32::new(mix64(seed ^ mix64(index)), index)
 }
 
-/// One image row: radiance, coverage, direct visibility, the rays it took, and the specular
-/// part of the radiance.
-type RowResult = (Vec<Rgb>, Vec<f32>, Vec<f32>, u64, Vec<Rgb>);
+/// What one pixel's paths found.
+#[derive(Clone, Copy)]
+struct PixelResult {
+    radiance: Rgb,
+    coverage: f32,
+    visibility: f32,
+    specular: Rgb,
+    primary: u32,
+}
 
 /// Renders `camera`'s view of `geometry` lit by `light`. `progress` counts image rows.
 pub fn render(
@@ -126,78 +138,100 @@ pub fn render(
     let basis = camera.basis();
     let integrator = Integrator::new(geometry, bvh, light, settings.bounces);
     progress.start(height as u64);
-    let rows: Vec<RowResult> = (0..height)
+    let rows: Vec<(Vec<PixelResult>, u64)> = (0..height)
         .into_par_iter()
         .map(|j| {
-            let mut row = (
-                Vec::with_capacity(width),
-                Vec::with_capacity(width),
-                Vec::with_capacity(width),
-                0u64,
-                Vec::with_capacity(width),
-            );
-            for i in 0..width {
-                let direction = camera.pixel_direction(&basis, i as u32, j as u32);
-                row.3 += 1;
-                let Some(hit) = bvh.intersect(camera.position, direction, 0.0, f32::INFINITY)
-                else {
-                    row.0.push(light.radiance(direction));
-                    row.1.push(0.0);
-                    row.2.push(1.0);
-                    row.4.push(Rgb::ZERO);
-                    continue;
-                };
-                let point = integrator.surface(&hit);
-                let mut sampler = PixelSampler::for_pass(
-                    settings.sampler,
-                    settings.seed,
-                    (j * width + i) as u64,
-                    settings.first_sample,
-                );
-                let (mut sum, mut specular) = (Rgb::ZERO, Rgb::ZERO);
-                let mut direct = DirectVisibility::default();
-                for _ in 0..settings.spp {
-                    let e = integrator.radiance(&point, -direction, &mut sampler, &mut row.3);
-                    sampler.next_sample();
-                    sum += e.radiance;
-                    specular += e.specular;
-                    direct.visible += e.direct.visible;
-                    direct.unoccluded += e.direct.unoccluded;
-                }
-                row.0.push(sum / settings.spp.max(1) as f32);
-                row.4.push(specular / settings.spp.max(1) as f32);
-                row.1.push(1.0);
-                row.2.push(if direct.unoccluded > 0.0 {
-                    direct.visible / direct.unoccluded
-                } else {
-                    1.0
-                });
-            }
+            let mut rays = 0u64;
+            let row = (0..width)
+                .map(|i| {
+                    let direction = camera.pixel_direction(&basis, i as u32, j as u32);
+                    let index = (j * width + i) as u64;
+                    render_pixel(
+                        &integrator,
+                        camera.position,
+                        direction,
+                        index,
+                        settings,
+                        &mut rays,
+                    )
+                })
+                .collect();
             progress.advance(1);
-            row
+            (row, rays)
         })
         .collect();
     progress.finish();
-    let mut pixels = Vec::with_capacity(width * height);
-    let mut image = ReferenceImage {
-        radiance: RgbImageF32::filled(0, 0, Rgb::ZERO),
-        coverage: Vec::with_capacity(width * height),
-        visibility: Vec::with_capacity(width * height),
-        specular: RgbImageF32::filled(0, 0, Rgb::ZERO),
-        stats: RenderStats::default(),
+    let pixels: Vec<PixelResult> = rows
+        .iter()
+        .flat_map(|(row, _)| row.iter().copied())
+        .collect();
+    let image = |f: fn(&PixelResult) -> Rgb| {
+        RgbImageF32::new(width, height, pixels.iter().map(f).collect())
     };
-    let mut specular = Vec::with_capacity(width * height);
-    for (radiance, coverage, visibility, rays, row_specular) in rows {
-        pixels.extend(radiance);
-        specular.extend(row_specular);
-        image.coverage.extend(coverage);
-        image.visibility.extend(visibility);
-        image.stats.rays += rays;
+    ReferenceImage {
+        radiance: image(|p| p.radiance),
+        specular: image(|p| p.specular),
+        coverage: pixels.iter().map(|p| p.coverage).collect(),
+        visibility: pixels.iter().map(|p| p.visibility).collect(),
+        primary: pixels.iter().map(|p| p.primary).collect(),
+        stats: RenderStats {
+            rays: rows.iter().map(|(_, rays)| rays).sum(),
+            seconds: start.elapsed().as_secs_f64(),
+        },
     }
-    image.radiance = RgbImageF32::new(width, height, pixels);
-    image.specular = RgbImageF32::new(width, height, specular);
-    image.stats.seconds = start.elapsed().as_secs_f64();
-    image
+}
+
+/// The paths of pixel `index`, whose centre's ray leaves `origin` in `direction`.
+fn render_pixel(
+    integrator: &Integrator,
+    origin: glam::Vec3,
+    direction: glam::Vec3,
+    index: u64,
+    settings: &ReferenceSettings,
+    rays: &mut u64,
+) -> PixelResult {
+    *rays += 1;
+    let Some(hit) = integrator
+        .bvh
+        .intersect(origin, direction, 0.0, f32::INFINITY)
+    else {
+        return PixelResult {
+            radiance: integrator.light.radiance(direction),
+            coverage: 0.0,
+            visibility: 1.0,
+            specular: Rgb::ZERO,
+            primary: NO_HIT,
+        };
+    };
+    let point = integrator.surface(&hit);
+    let mut sampler = PixelSampler::for_pass(
+        settings.sampler,
+        settings.seed,
+        index,
+        settings.first_sample,
+    );
+    let (mut sum, mut specular) = (Rgb::ZERO, Rgb::ZERO);
+    let mut direct = DirectVisibility::default();
+    for _ in 0..settings.spp {
+        let e = integrator.radiance(&point, -direction, &mut sampler, rays);
+        sampler.next_sample();
+        sum += e.radiance;
+        specular += e.specular;
+        direct.visible += e.direct.visible;
+        direct.unoccluded += e.direct.unoccluded;
+    }
+    let samples = settings.spp.max(1) as f32;
+    PixelResult {
+        radiance: sum / samples,
+        coverage: 1.0,
+        visibility: if direct.unoccluded > 0.0 {
+            direct.visible / direct.unoccluded
+        } else {
+            1.0
+        },
+        specular: specular / samples,
+        primary: hit.triangle,
+    }
 }
 
 /// Mean and standard error of `samples` estimates of the radiance leaving vertex `v` (the

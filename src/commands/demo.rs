@@ -54,6 +54,10 @@ const MODEL_SAMPLE_MAP: &str = "scenes/env/city.exr";
 /// Reference samples of the sample's report: a small scene, a quick reference (its noise
 /// floor is stated in the report).
 const MODEL_SAMPLE_SPP: u32 = 512;
+/// Compositing: the teapot composited into the sunrise map (its proxy floor takes the
+/// shadow), path-traced with and without it; light paths per pixel of that truth.
+const COMPOSITE: &str = "scenes/teapot_composite.toml";
+const COMPOSITE_SPP: u32 = 512;
 /// Glossy materials: the teapot (shininess 60) under every bundled map, and the dragon under
 /// one, with a quick reference.
 const GLOSSY_TEAPOT: &str = "scenes/teapot_glossy.toml";
@@ -109,6 +113,10 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         )?;
     }
 
+    if bundled_scenes {
+        composite_truth(&args.output.join("composite"), args.width, args.height)?;
+    }
+
     // A model as users bring theirs: the textured glTF sample, placed on its own, through
     // bake, hybrid, PRT and the path-traced reference.
     println!("\nthe glTF sample {MODEL_SAMPLE}:");
@@ -126,4 +134,28 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         &sample_options,
         &args.output.join("crate"),
     )
+}
+
+/// The true composite of the bundled compositing example into `dir`: the composite, its PNG,
+/// and its masks and layers (`aux/`). The GPU methods' composites are being built.
+fn composite_truth(dir: &Path, width: u32, height: u32) -> anyhow::Result<()> {
+    println!("\nthe composite {COMPOSITE} (path-traced truth):");
+    crate::support::create_folder(dir)?;
+    crate::commands::reference::run(crate::commands::reference::ReferenceArgs {
+        scene: bundled(COMPOSITE),
+        environment: Default::default(),
+        size: ImageSizeArgs {
+            width: Some(width),
+            height: Some(height),
+        },
+        spp: COMPOSITE_SPP,
+        bounces: 3,
+        seed: 0,
+        sampler: Default::default(),
+        threads: None,
+        exposure: None,
+        output: dir.join("composite.exr"),
+        png: Some(dir.join("composite.png")),
+        aux: Some(dir.join("aux")),
+    })
 }

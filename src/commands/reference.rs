@@ -8,6 +8,8 @@ use anyhow::Context;
 use clap::Args;
 use foundation::bvh::SceneBvh;
 use foundation::image_io::{RgbImageF32, exr_bytes, png_bytes, to_display_rgb8};
+use foundation::scene::{Backplate, load_backplate_image};
+use reference::composite::{Composite, PixelKind};
 use reference::{self, EnvironmentLight, ReferenceImage, ReferenceSettings, SamplerKind};
 use std::path::PathBuf;
 
@@ -44,7 +46,10 @@ pub struct ReferenceArgs {
     /// Also write a tone-mapped PNG.
     #[arg(long)]
     pub png: Option<PathBuf>,
-    /// Also write coverage and direct-visibility images (EXR and PNG) into this folder.
+    /// Also write coverage and direct-visibility images (EXR and PNG) into this folder; for a
+    /// scene with a [backplate], also the masks of the objects, the proxies and the changed
+    /// region, and the layers a compositor redoes the composite from (the objects, the shadow
+    /// ratio).
     #[arg(long)]
     pub aux: Option<PathBuf>,
 }
@@ -60,6 +65,23 @@ fn grey_files(width: usize, height: usize, values: &[f32]) -> anyhow::Result<[Ve
     Ok([exr_bytes(&image)?, png_bytes(&rgb, width, height)?])
 }
 
+/// The file names `--aux DIR` adds: coverage and direct visibility, and for a composite its
+/// masks (object, proxy, changed region) and layers (the objects, the shadow ratio).
+fn aux_files(dir: &std::path::Path, composite: bool) -> Vec<PathBuf> {
+    let mut names = vec!["coverage", "visibility"];
+    if composite {
+        names.extend(["object_mask", "proxy_mask", "changed_mask"]);
+    }
+    let mut files: Vec<PathBuf> = names
+        .into_iter()
+        .flat_map(|name| ["exr", "png"].map(|ext| dir.join(format!("{name}.{ext}"))))
+        .collect();
+    if composite {
+        files.extend(["objects.exr", "ratio.exr"].map(|name| dir.join(name)));
+    }
+    files
+}
+
 pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
     let env = args.environment.choose(&scene)?;
@@ -69,16 +91,27 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
         ..ReferenceSettings::new(args.spp, args.bounces, args.seed)
     };
     settings.validate()?;
+    let composite = scene.backplate.is_some();
+    let backplate = match &scene.backplate {
+        Some(Backplate::Image(path)) => Some(
+            load_backplate_image(path, camera.width, camera.height)
+                .with_context(|| format!("scene {}", scene.path.display()))?,
+        ),
+        _ => None,
+    };
+    if composite && !scene.geometry.has_proxies() {
+        eprintln!(
+            "warning: {}: [backplate] but no proxy (role = \"proxy\"): the objects are \
+             composited without shadows on the picture",
+            scene.path.display()
+        );
+    }
     let inputs = scene_inputs(&scene, &[Some(&env.path)]);
-    let aux: Vec<PathBuf> = args
+    let aux = args
         .aux
-        .iter()
-        .flat_map(|dir| {
-            ["coverage", "visibility"]
-                .into_iter()
-                .flat_map(move |name| ["exr", "png"].map(|ext| dir.join(format!("{name}.{ext}"))))
-        })
-        .collect();
+        .as_deref()
+        .map(|dir| aux_files(dir, composite))
+        .unwrap_or_default();
     let mut outputs = vec![
         ("-o", Some(args.output.as_path())),
         ("--png", args.png.as_deref()),
@@ -90,38 +123,32 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
     }
     let files = open_outputs(&outputs)?;
     println!(
-        "{}: {}x{}, {} spp, {} bounces, lit by {} rotated {}°",
+        "{}: {}x{}, {} spp, {} bounces, lit by {} rotated {}°{}",
         scene.name,
         camera.width,
         camera.height,
         settings.spp,
         settings.bounces,
         env.path.display(),
-        env.rotation_deg
+        env.rotation_deg,
+        if composite {
+            ", composited (with and without the objects)"
+        } else {
+            ""
+        }
     );
-    let image: ReferenceImage = with_threads(args.threads, || {
-        let bvh = SceneBvh::build(&scene.geometry.mesh);
-        let light = EnvironmentLight::new(&env.loaded.map, env.rotation_deg);
-        let progress = TerminalProgress::new("rendering rows");
-        reference::render(&scene.geometry, &bvh, &light, &camera, &settings, &progress)
-    })?;
+    let (image, composite) = render_scene(
+        &scene,
+        &env,
+        &camera,
+        &settings,
+        backplate.as_ref(),
+        args.threads,
+    )?;
     let exposure = args
         .exposure
         .unwrap_or_else(|| default_exposure(&env.loaded.map));
-    let mut bytes = vec![exr_bytes(&image.radiance).context("the render failed")?];
-    if args.png.is_some() {
-        let (w, h) = (image.radiance.width, image.radiance.height);
-        bytes.push(png_bytes(
-            &to_display_rgb8(&image.radiance, exposure),
-            w,
-            h,
-        )?);
-    }
-    if args.aux.is_some() {
-        let (w, h) = (camera.width as usize, camera.height as usize);
-        bytes.extend(grey_files(w, h, &image.coverage)?);
-        bytes.extend(grey_files(w, h, &image.visibility)?);
-    }
+    let bytes = output_bytes(&args, &image, composite.as_ref(), exposure)?;
     write_outputs(files, bytes)?;
     let megapixel_samples = camera.width as f64 * camera.height as f64 * settings.spp as f64 / 1e6;
     println!(
@@ -132,4 +159,75 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// The bytes of every output, in the order of [`aux_files`] after `-o` and `--png`.
+fn output_bytes(
+    args: &ReferenceArgs,
+    image: &ReferenceImage,
+    composite: Option<&Composite>,
+    exposure: f32,
+) -> anyhow::Result<Vec<Vec<u8>>> {
+    let shown = composite.map_or(&image.radiance, |c| &c.image);
+    let mut bytes = vec![exr_bytes(shown).context("the render failed")?];
+    let (w, h) = (shown.width, shown.height);
+    if args.png.is_some() {
+        bytes.push(png_bytes(&to_display_rgb8(shown, exposure), w, h)?);
+    }
+    if args.aux.is_some() {
+        bytes.extend(grey_files(w, h, &image.coverage)?);
+        bytes.extend(grey_files(w, h, &image.visibility)?);
+        if let Some(c) = composite {
+            bytes.extend(grey_files(w, h, &c.mask(PixelKind::Object))?);
+            bytes.extend(grey_files(w, h, &c.mask(PixelKind::Proxy))?);
+            bytes.extend(grey_files(w, h, &c.changed_mask())?);
+            bytes.push(exr_bytes(&c.objects)?);
+            bytes.push(exr_bytes(&c.ratio)?);
+        }
+    }
+    Ok(bytes)
+}
+
+/// Path-traces `scene` (composited into `backplate` when it has a `[backplate]`), warning when
+/// its objects change none of its proxies.
+fn render_scene(
+    scene: &foundation::scene::Scene,
+    env: &crate::maps::ChosenEnvironment,
+    camera: &foundation::camera::Camera,
+    settings: &ReferenceSettings,
+    backplate: Option<&RgbImageF32>,
+    threads: Option<usize>,
+) -> anyhow::Result<(ReferenceImage, Option<Composite>)> {
+    let (image, composite) = with_threads(threads, || {
+        let light = EnvironmentLight::new(&env.loaded.map, env.rotation_deg);
+        let progress = TerminalProgress::new("rendering rows");
+        if scene.backplate.is_some() {
+            let out = reference::composite::render_composite(
+                &scene.geometry,
+                &light,
+                camera,
+                settings,
+                backplate,
+                &progress,
+            );
+            (out.with_objects, Some(out.composite))
+        } else {
+            let bvh = SceneBvh::build(&scene.geometry.mesh);
+            let image =
+                reference::render(&scene.geometry, &bvh, &light, camera, settings, &progress);
+            (image, None)
+        }
+    })?;
+    if let Some(c) = &composite
+        && scene.geometry.has_proxies()
+        && !c.changed.iter().any(|c| *c)
+    {
+        eprintln!(
+            "warning: {}: the objects change no proxy pixel by more than {}% (is anything \
+             above the proxies, and in view?)",
+            scene.path.display(),
+            100.0 * reference::composite::CHANGED_THRESHOLD
+        );
+    }
+    Ok((image, composite))
 }

@@ -63,6 +63,7 @@ pub struct RenderArgs {
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
+    crate::support::refuse_proxies(&scene, "render")?;
     let transfer = load_bake(&scene, &args.bake, args.decompose.order)?;
     let rotation_deg = scene_rotation(&scene, args.environment.rotate);
     let mut camera = args.size.camera(&scene)?;

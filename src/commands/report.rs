@@ -35,6 +35,7 @@ pub struct ReportArgs {
 
 pub fn run(args: ReportArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
+    crate::support::refuse_proxies(&scene, "report")?;
     if let Some(sequence) = &args.env_sequence {
         return write_sequence_report(&scene, sequence, &args.options, &args.output);
     }

@@ -150,6 +150,7 @@ fn initial_settings(scene: &Scene, env: &Path, order: usize) -> ViewSettings {
 pub fn run(args: ViewArgs) -> anyhow::Result<()> {
     check_display()?;
     let scene = load_scene(&args.scene)?;
+    crate::support::refuse_proxies(&scene, "view")?;
     let bake = open_bake(&scene, args.bake.as_deref())?;
     let env = match (&args.env, &scene.environment) {
         (Some(p), _) => p.clone(),

@@ -30,6 +30,12 @@ pub const MAX_TEXTURE_TEXELS: u64 = 4096 * 4096;
 /// Longest side of a texture (a long, thin texture is still bounded by its texel count).
 pub const MAX_TEXTURE_SIDE: u32 = 16_384;
 
+/// Most pixels of a backplate photograph, and its longest side: it is decoded, made linear
+/// (12 bytes a pixel: 480 MB here) and resampled to the camera's resolution; a 40-megapixel
+/// camera's full frame fits, a larger one should be downscaled first.
+pub const MAX_BACKPLATE_PIXELS: u64 = 40_000_000;
+pub const MAX_BACKPLATE_SIDE: u32 = 16_384;
+
 /// Most triangles a scene may hold after instancing: the bake's tables take about a kilobyte
 /// per vertex at order 5, so this many triangles is already tens of gigabytes of bake.
 pub const MAX_SCENE_TRIANGLES: usize = 50_000_000;

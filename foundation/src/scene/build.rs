@@ -63,6 +63,8 @@ impl Scene {
                 env.rotation_deg
             )));
         }
+        let backplate = check_roles(&geometry, file.backplate.as_ref()).map_err(invalid)?;
+        let backplate = backplate.map(|b| b.resolve(dir));
         let environment = file.environment.map(|env| EnvironmentSpec {
             map: dir.join(env.map),
             rotation_deg: env.rotation_deg,
@@ -84,8 +86,41 @@ impl Scene {
                         .iter()
                         .filter_map(|o| o.mesh.as_ref().map(|m| dir.join(m))),
                 )
+                .chain(match &backplate {
+                    Some(Backplate::Image(image)) => Some(image.clone()),
+                    _ => None,
+                })
                 .collect(),
+            backplate,
         })
+    }
+}
+
+/// Checks that a scene's proxies and backplate go together: proxies need a backplate to be
+/// composited into, and something virtual to composite. Returns the backplate.
+fn check_roles<'a>(
+    geometry: &SceneMesh,
+    backplate: Option<&'a BackplateSpec>,
+) -> Result<Option<&'a BackplateSpec>, String> {
+    let proxies = geometry.has_proxies();
+    if proxies && geometry.objects.iter().all(|o| o.role == ObjectRole::Proxy) {
+        return Err(
+            "every object is a proxy (role = \"proxy\"): there is nothing virtual to \
+                    composite; give the model role = \"object\" (the default)"
+                .into(),
+        );
+    }
+    match backplate {
+        None if proxies => Err(
+            "the scene has proxies (role = \"proxy\") but no [backplate] to \
+                                composite into: add [backplate] with image = \"environment\" or \
+                                a photograph"
+                .into(),
+        ),
+        Some(b) if b.image.trim().is_empty() => {
+            Err("[backplate]: image is empty (give \"environment\" or an image file)".into())
+        }
+        other => Ok(other),
     }
 }
 
@@ -160,6 +195,7 @@ fn add_object(
         }
         if let Some(o) = geometry.objects.last_mut() {
             o.material = material;
+            o.role = object.role;
         }
     }
     Ok(())

@@ -20,6 +20,59 @@ pub struct SceneFile {
     pub bake: BakeSettings,
     #[serde(rename = "object", default)]
     pub objects: Vec<ObjectSpec>,
+    /// The picture the virtual objects are composited into (CONVENTIONS.md, "Compositing").
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub backplate: Option<BackplateSpec>,
+}
+
+/// `[backplate]`: the picture to composite into, seen through the scene's `[camera]`.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BackplateSpec {
+    /// `"environment"` (the environment map as the camera sees it), or an image (sRGB JPEG or
+    /// PNG, or a linear EXR) relative to the scene file, of the camera's aspect ratio.
+    pub image: String,
+}
+
+impl BackplateSpec {
+    /// The value of `image` that names the environment map.
+    pub const ENVIRONMENT: &str = "environment";
+
+    /// What the backplate is, an image's path resolved against the scene's folder `dir`.
+    pub fn resolve(&self, dir: &std::path::Path) -> Backplate {
+        match self.image.as_str() {
+            Self::ENVIRONMENT => Backplate::Environment,
+            image => Backplate::Image(dir.join(image)),
+        }
+    }
+}
+
+/// The picture composited into.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Backplate {
+    /// The environment map as the camera sees it (the HDRI-backplate workflow).
+    Environment,
+    /// A photograph (or any image) taken through the scene's camera.
+    Image(PathBuf),
+}
+
+/// What an object is in a composite.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ObjectRole {
+    /// A virtual object: drawn, and composited over the backplate.
+    #[default]
+    Object,
+    /// A stand-in for a real surface of the backplate (a floor, a table top): lit, shadowed
+    /// and baked like any object, but never drawn; only the change the virtual objects make
+    /// to it is composited.
+    Proxy,
+}
+
+impl ObjectRole {
+    fn is_object(&self) -> bool {
+        *self == Self::Object
+    }
 }
 
 /// The environment map a scene is lit by unless the command line says otherwise.
@@ -70,6 +123,9 @@ pub struct ObjectSpec {
     /// Weld coincident vertices (default: when the file has no normals).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub weld: Option<bool>,
+    /// `"object"` (default) or `"proxy"`.
+    #[serde(default, skip_serializing_if = "ObjectRole::is_object")]
+    pub role: ObjectRole,
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize)]

@@ -4,6 +4,7 @@
 use crate::color::Rgb;
 use crate::material::Material;
 use crate::mesh::TriangleMesh;
+use crate::scene::ObjectRole;
 use crate::texture::AlbedoTexture;
 use std::sync::Arc;
 
@@ -19,6 +20,8 @@ pub struct SceneObject {
     pub texture: Option<usize>,
     /// Its specular lobe, if glossy (the albedo above is its diffuse `k_d`).
     pub material: Material,
+    /// A virtual object, or a proxy of a real surface.
+    pub role: ObjectRole,
 }
 
 /// Marks a triangle without a texture in [`SceneMesh::triangle_textures`].
@@ -113,6 +116,7 @@ impl SceneMesh {
             triangles: t0..self.mesh.triangle_count() as u32,
             texture: None,
             material: Material::DIFFUSE,
+            role: ObjectRole::Object,
         });
     }
 
@@ -137,6 +141,47 @@ impl SceneMesh {
         if let Some(object) = self.objects.last_mut() {
             object.texture = Some(index);
         }
+    }
+
+    /// Whether any object is a proxy of a real surface.
+    pub fn has_proxies(&self) -> bool {
+        self.objects.iter().any(|o| o.role == ObjectRole::Proxy)
+    }
+
+    /// The objects `keep` accepts, as a scene mesh of their own (their names, albedos,
+    /// textures, materials and roles kept; triangles in the same order).
+    pub fn subset(&self, keep: impl Fn(&SceneObject) -> bool) -> SceneMesh {
+        let mut out = SceneMesh::default();
+        for o in self.objects.iter().filter(|o| keep(o)) {
+            let (v0, v1) = (o.vertices.start as usize, o.vertices.end as usize);
+            let part = TriangleMesh {
+                positions: self.mesh.positions[v0..v1].to_vec(),
+                normals: self.mesh.normals[v0..v1].to_vec(),
+                triangles: self.mesh.triangles
+                    [o.triangles.start as usize..o.triangles.end as usize]
+                    .iter()
+                    .map(|t| t.map(|i| i - o.vertices.start))
+                    .collect(),
+                uvs: match self.mesh.uvs.is_empty() {
+                    true => Vec::new(),
+                    false => self.mesh.uvs[v0..v1].to_vec(),
+                },
+            };
+            match o.texture {
+                Some(t) => out.push_textured_object(
+                    o.name.clone(),
+                    &part,
+                    o.albedo,
+                    self.textures[t].clone(),
+                ),
+                None => out.push_object(o.name.clone(), &part, o.albedo),
+            }
+            if let Some(last) = out.objects.last_mut() {
+                last.material = o.material;
+                last.role = o.role;
+            }
+        }
+        out
     }
 
     /// Whether any object has a specular lobe.

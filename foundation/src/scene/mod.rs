@@ -1,14 +1,17 @@
 //! Scene files (TOML): objects with transforms and albedos, the camera, the default
 //! environment map and the default bake settings. The format is described in `scenes/README.md`.
 
+mod backplate;
 mod build;
 mod description;
 mod geometry;
 pub mod model;
 
+pub use backplate::{BackplateError, load_backplate_image};
 pub use build::MAX_MATERIAL_ALBEDO;
 pub use description::{
-    AnnulusSpec, BoxSpec, EnvironmentSpec, ObjectSpec, Scale, SceneFile, Transform,
+    AnnulusSpec, Backplate, BackplateSpec, BoxSpec, EnvironmentSpec, ObjectRole, ObjectSpec, Scale,
+    SceneFile, Transform,
 };
 pub use geometry::{NO_TEXTURE, SceneMesh, SceneObject};
 
@@ -48,6 +51,8 @@ pub struct Scene {
     /// Default environment, its path resolved relative to the scene file.
     pub environment: Option<EnvironmentSpec>,
     pub bake: BakeSettings,
+    /// The picture its objects are composited into, when it has proxies.
+    pub backplate: Option<Backplate>,
     /// Every file the scene was read from: the scene file (or model) and each object's mesh.
     pub sources: Vec<PathBuf>,
 }
@@ -91,6 +96,58 @@ mod tests {
                 .all(|a| *a == Rgb::new(0.5, 0.4, 0.3))
         );
         assert_eq!(scene.bake, BakeSettings::default());
+    }
+
+    #[test]
+    fn proxies_and_backplates_are_checked() {
+        let dir = tempfile::tempdir().unwrap();
+        let object = "[[object]]\nname = \"model\"\nbox = { min = [0,0,0], max = [1,1,1] }\nalbedo = [0.5, 0.5, 0.5]\n";
+        let proxy = "[[object]]\nname = \"floor\"\nrole = \"proxy\"\nbox = { min = [-4,-1,-4], max = [4,0,4] }\nalbedo = [0.3, 0.3, 0.3]\n";
+        let load = |text: String| Scene::load(&write_scene(dir.path(), &text));
+        let scene = load(format!(
+            "{CAMERA}[backplate]\nimage = \"environment\"\n{object}{proxy}"
+        ))
+        .unwrap();
+        assert_eq!(scene.backplate, Some(Backplate::Environment));
+        let roles: Vec<ObjectRole> = scene.geometry.objects.iter().map(|o| o.role).collect();
+        assert_eq!(roles, [ObjectRole::Object, ObjectRole::Proxy]);
+        let proxies = scene.geometry.subset(|o| o.role == ObjectRole::Proxy);
+        assert_eq!(proxies.objects.len(), 1);
+        assert_eq!(proxies.objects[0].name, "floor");
+        assert_eq!(proxies.mesh.triangle_count(), 12);
+
+        // A photograph resolves against the scene's folder and counts as an input.
+        let scene = load(format!(
+            "{CAMERA}[backplate]\nimage = \"plate.jpg\"\n{object}{proxy}"
+        ))
+        .unwrap();
+        let plate = dir.path().join("plate.jpg");
+        assert_eq!(scene.backplate, Some(Backplate::Image(plate.clone())));
+        assert!(scene.sources.contains(&plate));
+
+        let err = load(format!("{CAMERA}{object}{proxy}"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("s.toml") && err.contains("[backplate]"),
+            "{err}"
+        );
+        let err = load(format!(
+            "{CAMERA}[backplate]\nimage = \"environment\"\n{proxy}"
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("s.toml") && err.contains("every object is a proxy"),
+            "{err}"
+        );
+        let err = load(format!(
+            "{CAMERA}{}",
+            object.replace("name", "role = \"ghost\"\nname")
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("ghost") && err.contains("line"), "{err}");
     }
 
     #[test]

@@ -95,6 +95,7 @@ pub fn scene_file_for_model(
         environment: None,
         bake: BakeSettings::default(),
         objects,
+        backplate: None,
     })
 }
 

@@ -1,0 +1,220 @@
+//! The true composite (CONVENTIONS.md, "Compositing"): differential rendering in the ratio
+//! form (Debevec 1998; the form of Blender's shadow catcher). The scene is path-traced with
+//! and without its virtual objects, with the same seed; on proxy pixels the backplate is
+//! multiplied by `L(with) / L(without)`, object pixels show the rendered objects, and every
+//! other pixel keeps the backplate.
+
+use crate::{EnvironmentLight, NO_HIT, ReferenceImage, ReferenceSettings, render};
+use foundation::bvh::SceneBvh;
+use foundation::camera::Camera;
+use foundation::color::{Rgb, luminance};
+use foundation::image_io::RgbImageF32;
+use foundation::infra::progress::Progress;
+use foundation::scene::{ObjectRole, SceneMesh};
+
+/// Below this fraction of the proxies' mean radiance (without the objects) a channel of
+/// `L(without)` is too dark to divide by.
+pub const RATIO_FLOOR: f32 = 1e-3;
+/// Largest shadow ratio: light the objects add to a proxy (their interreflection) can brighten
+/// it, but never by more than this (a noisy near-black `L(without)` would otherwise flare).
+pub const MAX_RATIO: f32 = 8.0;
+/// A proxy pixel is in the changed region when its luminance ratio differs from 1 by more.
+pub const CHANGED_THRESHOLD: f32 = 0.02;
+
+/// What the camera sees at a pixel's centre.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PixelKind {
+    /// A virtual object: the composite shows it as rendered.
+    Object,
+    /// A proxy of a real surface: the backplate, times the shadow ratio.
+    Proxy,
+    /// Neither: the backplate as it is.
+    Background,
+}
+
+/// `L(with) / L(without)` per channel, for a proxy pixel. A channel of `L(without)` at or
+/// below `floor` takes the luminance ratio instead, and where the luminance too is at or below
+/// it the ratio is 1 (the model says the surface is black there: the photograph is kept).
+/// Clamped to `[0, MAX_RATIO]`.
+pub fn shadow_ratio(with: Rgb, without: Rgb, floor: f32) -> Rgb {
+    let (y_with, y_without) = (luminance(with), luminance(without));
+    let grey = if y_without > floor {
+        y_with / y_without
+    } else {
+        1.0
+    };
+    let channel = |w: f32, wo: f32| if wo > floor { w / wo } else { grey };
+    Rgb::new(
+        channel(with.x, without.x),
+        channel(with.y, without.y),
+        channel(with.z, without.z),
+    )
+    .clamp(Rgb::ZERO, Rgb::splat(MAX_RATIO))
+}
+
+/// The composite at one pixel: the rendered object, the backplate times the ratio on a proxy,
+/// else the backplate.
+pub fn composite_pixel(kind: PixelKind, backplate: Rgb, rendered: Rgb, ratio: Rgb) -> Rgb {
+    match kind {
+        PixelKind::Object => rendered,
+        PixelKind::Proxy => backplate * ratio,
+        PixelKind::Background => backplate,
+    }
+}
+
+/// A composite and its layers, for a compositor to redo it.
+#[derive(Debug, Clone)]
+pub struct Composite {
+    pub image: RgbImageF32,
+    /// The rendered radiance on object pixels, zero elsewhere.
+    pub objects: RgbImageF32,
+    /// The shadow ratio on proxy pixels, one elsewhere.
+    pub ratio: RgbImageF32,
+    pub kinds: Vec<PixelKind>,
+    /// Proxy pixels whose luminance ratio differs from 1 by more than [`CHANGED_THRESHOLD`].
+    pub changed: Vec<bool>,
+}
+
+impl Composite {
+    /// Whether the pixel is of `kind`, as 1 or 0 (a mask image).
+    pub fn mask(&self, kind: PixelKind) -> Vec<f32> {
+        self.kinds.iter().map(|k| f32::from(*k == kind)).collect()
+    }
+
+    pub fn changed_mask(&self) -> Vec<f32> {
+        self.changed.iter().map(|c| f32::from(*c)).collect()
+    }
+}
+
+/// The kind of each pixel of `image` (a render of `geometry`).
+pub fn pixel_kinds(geometry: &SceneMesh, image: &ReferenceImage) -> Vec<PixelKind> {
+    let mut roles = vec![ObjectRole::Object; geometry.mesh.triangle_count()];
+    for o in &geometry.objects {
+        roles[o.triangles.start as usize..o.triangles.end as usize].fill(o.role);
+    }
+    image
+        .primary
+        .iter()
+        .map(|&t| match t {
+            NO_HIT => PixelKind::Background,
+            t => match roles[t as usize] {
+                ObjectRole::Object => PixelKind::Object,
+                ObjectRole::Proxy => PixelKind::Proxy,
+            },
+        })
+        .collect()
+}
+
+/// Composites `with` (the whole scene) into `backplate`, the proxies' change measured against
+/// `without` (the proxies alone, same camera and seed).
+pub fn composite(
+    kinds: &[PixelKind],
+    with: &RgbImageF32,
+    without: &RgbImageF32,
+    backplate: &RgbImageF32,
+) -> Composite {
+    let proxies: Vec<usize> = (0..kinds.len())
+        .filter(|&i| kinds[i] == PixelKind::Proxy)
+        .collect();
+    let mean_without = proxies
+        .iter()
+        .map(|&i| f64::from(luminance(without.pixels[i])))
+        .sum::<f64>()
+        / proxies.len().max(1) as f64;
+    let floor = RATIO_FLOOR * mean_without as f32;
+    let n = kinds.len();
+    let (mut image, mut objects, mut ratio) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
+    let mut changed = Vec::with_capacity(n);
+    for (i, kind) in kinds.iter().enumerate() {
+        let r = match kind {
+            PixelKind::Proxy => shadow_ratio(with.pixels[i], without.pixels[i], floor),
+            _ => Rgb::ONE,
+        };
+        image.push(composite_pixel(
+            *kind,
+            backplate.pixels[i],
+            with.pixels[i],
+            r,
+        ));
+        objects.push(match kind {
+            PixelKind::Object => with.pixels[i],
+            _ => Rgb::ZERO,
+        });
+        ratio.push(r);
+        changed.push((luminance(r) - 1.0).abs() > CHANGED_THRESHOLD);
+    }
+    let image_of = |pixels| RgbImageF32::new(with.width, with.height, pixels);
+    Composite {
+        image: image_of(image),
+        objects: image_of(objects),
+        ratio: image_of(ratio),
+        kinds: kinds.to_vec(),
+        changed,
+    }
+}
+
+/// The environment map as `camera` sees it: the backplate of the HDRI workflow.
+pub fn environment_backplate(light: &EnvironmentLight, camera: &Camera) -> RgbImageF32 {
+    let basis = camera.basis();
+    let pixels = (0..camera.height)
+        .flat_map(|j| (0..camera.width).map(move |i| (i, j)))
+        .map(|(i, j)| light.radiance(camera.pixel_direction(&basis, i, j)))
+        .collect();
+    RgbImageF32::new(camera.width as usize, camera.height as usize, pixels)
+}
+
+/// The two path traces of a composite and the composite itself.
+pub struct CompositeRender {
+    pub composite: Composite,
+    /// The whole scene: virtual objects and proxies.
+    pub with_objects: ReferenceImage,
+    /// The proxies alone, with the same seed.
+    pub without_objects: ReferenceImage,
+}
+
+/// Path-traces `geometry` with and without its virtual objects (same settings and seed) and
+/// composites the objects into `backplate` (`None`: the environment map as the camera sees
+/// it). `progress` counts the rows of both renders.
+pub fn render_composite(
+    geometry: &SceneMesh,
+    light: &EnvironmentLight,
+    camera: &Camera,
+    settings: &ReferenceSettings,
+    backplate: Option<&RgbImageF32>,
+    progress: &dyn Progress,
+) -> CompositeRender {
+    let proxies = geometry.subset(|o| o.role == ObjectRole::Proxy);
+    let trace = |scene: &SceneMesh| {
+        let bvh = SceneBvh::build(&scene.mesh);
+        render(scene, &bvh, light, camera, settings, progress)
+    };
+    let with_objects = trace(geometry);
+    let without_objects = trace(&proxies);
+    let environment;
+    let backplate = match backplate {
+        Some(image) => image,
+        None => {
+            environment = environment_backplate(light, camera);
+            &environment
+        }
+    };
+    let kinds = pixel_kinds(geometry, &with_objects);
+    let composite = composite(
+        &kinds,
+        &with_objects.radiance,
+        &without_objects.radiance,
+        backplate,
+    );
+    CompositeRender {
+        composite,
+        with_objects,
+        without_objects,
+    }
+}
+
+#[cfg(test)]
+mod tests;

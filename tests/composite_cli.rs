@@ -1,0 +1,179 @@
+//! `hprt reference` on a scene with proxies and a backplate (issue 31): the true composite,
+//! its masks and layers, and the inputs it refuses.
+
+mod common;
+
+use common::*;
+use foundation::image_io::{png_bytes, read_exr};
+use std::path::Path;
+
+/// A scene file: a box (`role` of the floor as given) on a floor slab, lit by `map.exr`,
+/// with `backplate` appended verbatim.
+fn floor_scene(dir: &Path, name: &str, floor_role: &str, backplate: &str) {
+    std::fs::write(
+        dir.join(name),
+        format!(
+            "[camera]\nposition = [0, 3, 5]\ntarget = [0, 0.3, 0]\nfov_y_deg = 50\nwidth = 40\nheight = 30\n\
+             [environment]\nmap = \"map.exr\"\n{backplate}\n\
+             [[object]]\nname = \"box\"\nbox = {{ min = [-0.5, 0, -0.5], max = [0.5, 1, 0.5] }}\nalbedo = [0.6, 0.4, 0.3]\n\
+             [[object]]\nname = \"floor\"\nrole = \"{floor_role}\"\n\
+             box = {{ min = [-4, -0.2, -4], max = [4, 0, 4], segments = [8, 1, 8] }}\nalbedo = [0.4, 0.4, 0.4]\n"
+        ),
+    )
+    .unwrap();
+}
+
+fn workspace() -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_owned();
+    std::fs::copy(repo().join("tests/data/hall_dwab.exr"), d.join("map.exr")).unwrap();
+    (dir, d)
+}
+
+const ENVIRONMENT: &str = "[backplate]\nimage = \"environment\"";
+
+/// The composite shows the objects exactly as a whole-scene render with the same seed does,
+/// and `--aux` writes masks that partition the frame and a changed region under the box.
+#[test]
+fn the_composite_shows_the_whole_scene_render_on_its_objects() {
+    let (_keep, d) = workspace();
+    floor_scene(&d, "composite.toml", "proxy", ENVIRONMENT);
+    floor_scene(&d, "whole.toml", "object", "");
+    let spp = ["--spp", "8", "--seed", "5"];
+    let out = hprt(
+        &d,
+        &[
+            &["reference", "composite.toml", "-o", "c.exr", "--aux", "aux"][..],
+            &spp,
+        ]
+        .concat(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = hprt(
+        &d,
+        &[&["reference", "whole.toml", "-o", "w.exr"][..], &spp].concat(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (c, w) = (
+        read_exr(&d.join("c.exr")).unwrap(),
+        read_exr(&d.join("w.exr")).unwrap(),
+    );
+    let mask = |name: &str| read_exr(&d.join("aux").join(name)).unwrap().pixels;
+    let (object, proxy, changed) = (
+        mask("object_mask.exr"),
+        mask("proxy_mask.exr"),
+        mask("changed_mask.exr"),
+    );
+    let count = |m: &[foundation::Rgb]| m.iter().filter(|p| p.x == 1.0).count();
+    assert!(
+        count(&object) > 20 && count(&proxy) > 200,
+        "masks are empty"
+    );
+    assert!(count(&changed) > 10, "the box changes the floor");
+    for i in 0..c.pixels.len() {
+        assert!(
+            object[i].x + proxy[i].x <= 1.0,
+            "pixel {i} is object and proxy"
+        );
+        assert!(
+            changed[i].x <= proxy[i].x,
+            "pixel {i} changed off the proxies"
+        );
+        if object[i].x == 1.0 {
+            assert_eq!(c.pixels[i], w.pixels[i], "object pixel {i}");
+        }
+    }
+    let ratio = read_exr(&d.join("aux/ratio.exr")).unwrap();
+    assert!(
+        ratio
+            .pixels
+            .iter()
+            .all(|r| r.is_finite() && r.min_element() >= 0.0)
+    );
+}
+
+#[test]
+fn bad_backplates_and_roles_are_refused_naming_the_file() {
+    let (_keep, d) = workspace();
+    // A square photograph for a 4:3 camera.
+    std::fs::write(
+        d.join("square.png"),
+        png_bytes(&vec![90u8; 30 * 30 * 3], 30, 30).unwrap(),
+    )
+    .unwrap();
+    floor_scene(
+        &d,
+        "square.toml",
+        "proxy",
+        "[backplate]\nimage = \"square.png\"",
+    );
+    let out = hprt(
+        &d,
+        &["reference", "square.toml", "-o", "out.exr", "--spp", "1"],
+    );
+    assert_clean_failure(&out, &["square.png", "aspect ratio", "30:30", "40:30"]);
+    assert!(!d.join("out.exr").exists());
+
+    std::fs::write(d.join("junk.jpg"), b"this is not a jpeg").unwrap();
+    floor_scene(
+        &d,
+        "junk.toml",
+        "proxy",
+        "[backplate]\nimage = \"junk.jpg\"",
+    );
+    let out = hprt(
+        &d,
+        &["reference", "junk.toml", "-o", "out.exr", "--spp", "1"],
+    );
+    assert_clean_failure(&out, &["junk.jpg"]);
+    assert!(!d.join("out.exr").exists());
+
+    floor_scene(&d, "no_plate.toml", "proxy", "");
+    let out = hprt(
+        &d,
+        &["reference", "no_plate.toml", "-o", "out.exr", "--spp", "1"],
+    );
+    assert_clean_failure(&out, &["no_plate.toml", "[backplate]"]);
+
+    // The GPU commands say they cannot composite yet rather than drawing the proxies.
+    floor_scene(&d, "composite.toml", "proxy", ENVIRONMENT);
+    let out = hprt(
+        &d,
+        &[
+            "render",
+            "composite.toml",
+            "--bake",
+            "none.bake",
+            "-o",
+            "out.png",
+        ],
+    );
+    assert_clean_failure(&out, &["composite.toml", "proxies", "hprt reference"]);
+    assert!(!d.join("out.png").exists());
+}
+
+/// Objects under the floor change nothing on it: the composite says so.
+#[test]
+fn proxies_with_nothing_above_them_are_warned_about() {
+    let (_keep, d) = workspace();
+    let text = std::fs::read_to_string({
+        floor_scene(&d, "under.toml", "proxy", ENVIRONMENT);
+        d.join("under.toml")
+    })
+    .unwrap()
+    .replace(
+        "min = [-0.5, 0, -0.5], max = [0.5, 1, 0.5]",
+        "min = [-0.5, -3, -0.5], max = [0.5, -2, 0.5]",
+    );
+    std::fs::write(d.join("under.toml"), text).unwrap();
+    let out = hprt(
+        &d,
+        &["reference", "under.toml", "-o", "out.exr", "--spp", "2"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("change no proxy pixel"),
+        "{}",
+        stderr(&out)
+    );
+}
