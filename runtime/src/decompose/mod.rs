@@ -224,8 +224,30 @@ impl Decomposer {
         );
         self.prepare_analysis(map);
         let full = self.projector.project(self.analysis_map(map));
-        let (_, lights) = self.extract(map, &full, centres, CONSISTENT_ITERATIONS, false);
-        lights.iter().map(|l| l.power).collect()
+        self.cap_powers(map, &full, centres, CONSISTENT_ITERATIONS)
+    }
+
+    /// The power of the excess in each of `centres`' caps after `iterations` refits ([`Self::
+    /// extract`]'s lights' powers, without their directions and sizes).
+    fn cap_powers(
+        &mut self,
+        map: &CubeMap,
+        full: &ShCoeffs<Rgb>,
+        centres: &[Vec3],
+        iterations: usize,
+    ) -> Vec<Rgb> {
+        let radius = self.settings.radius_deg.to_radians();
+        let members = self.cap_members(centres, radius);
+        let (_, excess) = self.refit(map, full, &members, iterations, false);
+        let mut power = vec![Rgb::ZERO; centres.len()];
+        for (e, &t) in excess.iter().zip(&members) {
+            let i = self.owner[t as usize].0 as usize;
+            power[i] += *e * self.geometry.solid_angles()[t as usize];
+        }
+        for &t in &members {
+            self.owner[t as usize] = (u16::MAX, 0.0);
+        }
+        power
     }
 
     /// Steps 1, 2 and 4: smoothed map minus SH part on the icosahedron, its significant local
@@ -330,17 +352,19 @@ impl Decomposer {
     ) -> (ShCoeffs<Rgb>, Vec<DirectionalLight>) {
         let centres: Vec<Vec3> = peaks.iter().map(|p| p.direction).collect();
         // One refit step is enough to rank the candidates.
-        let (_, trial) = self.extract(map, full, &centres, 1, false);
-        let mut order: Vec<usize> = (0..trial.len())
-            .filter(|&i| luminance(trial[i].power) > 0.0)
+        let trial: Vec<f32> = self
+            .cap_powers(map, full, &centres, 1)
+            .iter()
+            .map(|p| luminance(*p))
             .collect();
-        order.sort_by(|a, b| luminance(trial[*b].power).total_cmp(&luminance(trial[*a].power)));
-        let luminances: Vec<f32> = order.iter().map(|&i| luminance(trial[i].power)).collect();
+        let mut order: Vec<usize> = (0..trial.len()).filter(|&i| trial[i] > 0.0).collect();
+        order.sort_by(|a, b| trial[*b].total_cmp(&trial[*a]));
+        let luminances: Vec<f32> = order.iter().map(|&i| trial[i]).collect();
         let kept: Vec<Vec3> = order[..self.keep_count(&luminances)]
             .iter()
             .map(|&i| centres[i])
             .collect();
-        let (mut sh, mut lights) = self.extract(map, full, &kept, CONSISTENT_ITERATIONS, true);
+        let (mut sh, mut lights) = self.extract(map, full, &kept, CONSISTENT_ITERATIONS);
         sh.scale_bands(&self.sh_window);
         lights.retain(|l| luminance(l.power) > 0.0);
         lights.sort_by(|a, b| luminance(b.power).total_cmp(&luminance(a.power)));
@@ -431,20 +455,18 @@ impl Decomposer {
 
     /// For caps of radius R around `centres`: the excess `max(0, L − P)` of the map over the SH
     /// part `P`, where `P` is refitted to the map minus that excess (a few fixed-point steps).
-    /// Texels in several caps belong to the nearest centre. Returns one light per centre and,
-    /// when `keep_sh`, the final `P` (else `full`: the callers that only rank or measure the
-    /// lights skip the last refit).
+    /// Texels in several caps belong to the nearest centre. Returns the final `P` and one light
+    /// per centre.
     fn extract(
         &mut self,
         map: &CubeMap,
         full: &ShCoeffs<Rgb>,
         centres: &[Vec3],
         iterations: usize,
-        keep_sh: bool,
     ) -> (ShCoeffs<Rgb>, Vec<DirectionalLight>) {
         let radius = self.settings.radius_deg.to_radians();
         let members = self.cap_members(centres, radius);
-        let (sh, excess) = self.refit(map, full, &members, iterations, keep_sh);
+        let (sh, excess) = self.refit(map, full, &members, iterations, true);
         // Each light: power, luminance-weighted centroid and spread of its excess.
         let mut power = vec![Rgb::ZERO; centres.len()];
         let mut moment = vec![Vec3::ZERO; centres.len()];
