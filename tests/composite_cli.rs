@@ -177,3 +177,48 @@ fn proxies_with_nothing_above_them_are_warned_about() {
         stderr(&out)
     );
 }
+
+/// `hprt scene init MODEL --backplate environment` makes the ground the model's proxy.
+#[test]
+fn a_model_gets_a_proxy_ground_for_its_backplate() {
+    let (_keep, d) = workspace();
+    let model = repo().join("scenes/models/crate.glb");
+    let model = model.to_str().unwrap();
+    let args = [
+        "scene",
+        "init",
+        model,
+        "-o",
+        "s.toml",
+        "--backplate",
+        "environment",
+    ];
+    let out = hprt(&d, &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let scene = foundation::scene::Scene::load(&d.join("s.toml")).unwrap();
+    assert_eq!(
+        scene.backplate,
+        Some(foundation::scene::Backplate::Environment)
+    );
+    let roles: Vec<_> = scene.geometry.objects.iter().map(|o| o.role).collect();
+    assert_eq!(roles.last(), Some(&foundation::scene::ObjectRole::Proxy));
+    assert!(
+        roles[..roles.len() - 1]
+            .iter()
+            .all(|r| *r == foundation::scene::ObjectRole::Object)
+    );
+    let out = hprt(
+        &d,
+        &[
+            "scene",
+            "init",
+            model,
+            "-o",
+            "t.toml",
+            "--backplate",
+            "environment",
+            "--no-ground",
+        ],
+    );
+    assert_clean_failure(&out, &["--backplate needs the ground slab"]);
+}

@@ -7,7 +7,7 @@ use clap::{Args, Subcommand};
 use foundation::infra::atomic_file::write_atomic;
 use foundation::mesh::is_mesh_file;
 use foundation::scene::model::scene_file_for_model;
-use foundation::scene::{EnvironmentSpec, Scene};
+use foundation::scene::{BackplateSpec, EnvironmentSpec, ObjectRole, Scene};
 use std::path::{Path, PathBuf};
 
 #[derive(Subcommand)]
@@ -30,6 +30,11 @@ pub struct SceneInitArgs {
     /// Leave out the ground slab.
     #[arg(long)]
     pub no_ground: bool,
+    /// Composite the model into a picture: "environment" (the map as the camera sees it) or an
+    /// image seen through the scene's camera. The ground slab becomes a proxy of the ground in
+    /// the picture (set its albedo to match it).
+    #[arg(long)]
+    pub backplate: Option<PathBuf>,
     /// Replace the output file if it exists.
     #[arg(long)]
     pub force: bool,
@@ -64,6 +69,26 @@ fn init(args: SceneInitArgs) -> anyhow::Result<()> {
         !args.no_ground,
     )
     .context("cannot make a scene for the model")?;
+    if let Some(backplate) = &args.backplate {
+        anyhow::ensure!(
+            !args.no_ground,
+            "--backplate needs the ground slab (it becomes the proxy the model's shadow falls \
+             on): leave out --no-ground"
+        );
+        let image = match backplate.to_str() {
+            Some(BackplateSpec::ENVIRONMENT) => BackplateSpec::ENVIRONMENT.to_owned(),
+            _ => {
+                anyhow::ensure!(backplate.exists(), "{}: no such file", backplate.display());
+                relative_to(backplate, folder)?
+                    .to_string_lossy()
+                    .into_owned()
+            }
+        };
+        file.backplate = Some(BackplateSpec { image });
+        for ground in file.objects.iter_mut().skip(1) {
+            ground.role = ObjectRole::Proxy;
+        }
+    }
     if let Some(env) = &args.env {
         anyhow::ensure!(env.exists(), "{}: no such file", env.display());
         file.environment = Some(EnvironmentSpec {
