@@ -5,6 +5,7 @@ mod bake_cache;
 mod cli;
 mod commands;
 mod env_sequence;
+mod gpu_composite;
 mod maps;
 mod outputs;
 mod report;

@@ -88,10 +88,7 @@ impl Composite {
 
 /// The kind of each pixel of `image` (a render of `geometry`).
 pub fn pixel_kinds(geometry: &SceneMesh, image: &ReferenceImage) -> Vec<PixelKind> {
-    let mut roles = vec![ObjectRole::Object; geometry.mesh.triangle_count()];
-    for o in &geometry.objects {
-        roles[o.triangles.start as usize..o.triangles.end as usize].fill(o.role);
-    }
+    let roles = geometry.triangle_roles();
     image
         .primary
         .iter()

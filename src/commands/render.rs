@@ -7,10 +7,12 @@ use crate::cli::{
 use crate::env_sequence::{Sequence, lighting_at_frame};
 use crate::maps::{default_exposure, scene_rotation};
 use crate::outputs::{check_outputs, open_outputs, scene_inputs, write_outputs};
+use crate::gpu_composite;
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
 use foundation::image_io::{RgbImageF32, check_finite, exr_bytes, png_bytes, to_display_rgb8};
+use reference::composite::PixelKind;
 use runtime::render::{GpuContext, Renderer};
 use runtime::{DecomposeMode, EnvironmentLighting};
 use std::path::PathBuf;
@@ -59,11 +61,24 @@ pub struct RenderArgs {
     /// Also write the linear image as OpenEXR.
     #[arg(long)]
     pub exr: Option<PathBuf>,
+    /// For a scene with a [backplate]: also write the layers a compositor redoes the composite
+    /// from into this folder (`objects.exr`, `ratio.exr`, and the object, proxy and changed
+    /// masks as EXR).
+    #[arg(long)]
+    pub layers: Option<PathBuf>,
 }
+
+/// The files `--layers DIR` writes.
+const LAYERS: [&str; 5] = [
+    "objects.exr",
+    "ratio.exr",
+    "object_mask.exr",
+    "proxy_mask.exr",
+    "changed_mask.exr",
+];
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
-    crate::support::refuse_proxies(&scene, "render")?;
     let transfer = load_bake(&scene, &args.bake, args.decompose.order)?;
     let rotation_deg = scene_rotation(&scene, args.environment.rotate);
     let mut camera = args.size.camera(&scene)?;
@@ -72,11 +87,25 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     camera.fov_y_deg = args.fov.unwrap_or(camera.fov_y_deg);
     camera.validate()?;
     let inputs = scene_inputs(&scene, &[Some(&args.bake), args.environment.env.as_deref()]);
-    let outputs = [
+    anyhow::ensure!(
+        args.layers.is_none() || scene.backplate.is_some(),
+        "--layers: {} has no [backplate] to composite into",
+        scene.path.display()
+    );
+    let layers: Vec<PathBuf> = args
+        .layers
+        .iter()
+        .flat_map(|dir| LAYERS.map(|name| dir.join(name)))
+        .collect();
+    let mut outputs = vec![
         ("-o", Some(args.output.as_path())),
         ("--exr", args.exr.as_deref()),
     ];
+    outputs.extend(layers.iter().map(|p| ("--layers", Some(p.as_path()))));
     check_outputs(&inputs, &outputs)?;
+    if let Some(dir) = &args.layers {
+        crate::support::create_folder(dir)?;
+    }
     let files = open_outputs(&outputs)?;
     let settings = args
         .decompose
@@ -107,10 +136,29 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         &camera,
         args.render.shadow_settings(),
     )?;
-    renderer.set_environment(lighting.map(), rotation_deg);
-    renderer.set_lighting(&frame.lighting)?;
-    renderer.render()?;
-    let image: RgbImageF32 = renderer.read_back()?;
+    let (image, composite) = if scene.backplate.is_some() {
+        let proxies = gpu_composite::proxies_transfer(&scene, &transfer)?;
+        let inputs = gpu_composite::CompositeInputs {
+            scene: &scene,
+            camera: &camera,
+            map: lighting.map(),
+            rotation_deg,
+            shadow: args.render.shadow_settings(),
+        };
+        let c = gpu_composite::composite_frame(
+            &gpu,
+            &mut renderer,
+            &proxies,
+            &frame.lighting,
+            &inputs,
+        )?;
+        (c.image.clone(), Some(c))
+    } else {
+        renderer.set_environment(lighting.map(), rotation_deg);
+        renderer.set_lighting(&frame.lighting)?;
+        renderer.render()?;
+        (renderer.read_back()?, None)
+    };
     // The renderer's target is half float: radiance above its largest value is clipped.
     let clipped = image
         .pixels
@@ -135,6 +183,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let mut bytes = vec![png];
     if args.exr.is_some() {
         bytes.push(exr_bytes(&image)?);
+    }
+    if let Some(c) = composite.as_ref().filter(|_| args.layers.is_some()) {
+        let grey = |values: Vec<f32>| {
+            exr_bytes(&RgbImageF32::from_grey(image.width, image.height, &values))
+        };
+        bytes.extend([
+            exr_bytes(&c.objects)?,
+            exr_bytes(&c.ratio)?,
+            grey(c.mask(PixelKind::Object))?,
+            grey(c.mask(PixelKind::Proxy))?,
+            grey(c.changed_mask())?,
+        ]);
     }
     write_outputs(files, bytes)?;
     println!(

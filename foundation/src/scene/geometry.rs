@@ -143,6 +143,15 @@ impl SceneMesh {
         }
     }
 
+    /// Per triangle, its object's role.
+    pub fn triangle_roles(&self) -> Vec<ObjectRole> {
+        let mut out = vec![ObjectRole::Object; self.mesh.triangle_count()];
+        for o in &self.objects {
+            out[o.triangles.start as usize..o.triangles.end as usize].fill(o.role);
+        }
+        out
+    }
+
     /// Whether any object is a proxy of a real surface.
     pub fn has_proxies(&self) -> bool {
         self.objects.iter().any(|o| o.role == ObjectRole::Proxy)
