@@ -48,9 +48,11 @@ pub fn proxies_transfer(scene: &Scene, whole: &Transfer) -> anyhow::Result<Trans
 /// The picture composited into, at the camera's size.
 pub fn backplate_image(inputs: &CompositeInputs) -> anyhow::Result<RgbImageF32> {
     match &inputs.scene.backplate {
-        Some(Backplate::Image(path)) => {
-            Ok(load_backplate_image(path, inputs.camera.width, inputs.camera.height)?)
-        }
+        Some(Backplate::Image(path)) => Ok(load_backplate_image(
+            path,
+            inputs.camera.width,
+            inputs.camera.height,
+        )?),
         _ => {
             let light = reference::EnvironmentLight::new(inputs.map, inputs.rotation_deg);
             Ok(environment_backplate(&light, inputs.camera))
@@ -87,7 +89,10 @@ pub fn composite_frame(
     lighting: &FrameLighting,
     inputs: &CompositeInputs,
 ) -> anyhow::Result<Composite> {
-    let geometry = inputs.scene.geometry.subset(|o| o.role == ObjectRole::Proxy);
+    let geometry = inputs
+        .scene
+        .geometry
+        .subset(|o| o.role == ObjectRole::Proxy);
     let mut without = Renderer::new(gpu, &geometry, proxies, inputs.camera, inputs.shadow)?;
     let draw = |renderer: &mut Renderer| -> anyhow::Result<RgbImageF32> {
         renderer.set_environment(inputs.map, inputs.rotation_deg);
@@ -99,5 +104,10 @@ pub fn composite_frame(
     let without_objects = draw(&mut without)?;
     let kinds = pixel_kinds(inputs.scene, inputs.camera);
     let backplate = backplate_image(inputs)?;
-    Ok(composite(&kinds, &with_objects, &without_objects, &backplate))
+    Ok(composite(
+        &kinds,
+        &with_objects,
+        &without_objects,
+        &backplate,
+    ))
 }

@@ -13,15 +13,15 @@ pub fn load_scene(path: &Path) -> anyhow::Result<Scene> {
     Scene::open(path).context("cannot load the scene")
 }
 
-/// Refuses a scene with proxies in a command that cannot composite yet (the GPU composite is
-/// being built; `hprt reference` composites such a scene), rather than drawing its proxies as
-/// ordinary objects.
+/// Refuses a scene with proxies in a command that cannot composite yet (the viewer's live
+/// composite and the report's are being built; `hprt reference` and `hprt render` composite
+/// such a scene), rather than drawing its proxies as ordinary objects.
 pub fn refuse_proxies(scene: &Scene, command: &str) -> anyhow::Result<()> {
     anyhow::ensure!(
         !scene.geometry.has_proxies(),
         "{}: the scene has proxies (role = \"proxy\") and a backplate; `hprt {command}` does not \
-         composite yet (the GPU composite is being built): `hprt reference` renders its true \
-         composite",
+         composite yet: `hprt reference` renders its true composite, `hprt render` the GPU \
+         methods'",
         scene.path.display()
     );
     Ok(())

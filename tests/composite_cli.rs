@@ -135,21 +135,11 @@ fn bad_backplates_and_roles_are_refused_naming_the_file() {
     );
     assert_clean_failure(&out, &["no_plate.toml", "[backplate]"]);
 
-    // The GPU commands say they cannot composite yet rather than drawing the proxies.
+    // The report says it cannot composite yet rather than drawing the proxies.
     floor_scene(&d, "composite.toml", "proxy", ENVIRONMENT);
-    let out = hprt(
-        &d,
-        &[
-            "render",
-            "composite.toml",
-            "--bake",
-            "none.bake",
-            "-o",
-            "out.png",
-        ],
-    );
+    let out = hprt(&d, &["report", "composite.toml", "-o", "report"]);
     assert_clean_failure(&out, &["composite.toml", "proxies", "hprt reference"]);
-    assert!(!d.join("out.png").exists());
+    assert!(!d.join("report").exists());
 }
 
 /// Objects under the floor change nothing on it: the composite says so.
@@ -221,4 +211,92 @@ fn a_model_gets_a_proxy_ground_for_its_backplate() {
         ],
     );
     assert_clean_failure(&out, &["--backplate needs the ground slab"]);
+}
+
+/// `hprt render` composites on either adapter: the object pixels are the whole scene's render,
+/// the two adapters agree, and the shadow it casts on the proxy (the mean ratio over the
+/// truth's changed region) is the truth's.
+#[test]
+fn the_gpu_composite_matches_the_truth_on_both_adapters() {
+    let (_keep, d) = workspace();
+    floor_scene(&d, "composite.toml", "proxy", ENVIRONMENT);
+    floor_scene(&d, "whole.toml", "object", "");
+    let cache = d.join("cache");
+    let run = |args: &[&str]| {
+        let out = hprt_with_env(&d, args, &[("HPRT_CACHE", &cache)]);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    };
+    run(&["bake", "composite.toml", "-o", "c.bake", "--samples", "256"]);
+    run(&[
+        "reference",
+        "composite.toml",
+        "-o",
+        "truth.exr",
+        "--spp",
+        "256",
+        "--aux",
+        "truth",
+    ]);
+    let read = |name: &str| read_exr(&d.join(name)).unwrap().pixels;
+    let mut composites = Vec::new();
+    for backend in ["vulkan", "gl"] {
+        let layers = format!("layers-{backend}");
+        let (c, w) = (format!("c-{backend}.exr"), format!("w-{backend}.exr"));
+        let common = [
+            "--bake",
+            "c.bake",
+            "--backend",
+            backend,
+            "-o",
+            "x.png",
+            "--exr",
+        ];
+        run(&[
+            &["render", "composite.toml"][..],
+            &common,
+            &[&c, "--layers", &layers],
+        ]
+        .concat());
+        run(&[&["render", "whole.toml"][..], &common, &[&w]].concat());
+        let (composite, whole) = (read(&c), read(&w));
+        let objects = read(&format!("{layers}/object_mask.exr"));
+        let on_objects: Vec<usize> = (0..objects.len())
+            .filter(|&i| objects[i].x == 1.0)
+            .collect();
+        assert!(on_objects.len() > 20);
+        for &i in &on_objects {
+            assert_eq!(composite[i], whole[i], "{backend}: object pixel {i}");
+        }
+        let (ratio, truth_ratio, changed) = (
+            read(&format!("{layers}/ratio.exr")),
+            read("truth/ratio.exr"),
+            read("truth/changed_mask.exr"),
+        );
+        let shadow: Vec<usize> = (0..changed.len())
+            .filter(|&i| changed[i].x == 1.0)
+            .collect();
+        let mean = |r: &[foundation::Rgb]| {
+            shadow
+                .iter()
+                .map(|&i| foundation::luminance(r[i]))
+                .sum::<f32>()
+                / shadow.len() as f32
+        };
+        let (gpu, truth) = (mean(&ratio), mean(&truth_ratio));
+        assert!(truth < 0.97, "the truth has a shadow ({truth})");
+        assert!(
+            (gpu - truth).abs() < 0.01,
+            "{backend}: mean ratio {gpu}, truth {truth}"
+        );
+        composites.push(composite);
+    }
+    let differ = composites[0]
+        .iter()
+        .zip(&composites[1])
+        .filter(|(a, b)| (**a - **b).abs().max_element() > 0.02 * a.max_element().max(0.05))
+        .count();
+    assert!(
+        differ * 100 < composites[0].len(),
+        "{differ} pixels differ between Vulkan and GL"
+    );
 }

@@ -5,9 +5,9 @@ use crate::cli::{
     DecomposeOptions, EnvironmentArgs, ImageSizeArgs, RenderOptions, parse_positive, parse_vec3,
 };
 use crate::env_sequence::{Sequence, lighting_at_frame};
+use crate::gpu_composite;
 use crate::maps::{default_exposure, scene_rotation};
 use crate::outputs::{check_outputs, open_outputs, scene_inputs, write_outputs};
-use crate::gpu_composite;
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
@@ -87,16 +87,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     camera.fov_y_deg = args.fov.unwrap_or(camera.fov_y_deg);
     camera.validate()?;
     let inputs = scene_inputs(&scene, &[Some(&args.bake), args.environment.env.as_deref()]);
-    anyhow::ensure!(
-        args.layers.is_none() || scene.backplate.is_some(),
-        "--layers: {} has no [backplate] to composite into",
-        scene.path.display()
-    );
-    let layers: Vec<PathBuf> = args
-        .layers
-        .iter()
-        .flat_map(|dir| LAYERS.map(|name| dir.join(name)))
-        .collect();
+    let layers = layer_files(&args, &scene)?;
     let mut outputs = vec![
         ("-o", Some(args.output.as_path())),
         ("--exr", args.exr.as_deref()),
@@ -129,36 +120,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let frame = lighting.frame(args.render.mode, args.render.lights_indirect());
     let gpu = GpuContext::headless(args.render.backend)?;
     println!("adapter: {}", gpu.description());
-    let mut renderer = Renderer::new(
+    let (image, composite) = draw(
         &gpu,
-        &scene.geometry,
+        &args,
+        &scene,
         &transfer,
         &camera,
-        args.render.shadow_settings(),
+        (lighting.map(), rotation_deg),
+        &frame.lighting,
     )?;
-    let (image, composite) = if scene.backplate.is_some() {
-        let proxies = gpu_composite::proxies_transfer(&scene, &transfer)?;
-        let inputs = gpu_composite::CompositeInputs {
-            scene: &scene,
-            camera: &camera,
-            map: lighting.map(),
-            rotation_deg,
-            shadow: args.render.shadow_settings(),
-        };
-        let c = gpu_composite::composite_frame(
-            &gpu,
-            &mut renderer,
-            &proxies,
-            &frame.lighting,
-            &inputs,
-        )?;
-        (c.image.clone(), Some(c))
-    } else {
-        renderer.set_environment(lighting.map(), rotation_deg);
-        renderer.set_lighting(&frame.lighting)?;
-        renderer.render()?;
-        (renderer.read_back()?, None)
-    };
     // The renderer's target is half float: radiance above its largest value is clipped.
     let clipped = image
         .pixels
@@ -174,28 +144,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let exposure = args
         .exposure
         .unwrap_or_else(|| default_exposure(lighting.map()));
-    check_finite(&image, "PNG").context("the render failed")?;
-    let png = png_bytes(
-        &to_display_rgb8(&image, exposure),
-        image.width,
-        image.height,
-    )?;
-    let mut bytes = vec![png];
-    if args.exr.is_some() {
-        bytes.push(exr_bytes(&image)?);
-    }
-    if let Some(c) = composite.as_ref().filter(|_| args.layers.is_some()) {
-        let grey = |values: Vec<f32>| {
-            exr_bytes(&RgbImageF32::from_grey(image.width, image.height, &values))
-        };
-        bytes.extend([
-            exr_bytes(&c.objects)?,
-            exr_bytes(&c.ratio)?,
-            grey(c.mask(PixelKind::Object))?,
-            grey(c.mask(PixelKind::Proxy))?,
-            grey(c.changed_mask())?,
-        ]);
-    }
+    let bytes = output_bytes(&args, &image, composite.as_ref(), exposure)?;
     write_outputs(files, bytes)?;
     println!(
         "{} mode, {} light(s), {} {:.2} ms; wrote {}",
@@ -210,4 +159,85 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// The files `--layers DIR` will write (none without it); refused for a scene that does not
+/// composite.
+fn layer_files(
+    args: &RenderArgs,
+    scene: &foundation::scene::Scene,
+) -> anyhow::Result<Vec<PathBuf>> {
+    anyhow::ensure!(
+        args.layers.is_none() || scene.backplate.is_some(),
+        "--layers: {} has no [backplate] to composite into",
+        scene.path.display()
+    );
+    Ok(args
+        .layers
+        .iter()
+        .flat_map(|dir| LAYERS.map(|name| dir.join(name)))
+        .collect())
+}
+
+/// The PNG, then the EXR and the layers when asked, in the order of the outputs.
+fn output_bytes(
+    args: &RenderArgs,
+    image: &RgbImageF32,
+    composite: Option<&reference::composite::Composite>,
+    exposure: f32,
+) -> anyhow::Result<Vec<Vec<u8>>> {
+    check_finite(image, "PNG").context("the render failed")?;
+    let png = png_bytes(&to_display_rgb8(image, exposure), image.width, image.height)?;
+    let mut bytes = vec![png];
+    if args.exr.is_some() {
+        bytes.push(exr_bytes(image)?);
+    }
+    if let Some(c) = composite.filter(|_| args.layers.is_some()) {
+        let grey = |values: Vec<f32>| {
+            exr_bytes(&RgbImageF32::from_grey(image.width, image.height, &values))
+        };
+        bytes.extend([
+            exr_bytes(&c.objects)?,
+            exr_bytes(&c.ratio)?,
+            grey(c.mask(PixelKind::Object))?,
+            grey(c.mask(PixelKind::Proxy))?,
+            grey(c.changed_mask())?,
+        ]);
+    }
+    Ok(bytes)
+}
+
+/// Draws `frame` of `scene`: composited into its backplate when it has one.
+fn draw(
+    gpu: &GpuContext,
+    args: &RenderArgs,
+    scene: &foundation::scene::Scene,
+    transfer: &precompute::bake::Transfer,
+    camera: &foundation::camera::Camera,
+    (map, rotation_deg): (&foundation::envmap::EnvMap, f32),
+    frame: &runtime::FrameLighting,
+) -> anyhow::Result<(RgbImageF32, Option<reference::composite::Composite>)> {
+    let mut renderer = Renderer::new(
+        gpu,
+        &scene.geometry,
+        transfer,
+        camera,
+        args.render.shadow_settings(),
+    )?;
+    if scene.backplate.is_none() {
+        renderer.set_environment(map, rotation_deg);
+        renderer.set_lighting(frame)?;
+        renderer.render()?;
+        return Ok((renderer.read_back()?, None));
+    }
+    let proxies = gpu_composite::proxies_transfer(scene, transfer)?;
+    let inputs = gpu_composite::CompositeInputs {
+        scene,
+        camera,
+        map,
+        rotation_deg,
+        shadow: args.render.shadow_settings(),
+    };
+    let c = gpu_composite::composite_frame(gpu, &mut renderer, &proxies, frame, &inputs)?;
+    Ok((c.image.clone(), Some(c)))
 }
