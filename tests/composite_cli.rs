@@ -101,32 +101,25 @@ fn bad_backplates_and_roles_are_refused_naming_the_file() {
         png_bytes(&vec![90u8; 30 * 30 * 3], 30, 30).unwrap(),
     )
     .unwrap();
-    floor_scene(
-        &d,
+    // A photograph that is not one, and one of another shape.
+    let refused = |scene: &str, image: &str, needles: &[&str]| {
+        floor_scene(
+            &d,
+            scene,
+            "proxy",
+            &format!("[backplate]\nimage = \"{image}\""),
+        );
+        let out = hprt(&d, &["reference", scene, "-o", "out.exr", "--spp", "1"]);
+        assert_clean_failure(&out, needles);
+        assert!(!d.join("out.exr").exists());
+    };
+    refused(
         "square.toml",
-        "proxy",
-        "[backplate]\nimage = \"square.png\"",
+        "square.png",
+        &["square.png", "aspect ratio", "30:30", "40:30"],
     );
-    let out = hprt(
-        &d,
-        &["reference", "square.toml", "-o", "out.exr", "--spp", "1"],
-    );
-    assert_clean_failure(&out, &["square.png", "aspect ratio", "30:30", "40:30"]);
-    assert!(!d.join("out.exr").exists());
-
     std::fs::write(d.join("junk.jpg"), b"this is not a jpeg").unwrap();
-    floor_scene(
-        &d,
-        "junk.toml",
-        "proxy",
-        "[backplate]\nimage = \"junk.jpg\"",
-    );
-    let out = hprt(
-        &d,
-        &["reference", "junk.toml", "-o", "out.exr", "--spp", "1"],
-    );
-    assert_clean_failure(&out, &["junk.jpg"]);
-    assert!(!d.join("out.exr").exists());
+    refused("junk.toml", "junk.jpg", &["junk.jpg"]);
 
     floor_scene(&d, "no_plate.toml", "proxy", "");
     let out = hprt(
