@@ -14,9 +14,23 @@ use foundation::envmap::EnvMap;
 use foundation::image_io::RgbImageF32;
 use foundation::scene::{Backplate, ObjectRole, Scene, load_backplate_image};
 use precompute::bake::Transfer;
-use reference::composite::{Composite, PixelKind, composite, environment_backplate};
+use reference::composite::{
+    Composite, PixelKind, composite, composite_with_ratio, environment_backplate,
+};
 use runtime::FrameLighting;
 use runtime::render::{GpuContext, Renderer, ShadowSettings};
+
+/// How the objects' effect on the proxies is composited.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum CompositeForm {
+    /// The ratio of the proxies with and without the objects (every light's shadow, the
+    /// light the objects bounce onto them): the truth's form.
+    #[default]
+    Differential,
+    /// The mobile-AR paper's simpler peer: the backplate times the proxies' ambient occlusion
+    /// by the objects (no lights' shadows).
+    Occlusion,
+}
 
 /// What the composite of one frame needs besides the whole scene's renderer.
 pub struct CompositeInputs<'a> {
@@ -26,6 +40,7 @@ pub struct CompositeInputs<'a> {
     pub map: &'a EnvMap,
     pub rotation_deg: f32,
     pub shadow: ShadowSettings,
+    pub form: CompositeForm,
 }
 
 /// The proxies alone as a scene of their own (their bake is cached like any scene's).
@@ -93,7 +108,6 @@ pub fn composite_frame(
         .scene
         .geometry
         .subset(|o| o.role == ObjectRole::Proxy);
-    let mut without = Renderer::new(gpu, &geometry, proxies, inputs.camera, inputs.shadow)?;
     let draw = |renderer: &mut Renderer| -> anyhow::Result<RgbImageF32> {
         renderer.set_environment(inputs.map, inputs.rotation_deg);
         renderer.set_lighting(lighting)?;
@@ -101,13 +115,71 @@ pub fn composite_frame(
         Ok(renderer.read_back()?)
     };
     let with_objects = draw(whole)?;
-    let without_objects = draw(&mut without)?;
     let kinds = pixel_kinds(inputs.scene, inputs.camera);
     let backplate = backplate_image(inputs)?;
+    if inputs.form == CompositeForm::Occlusion {
+        let occlusion = ambient_occlusion(inputs.scene, inputs.camera, &kinds);
+        return Ok(composite_with_ratio(
+            &kinds,
+            &with_objects,
+            &occlusion,
+            &backplate,
+        ));
+    }
+    let mut without = Renderer::new(gpu, &geometry, proxies, inputs.camera, inputs.shadow)?;
+    let without_objects = draw(&mut without)?;
     Ok(composite(
         &kinds,
         &with_objects,
         &without_objects,
         &backplate,
     ))
+}
+
+/// Rays per proxy pixel of [`ambient_occlusion`].
+pub const OCCLUSION_RAYS: u32 = 64;
+
+/// The mobile-AR paper's simpler account of the objects on a proxy (a peer): at the point
+/// each proxy pixel's centre sees, the cosine-weighted fraction of its hemisphere the virtual
+/// objects leave open (no lights' shadows, no bounced light). One per pixel, 1 off the
+/// proxies; Hammersley directions rotated per pixel, so the same every run.
+pub fn ambient_occlusion(
+    scene: &Scene,
+    camera: &Camera,
+    kinds: &[PixelKind],
+) -> Vec<foundation::Rgb> {
+    use foundation::sampling::{Frame, cosine_hemisphere, cranley_patterson, hammersley};
+    let whole = SceneBvh::build(&scene.geometry.mesh);
+    let objects_geometry = scene.geometry.subset(|o| o.role == ObjectRole::Object);
+    let objects = SceneBvh::build(&objects_geometry.mesh);
+    let offset = 1e-4 * scene.geometry.diagonal();
+    let basis = camera.basis();
+    let width = camera.width as usize;
+    (0..kinds.len())
+        .map(|index| {
+            let (i, j) = ((index % width) as u32, (index / width) as u32);
+            let direction = camera.pixel_direction(&basis, i, j);
+            let hit = whole.intersect(camera.position, direction, 0.0, f32::INFINITY);
+            let (Some(hit), PixelKind::Proxy) = (hit, kinds[index]) else {
+                return foundation::Rgb::ONE;
+            };
+            let [a, b, c] = scene.geometry.mesh.corners(hit.triangle as usize);
+            let mut normal = (b - a).cross(c - a).normalize_or_zero();
+            if normal.dot(direction) > 0.0 {
+                normal = -normal;
+            }
+            let point = camera.position + direction * hit.t + normal * offset;
+            let frame = Frame::from_normal(normal);
+            let shift =
+                foundation::sampling::hash_to_unit2(foundation::sampling::mix64(index as u64));
+            let open = (0..OCCLUSION_RAYS)
+                .filter(|k| {
+                    let u = cranley_patterson(hammersley(*k, OCCLUSION_RAYS), shift);
+                    let w = frame.to_world(cosine_hemisphere(u));
+                    objects.intersect(point, w, 0.0, f32::INFINITY).is_none()
+                })
+                .count();
+            foundation::Rgb::splat(open as f32 / OCCLUSION_RAYS as f32)
+        })
+        .collect()
 }

@@ -293,3 +293,63 @@ fn the_gpu_composite_matches_the_truth_on_both_adapters() {
         "{differ} pixels differ between Vulkan and GL"
     );
 }
+
+/// The mobile-AR peer: the proxies darkened by the objects' ambient occlusion alone, a ratio
+/// in [0, 1] that is 1 far from the box and well below it at the box's foot; the objects as
+/// the differential composite draws them.
+#[test]
+fn the_occlusion_peer_darkens_the_proxy_by_ambient_occlusion() {
+    let (_keep, d) = workspace();
+    floor_scene(&d, "composite.toml", "proxy", ENVIRONMENT);
+    let cache = d.join("cache");
+    let run = |args: &[&str]| {
+        let out = hprt_with_env(&d, args, &[("HPRT_CACHE", &cache)]);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    };
+    run(&["bake", "composite.toml", "-o", "c.bake", "--samples", "64"]);
+    let render = [
+        "render",
+        "composite.toml",
+        "--bake",
+        "c.bake",
+        "-o",
+        "x.png",
+        "--exr",
+    ];
+    run(&[&render[..], &["d.exr", "--layers", "d"]].concat());
+    run(&[
+        &render[..],
+        &["o.exr", "--layers", "o", "--composite", "occlusion"],
+    ]
+    .concat());
+    let read = |name: &str| read_exr(&d.join(name)).unwrap().pixels;
+    let (ratio, proxy, object) = (
+        read("o/ratio.exr"),
+        read("o/proxy_mask.exr"),
+        read("o/object_mask.exr"),
+    );
+    assert!(
+        ratio
+            .iter()
+            .all(|r| (0.0..=1.0).contains(&r.x) && r.x == r.y)
+    );
+    let on_proxy: Vec<f32> = (0..ratio.len())
+        .filter(|&i| proxy[i].x == 1.0)
+        .map(|i| ratio[i].x)
+        .collect();
+    let mean = on_proxy.iter().sum::<f32>() / on_proxy.len() as f32;
+    let open = on_proxy.iter().filter(|r| **r == 1.0).count();
+    assert!(
+        open > 0 && mean > 0.8,
+        "the floor is mostly open: mean {mean}, {open} of {} fully open",
+        on_proxy.len()
+    );
+    assert!(
+        on_proxy.iter().any(|r| *r < 0.8),
+        "the box's foot is occluded"
+    );
+    let (occlusion, differential) = (read("o.exr"), read("d.exr"));
+    for i in (0..object.len()).filter(|&i| object[i].x == 1.0) {
+        assert_eq!(occlusion[i], differential[i], "object pixel {i}");
+    }
+}

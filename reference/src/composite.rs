@@ -154,6 +154,42 @@ pub fn composite(
     }
 }
 
+/// Composites `rendered` (its object pixels) into `backplate` with a given ratio per pixel
+/// on the proxies (a peer's own account of the objects' effect on them, such as ambient
+/// occlusion); other pixels' ratios are ignored.
+pub fn composite_with_ratio(
+    kinds: &[PixelKind],
+    rendered: &RgbImageF32,
+    ratio: &[Rgb],
+    backplate: &RgbImageF32,
+) -> Composite {
+    let (w, h) = (rendered.width, rendered.height);
+    let ratio: Vec<Rgb> = kinds
+        .iter()
+        .zip(ratio)
+        .map(|(k, r)| if *k == PixelKind::Proxy { *r } else { Rgb::ONE })
+        .collect();
+    let image = (0..kinds.len())
+        .map(|i| composite_pixel(kinds[i], backplate.pixels[i], rendered.pixels[i], ratio[i]))
+        .collect();
+    let objects = (0..kinds.len())
+        .map(|i| match kinds[i] {
+            PixelKind::Object => rendered.pixels[i],
+            _ => Rgb::ZERO,
+        })
+        .collect();
+    Composite {
+        image: RgbImageF32::new(w, h, image),
+        objects: RgbImageF32::new(w, h, objects),
+        changed: ratio
+            .iter()
+            .map(|r| (luminance(*r) - 1.0).abs() > CHANGED_THRESHOLD)
+            .collect(),
+        ratio: RgbImageF32::new(w, h, ratio),
+        kinds: kinds.to_vec(),
+    }
+}
+
 /// The environment map as `camera` sees it: the backplate of the HDRI workflow.
 pub fn environment_backplate(light: &EnvironmentLight, camera: &Camera) -> RgbImageF32 {
     let basis = camera.basis();

@@ -66,6 +66,11 @@ pub struct RenderArgs {
     /// masks as EXR).
     #[arg(long)]
     pub layers: Option<PathBuf>,
+    /// For a scene with a [backplate]: how the objects change the proxies. differential: the
+    /// ratio with and without the objects (the truth's form); occlusion: the mobile-AR paper's
+    /// peer, the backplate times the proxies' ambient occlusion by the objects.
+    #[arg(long, value_enum, default_value_t)]
+    pub composite: gpu_composite::CompositeForm,
 }
 
 /// The files `--layers DIR` writes.
@@ -237,6 +242,7 @@ fn draw(
         map,
         rotation_deg,
         shadow: args.render.shadow_settings(),
+        form: args.composite,
     };
     let c = gpu_composite::composite_frame(gpu, &mut renderer, &proxies, frame, &inputs)?;
     Ok((c.image.clone(), Some(c)))
