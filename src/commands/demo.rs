@@ -114,7 +114,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
 
     if bundled_scenes {
-        composite_truth(&args.output.join("composite"), args.width, args.height)?;
+        let dir = args.output.join("composite");
+        composite_truth(&dir, args.width, args.height)?;
+        composite_methods(&dir, args.width, args.height, args.backend)?;
     }
 
     // A model as users bring theirs: the textured glTF sample, placed on its own, through
@@ -158,4 +160,54 @@ fn composite_truth(dir: &Path, width: u32, height: u32) -> anyhow::Result<()> {
         png: Some(dir.join("composite.png")),
         aux: Some(dir.join("aux")),
     })
+}
+
+/// The GPU methods' composites of the bundled compositing example beside its truth: the
+/// hybrid, plain PRT and the mobile-AR paper's occlusion peer (`hybrid.png`, `prt.png`,
+/// `occlusion.png`, with their EXRs).
+fn composite_methods(
+    dir: &Path,
+    width: u32,
+    height: u32,
+    backend: runtime::render::Backend,
+) -> anyhow::Result<()> {
+    #[derive(clap::Parser)]
+    struct Line {
+        #[command(flatten)]
+        args: crate::commands::render::RenderArgs,
+    }
+    let scene = load_scene(&bundled(COMPOSITE))?;
+    let (bake, _) = crate::bake_cache::bake_for(&scene, None)?;
+    for (name, extra) in [
+        ("hybrid", &["--mode", "hybrid"][..]),
+        ("prt", &["--mode", "prt"]),
+        (
+            "occlusion",
+            &["--mode", "hybrid", "--composite", "occlusion"],
+        ),
+    ] {
+        let (png, exr) = (
+            dir.join(format!("{name}.png")),
+            dir.join(format!("{name}.exr")),
+        );
+        let size = (width.to_string(), height.to_string());
+        let mut line: Vec<std::ffi::OsString> = ["hprt", "--bake"].map(Into::into).to_vec();
+        line.push(bake.clone().into());
+        line.push(scene.path.clone().into());
+        for arg in [
+            "--width",
+            &size.0,
+            "--height",
+            &size.1,
+            "--backend",
+            backend.name(),
+        ] {
+            line.push(arg.into());
+        }
+        line.extend(extra.iter().map(Into::into));
+        line.extend(["-o".into(), png.into(), "--exr".into(), exr.into()]);
+        let parsed = <Line as clap::Parser>::try_parse_from(line)?;
+        crate::commands::render::run(parsed.args)?;
+    }
+    Ok(())
 }
