@@ -8,14 +8,17 @@
 
 use crate::bake_cache::bake_for;
 use anyhow::Context;
+use foundation::Rgb;
 use foundation::bvh::SceneBvh;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::image_io::RgbImageF32;
 use foundation::scene::{Backplate, ObjectRole, Scene, load_backplate_image};
+use glam::Vec3;
 use precompute::bake::Transfer;
+use reference::NO_HIT;
 use reference::composite::{
-    Composite, PixelKind, composite, composite_with_ratio, environment_backplate,
+    Composite, PixelKind, composite, composite_with_ratio, environment_backplate, pixel_kinds,
 };
 use runtime::FrameLighting;
 use runtime::render::{GpuContext, Renderer, ShadowSettings};
@@ -43,25 +46,19 @@ pub struct CompositeInputs<'a> {
     pub form: CompositeForm,
 }
 
-/// The proxies alone as a scene of their own (their bake is cached like any scene's).
-pub fn proxies_scene(scene: &Scene) -> Scene {
+/// The proxies alone as a scene of their own, with the whole scene's bake settings (their
+/// bake is cached like any scene's).
+fn proxies_scene(scene: &Scene, whole: &Transfer) -> Scene {
     Scene {
         name: format!("{}-proxies", scene.name),
         geometry: scene.geometry.subset(|o| o.role == ObjectRole::Proxy),
+        bake: whole.settings,
         ..scene.clone()
     }
 }
 
-/// The bake of the proxies alone, at the whole scene's bake settings.
-pub fn proxies_transfer(scene: &Scene, whole: &Transfer) -> anyhow::Result<Transfer> {
-    let mut proxies = proxies_scene(scene);
-    proxies.bake = whole.settings;
-    let (_, transfer) = bake_for(&proxies, None).context("cannot bake the proxies alone")?;
-    Ok(transfer)
-}
-
 /// The picture composited into, at the camera's size.
-pub fn backplate_image(inputs: &CompositeInputs) -> anyhow::Result<RgbImageF32> {
+fn backplate_image(inputs: &CompositeInputs) -> anyhow::Result<RgbImageF32> {
     match &inputs.scene.backplate {
         Some(Backplate::Image(path)) => Ok(load_backplate_image(
             path,
@@ -75,39 +72,50 @@ pub fn backplate_image(inputs: &CompositeInputs) -> anyhow::Result<RgbImageF32> 
     }
 }
 
-/// Each pixel's kind, by its centre's ray through the whole scene.
-pub fn pixel_kinds(scene: &Scene, camera: &Camera) -> Vec<PixelKind> {
-    let bvh = SceneBvh::build(&scene.geometry.mesh);
-    let basis = camera.basis();
-    let roles = scene.geometry.triangle_roles();
-    (0..camera.height)
-        .flat_map(|j| (0..camera.width).map(move |i| (i, j)))
-        .map(|(i, j)| {
-            let direction = camera.pixel_direction(&basis, i, j);
-            match bvh.intersect(camera.position, direction, 0.0, f32::INFINITY) {
-                None => PixelKind::Background,
-                Some(hit) => match roles[hit.triangle as usize] {
-                    ObjectRole::Object => PixelKind::Object,
-                    ObjectRole::Proxy => PixelKind::Proxy,
-                },
-            }
-        })
-        .collect()
+/// What each pixel's centre ray sees first in the whole scene: the point and the face normal
+/// turned toward the camera, with the triangle (as the reference's primary rays find them).
+struct PrimaryHits {
+    triangles: Vec<u32>,
+    points: Vec<Option<(Vec3, Vec3)>>,
 }
 
-/// Draws `lighting` with `whole` (the whole scene's renderer) and a renderer of the proxies
-/// alone, and composites the two into the backplate.
+impl PrimaryHits {
+    fn trace(scene: &Scene, camera: &Camera) -> Self {
+        let bvh = SceneBvh::build(&scene.geometry.mesh);
+        let basis = camera.basis();
+        let (triangles, points) = (0..camera.height)
+            .flat_map(|j| (0..camera.width).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                let direction = camera.pixel_direction(&basis, i, j);
+                let Some(hit) = bvh.intersect(camera.position, direction, 0.0, f32::INFINITY)
+                else {
+                    return (NO_HIT, None);
+                };
+                let [a, b, c] = scene.geometry.mesh.corners(hit.triangle as usize);
+                let normal = (b - a).cross(c - a).normalize_or_zero();
+                let facing = if normal.dot(direction) > 0.0 {
+                    -normal
+                } else {
+                    normal
+                };
+                let point = camera.position + direction * hit.t;
+                (hit.triangle, Some((point, facing)))
+            })
+            .unzip();
+        Self { triangles, points }
+    }
+}
+
+/// Draws `lighting` with `whole` (the whole scene's renderer, drawing `transfer`) and, for
+/// the differential form, a renderer of the proxies alone with their own bake, and composites
+/// the result into the backplate.
 pub fn composite_frame(
     gpu: &GpuContext,
     whole: &mut Renderer,
-    proxies: &Transfer,
+    transfer: &Transfer,
     lighting: &FrameLighting,
     inputs: &CompositeInputs,
 ) -> anyhow::Result<Composite> {
-    let geometry = inputs
-        .scene
-        .geometry
-        .subset(|o| o.role == ObjectRole::Proxy);
     let draw = |renderer: &mut Renderer| -> anyhow::Result<RgbImageF32> {
         renderer.set_environment(inputs.map, inputs.rotation_deg);
         renderer.set_lighting(lighting)?;
@@ -115,10 +123,11 @@ pub fn composite_frame(
         Ok(renderer.read_back()?)
     };
     let with_objects = draw(whole)?;
-    let kinds = pixel_kinds(inputs.scene, inputs.camera);
+    let hits = PrimaryHits::trace(inputs.scene, inputs.camera);
+    let kinds = pixel_kinds(&inputs.scene.geometry, &hits.triangles);
     let backplate = backplate_image(inputs)?;
     if inputs.form == CompositeForm::Occlusion {
-        let occlusion = ambient_occlusion(inputs.scene, inputs.camera, &kinds);
+        let occlusion = ambient_occlusion(inputs.scene, &hits, &kinds);
         return Ok(composite_with_ratio(
             &kinds,
             &with_objects,
@@ -126,7 +135,16 @@ pub fn composite_frame(
             &backplate,
         ));
     }
-    let mut without = Renderer::new(gpu, &geometry, proxies, inputs.camera, inputs.shadow)?;
+    let proxies = proxies_scene(inputs.scene, transfer);
+    let (_, proxies_transfer) =
+        bake_for(&proxies, None).context("cannot bake the proxies alone")?;
+    let mut without = Renderer::new(
+        gpu,
+        &proxies.geometry,
+        &proxies_transfer,
+        inputs.camera,
+        inputs.shadow,
+    )?;
     let without_objects = draw(&mut without)?;
     Ok(composite(
         &kinds,
@@ -143,43 +161,30 @@ pub const OCCLUSION_RAYS: u32 = 64;
 /// each proxy pixel's centre sees, the cosine-weighted fraction of its hemisphere the virtual
 /// objects leave open (no lights' shadows, no bounced light). One per pixel, 1 off the
 /// proxies; Hammersley directions rotated per pixel, so the same every run.
-pub fn ambient_occlusion(
-    scene: &Scene,
-    camera: &Camera,
-    kinds: &[PixelKind],
-) -> Vec<foundation::Rgb> {
-    use foundation::sampling::{Frame, cosine_hemisphere, cranley_patterson, hammersley};
-    let whole = SceneBvh::build(&scene.geometry.mesh);
+fn ambient_occlusion(scene: &Scene, hits: &PrimaryHits, kinds: &[PixelKind]) -> Vec<Rgb> {
+    use foundation::sampling::{
+        Frame, cosine_hemisphere, cranley_patterson, hammersley, hash_to_unit2, mix64,
+    };
     let objects_geometry = scene.geometry.subset(|o| o.role == ObjectRole::Object);
     let objects = SceneBvh::build(&objects_geometry.mesh);
     let offset = 1e-4 * scene.geometry.diagonal();
-    let basis = camera.basis();
-    let width = camera.width as usize;
     (0..kinds.len())
         .map(|index| {
-            let (i, j) = ((index % width) as u32, (index / width) as u32);
-            let direction = camera.pixel_direction(&basis, i, j);
-            let hit = whole.intersect(camera.position, direction, 0.0, f32::INFINITY);
-            let (Some(hit), PixelKind::Proxy) = (hit, kinds[index]) else {
-                return foundation::Rgb::ONE;
+            let (Some((point, normal)), PixelKind::Proxy) = (hits.points[index], kinds[index])
+            else {
+                return Rgb::ONE;
             };
-            let [a, b, c] = scene.geometry.mesh.corners(hit.triangle as usize);
-            let mut normal = (b - a).cross(c - a).normalize_or_zero();
-            if normal.dot(direction) > 0.0 {
-                normal = -normal;
-            }
-            let point = camera.position + direction * hit.t + normal * offset;
+            let origin = point + normal * offset;
             let frame = Frame::from_normal(normal);
-            let shift =
-                foundation::sampling::hash_to_unit2(foundation::sampling::mix64(index as u64));
+            let shift = hash_to_unit2(mix64(index as u64));
             let open = (0..OCCLUSION_RAYS)
                 .filter(|k| {
                     let u = cranley_patterson(hammersley(*k, OCCLUSION_RAYS), shift);
                     let w = frame.to_world(cosine_hemisphere(u));
-                    objects.intersect(point, w, 0.0, f32::INFINITY).is_none()
+                    objects.intersect(origin, w, 0.0, f32::INFINITY).is_none()
                 })
                 .count();
-            foundation::Rgb::splat(open as f32 / OCCLUSION_RAYS as f32)
+            Rgb::splat(open as f32 / OCCLUSION_RAYS as f32)
         })
         .collect()
 }

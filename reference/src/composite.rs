@@ -86,11 +86,11 @@ impl Composite {
     }
 }
 
-/// The kind of each pixel of `image` (a render of `geometry`).
-pub fn pixel_kinds(geometry: &SceneMesh, image: &ReferenceImage) -> Vec<PixelKind> {
+/// The kind of each pixel, from the triangle of `geometry` its centre's ray hits first
+/// (`primary`, [`NO_HIT`] for none: [`ReferenceImage::primary`]).
+pub fn pixel_kinds(geometry: &SceneMesh, primary: &[u32]) -> Vec<PixelKind> {
     let roles = geometry.triangle_roles();
-    image
-        .primary
+    primary
         .iter()
         .map(|&t| match t {
             NO_HIT => PixelKind::Background,
@@ -119,44 +119,18 @@ pub fn composite(
         .sum::<f64>()
         / proxies.len().max(1) as f64;
     let floor = RATIO_FLOOR * mean_without as f32;
-    let n = kinds.len();
-    let (mut image, mut objects, mut ratio) = (
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-    );
-    let mut changed = Vec::with_capacity(n);
-    for (i, kind) in kinds.iter().enumerate() {
-        let r = match kind {
+    let ratio: Vec<Rgb> = (0..kinds.len())
+        .map(|i| match kinds[i] {
             PixelKind::Proxy => shadow_ratio(with.pixels[i], without.pixels[i], floor),
             _ => Rgb::ONE,
-        };
-        image.push(composite_pixel(
-            *kind,
-            backplate.pixels[i],
-            with.pixels[i],
-            r,
-        ));
-        objects.push(match kind {
-            PixelKind::Object => with.pixels[i],
-            _ => Rgb::ZERO,
-        });
-        ratio.push(r);
-        changed.push((luminance(r) - 1.0).abs() > CHANGED_THRESHOLD);
-    }
-    let image_of = |pixels| RgbImageF32::new(with.width, with.height, pixels);
-    Composite {
-        image: image_of(image),
-        objects: image_of(objects),
-        ratio: image_of(ratio),
-        kinds: kinds.to_vec(),
-        changed,
-    }
+        })
+        .collect();
+    composite_with_ratio(kinds, with, &ratio, backplate)
 }
 
 /// Composites `rendered` (its object pixels) into `backplate` with a given ratio per pixel
-/// on the proxies (a peer's own account of the objects' effect on them, such as ambient
-/// occlusion); other pixels' ratios are ignored.
+/// on the proxies (the ratio form's, or a peer's own account of the objects' effect on them,
+/// such as ambient occlusion); other pixels' ratios are ignored.
 pub fn composite_with_ratio(
     kinds: &[PixelKind],
     rendered: &RgbImageF32,
@@ -235,7 +209,7 @@ pub fn render_composite(
             &environment
         }
     };
-    let kinds = pixel_kinds(geometry, &with_objects);
+    let kinds = pixel_kinds(geometry, &with_objects.primary);
     let composite = composite(
         &kinds,
         &with_objects.radiance,

@@ -235,7 +235,6 @@ fn draw(
         renderer.render()?;
         return Ok((renderer.read_back()?, None));
     }
-    let proxies = gpu_composite::proxies_transfer(scene, transfer)?;
     let inputs = gpu_composite::CompositeInputs {
         scene,
         camera,
@@ -244,6 +243,6 @@ fn draw(
         shadow: args.render.shadow_settings(),
         form: args.composite,
     };
-    let c = gpu_composite::composite_frame(gpu, &mut renderer, &proxies, frame, &inputs)?;
+    let c = gpu_composite::composite_frame(gpu, &mut renderer, transfer, frame, &inputs)?;
     Ok((c.image.clone(), Some(c)))
 }
