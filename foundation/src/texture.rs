@@ -27,32 +27,28 @@ pub enum TextureError {
 /// small compressed file can declare gigabytes of pixels).
 pub(crate) fn decode_image(bytes: &[u8]) -> Result<image::DynamicImage, TextureError> {
     decode_image_within(bytes, MAX_TEXTURE_TEXELS, MAX_TEXTURE_SIDE)
-        .map_err(|e| e.unwrap_or_else(|(width, height)| TextureError::TooLarge { width, height }))
 }
 
-/// Decodes an image file's bytes, refusing before decoding one whose header declares more than
-/// `max_pixels` pixels or a side over `max_side` (`Err(Err((width, height)))`).
+/// [`decode_image`] with other limits: more than `max_pixels` pixels or a side over
+/// `max_side` is [`TextureError::TooLarge`].
 pub(crate) fn decode_image_within(
     bytes: &[u8],
     max_pixels: u64,
     max_side: u32,
-) -> Result<image::DynamicImage, Result<TextureError, (u32, u32)>> {
+) -> Result<image::DynamicImage, TextureError> {
     let reader = || image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format();
-    let (width, height) = reader()
-        .map_err(|e| Ok(e.into()))?
-        .into_dimensions()
-        .map_err(|e| Ok(e.into()))?;
+    let (width, height) = reader()?.into_dimensions()?;
     if u64::from(width) * u64::from(height) > max_pixels || width.max(height) > max_side {
-        return Err(Err((width, height)));
+        return Err(TextureError::TooLarge { width, height });
     }
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(max_side);
     limits.max_image_height = Some(max_side);
     // RGBA at 16 bits a channel is the widest decoded form of such an image.
     limits.max_alloc = Some(8 * max_pixels + (64 << 20));
-    let mut reader = reader().map_err(|e| Ok(e.into()))?;
+    let mut reader = reader()?;
     reader.limits(limits);
-    reader.decode().map_err(|e| Ok(e.into()))
+    Ok(reader.decode()?)
 }
 
 /// A base colour texture, decoded from sRGB to linear RGB; rows from the top, so texture

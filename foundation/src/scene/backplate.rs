@@ -4,6 +4,7 @@
 use crate::color::Rgb;
 use crate::image_io::{RgbImageF32, read_exr, srgb_decode};
 use crate::infra::limits::{MAX_BACKPLATE_PIXELS, MAX_BACKPLATE_SIDE, read_regular_file};
+use crate::texture::TextureError;
 use std::path::{Path, PathBuf};
 
 /// Why a backplate image cannot be used; names the file.
@@ -73,8 +74,10 @@ fn decode_srgb(path: &Path) -> Result<RgbImageF32, String> {
     let image =
         crate::texture::decode_image_within(&bytes, MAX_BACKPLATE_PIXELS, MAX_BACKPLATE_SIDE)
             .map_err(|e| match e {
-                Ok(e) => e.to_string(),
-                Err((w, h)) => check_size(w.into(), h.into()).err().unwrap_or_default(),
+                TextureError::TooLarge { width, height } => check_size(width.into(), height.into())
+                    .err()
+                    .unwrap_or_default(),
+                other => other.to_string(),
             })?
             .into_rgb32f();
     let (w, h) = (image.width() as usize, image.height() as usize);

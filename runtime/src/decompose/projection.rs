@@ -59,13 +59,18 @@ pub(crate) struct BasisColumns {
 impl BasisColumns {
     pub(crate) fn new(order: usize, directions: &[Vec3]) -> Self {
         let rows = BasisTable::new(order, directions);
-        let mut columns = Self {
+        let mut columns = Self::empty(order);
+        columns.set_rows(&rows.values, rows.stride);
+        columns
+    }
+
+    /// A table of no directions.
+    fn empty(order: usize) -> Self {
+        Self {
             order,
             count: 0,
             values: Vec::new(),
-        };
-        columns.set_rows(&rows.values, rows.stride);
-        columns
+        }
     }
 
     /// Makes the table that of the directions whose padded basis rows are `rows`.
@@ -268,11 +273,7 @@ impl MemberBasis {
         Self {
             order,
             rows: Vec::new(),
-            columns: BasisColumns {
-                order,
-                count: 0,
-                values: Vec::new(),
-            },
+            columns: BasisColumns::empty(order),
         }
     }
 

@@ -11,61 +11,77 @@ pub(super) fn order_key(v: f32) -> u32 {
 /// Bits of an [`order_key`] counted by each level of [`median_of_keys`]' radix selection.
 pub(super) const RADIX_LEVELS: [u32; 3] = [11, 11, 10];
 
-/// The counts of the keys' top [`RADIX_LEVELS`]`[0]` bits: the selection's first histogram,
-/// taken while the keys are gathered. Neighbouring texels mostly fall in one bin, so the keys
-/// are counted into [`TopBits::WAYS`] histograms in turn (summed at the end): increments of
-/// one bin then do not wait on each other.
-pub(super) struct TopBits {
-    ways: [[u32; 1 << 11]; TopBits::WAYS],
+/// Counts of a digit of keys (up to 11 bits). Neighbouring texels mostly share a digit, so
+/// the keys are counted into four histograms in turn (summed at the end): increments of one
+/// bin then do not wait on each other.
+struct DigitCounts {
+    ways: [[u32; 1 << 11]; 4],
 }
 
-impl TopBits {
-    const WAYS: usize = 4;
-
-    pub(super) fn new() -> Self {
+impl DigitCounts {
+    fn new() -> Self {
         Self {
-            ways: [[0; 1 << 11]; Self::WAYS],
+            ways: [[0; 1 << 11]; 4],
         }
     }
 
+    /// Counts the `bits` bits from `shift` up of each of `keys`, key `i` into histogram
+    /// `i mod 4`.
     #[inline]
-    fn bin(key: u32) -> usize {
-        (key >> (32 - RADIX_LEVELS[0])) as usize
-    }
-
-    #[inline]
-    pub(super) fn count(&mut self, key: u32) -> u32 {
-        self.ways[0][Self::bin(key)] += 1;
-        key
-    }
-
-    /// Appends the keys `values` to `out`, counting them: first the keys (a loop that
-    /// vectorizes), then their bins, key `i` into histogram `i mod WAYS`.
-    #[inline]
-    pub(super) fn extend(&mut self, out: &mut Vec<u32>, values: impl Iterator<Item = u32>) {
-        let start = out.len();
-        out.extend(values);
-        let keys = &out[start..];
-        let mut quads = keys.chunks_exact(Self::WAYS);
+    fn add(&mut self, keys: &[u32], shift: u32, bits: u32) {
+        let mask = (1u32 << bits) - 1;
+        let digit = |k: &u32| ((k >> shift) & mask) as usize;
+        let mut quads = keys.chunks_exact(4);
         for quad in &mut quads {
             for (way, key) in self.ways.iter_mut().zip(quad) {
-                way[Self::bin(*key)] += 1;
+                way[digit(key)] += 1;
             }
         }
         for key in quads.remainder() {
-            self.ways[0][Self::bin(*key)] += 1;
+            self.ways[0][digit(key)] += 1;
         }
     }
 
     /// The counts, all histograms summed.
-    fn counts(&self) -> [u32; 1 << 11] {
-        let mut total = self.ways[0];
-        for way in &self.ways[1..] {
+    fn total(&self) -> [u32; 1 << 11] {
+        let [mut total, rest @ ..] = self.ways;
+        for way in &rest {
             for (t, c) in total.iter_mut().zip(way) {
                 *t += c;
             }
         }
         total
+    }
+}
+
+/// The counts of the keys' top [`RADIX_LEVELS`]`[0]` bits: the selection's first histogram,
+/// taken while the keys are gathered.
+pub(super) struct TopBits(DigitCounts);
+
+impl TopBits {
+    const SHIFT: u32 = 32 - RADIX_LEVELS[0];
+
+    pub(super) fn new() -> Self {
+        Self(DigitCounts::new())
+    }
+
+    #[inline]
+    pub(super) fn count(&mut self, key: u32) -> u32 {
+        self.0.add(&[key], Self::SHIFT, RADIX_LEVELS[0]);
+        key
+    }
+
+    /// Appends the keys `values` to `out`, counting them: first the keys (a loop that
+    /// vectorizes), then their top bits.
+    #[inline]
+    pub(super) fn extend(&mut self, out: &mut Vec<u32>, values: impl Iterator<Item = u32>) {
+        let start = out.len();
+        out.extend(values);
+        self.0.add(&out[start..], Self::SHIFT, RADIX_LEVELS[0]);
+    }
+
+    fn counts(&self) -> [u32; 1 << 11] {
+        self.0.total()
     }
 }
 
@@ -112,28 +128,11 @@ pub(super) fn median_of_keys(keys: &mut Vec<u32>, top: &TopBits) -> f32 {
     f32::from_bits(if key >> 31 == 1 { key ^ 1 << 31 } else { !key })
 }
 
-/// How many `keys` have each value of the `bits` bits from `shift` up, counted into four
-/// histograms in turn (as [`TopBits`] does) and summed.
+/// How many `keys` have each value of the `bits` bits from `shift` up.
 fn digit_counts(keys: &[u32], shift: u32, bits: u32) -> [u32; 1 << 11] {
-    let mask = (1u32 << bits) - 1;
-    let digit = |k: &u32| ((k >> shift) & mask) as usize;
-    let mut ways = [[0u32; 1 << 11]; 4];
-    let mut quads = keys.chunks_exact(4);
-    for quad in &mut quads {
-        for (way, key) in ways.iter_mut().zip(quad) {
-            way[digit(key)] += 1;
-        }
-    }
-    for key in quads.remainder() {
-        ways[0][digit(key)] += 1;
-    }
-    let [mut total, rest @ ..] = ways;
-    for way in &rest {
-        for (t, c) in total.iter_mut().zip(way) {
-            *t += c;
-        }
-    }
-    total
+    let mut counts = DigitCounts::new();
+    counts.add(keys, shift, bits);
+    counts.total()
 }
 
 /// Keeps the keys whose bits above `shift` are `prefix`, in order. Without a branch per key:
