@@ -32,7 +32,8 @@ struct VertexIn {
 };
 
 struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
+    // Invariant: the proxy pass (`shaders/proxies.wgsl`) finds these depths again, exactly.
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) normal: vec3<f32>,
     @location(1) albedo: vec3<f32>,
     @location(2) radiance: vec3<f32>,
@@ -66,20 +67,6 @@ struct FragmentOut {
     // load from depth textures).
     @location(3) depth: vec4<f32>,
 };
-
-// ρ/π E(n) from `frame.sh_irradiance`: the real SH of bands 0–2 at n (CONVENTIONS.md: polar
-// axis +Y, azimuth from +Z toward +X, no Condon–Shortley phase).
-fn sh_irradiance_over_pi(n: vec3<f32>) -> vec3<f32> {
-    let c = frame.sh_irradiance;
-    var e = c[0].xyz * 0.282095;
-    e += 0.488603 * (c[1].xyz * n.x + c[2].xyz * n.y + c[3].xyz * n.z);
-    e += c[4].xyz * (1.092548 * n.z * n.x);
-    e += c[5].xyz * (1.092548 * n.x * n.y);
-    e += c[6].xyz * (0.315392 * (3.0 * n.y * n.y - 1.0));
-    e += c[7].xyz * (1.092548 * n.z * n.y);
-    e += c[8].xyz * (0.546274 * (n.z * n.z - n.x * n.x));
-    return e;
-}
 
 @fragment
 fn fs_main(in: VertexOut) -> FragmentOut {

@@ -26,23 +26,6 @@ override SHADOWED: bool = true;
 // Whether PCF kernels are sized from the light's angular radius (blocker search).
 override KERNEL_FROM_RADIUS: bool = true;
 
-// The background seen along `w_world`: the equirectangular map (CONVENTIONS.md) filtered at the
-// mip level whose texels span `pixel_angle` radians, the angle between neighbouring pixels'
-// rays (bilinear when magnified, no aliasing when minified).
-fn environment_radiance(w_world: vec3<f32>, pixel_angle: f32) -> vec3<f32> {
-    // The map is turned by the rotation: look up R_y(-angle) w.
-    let c = frame.env_rotation.x;
-    let s = frame.env_rotation.y;
-    let w = vec3<f32>(w_world.x * c - w_world.z * s, w_world.y, w_world.x * s + w_world.z * c);
-    let size = vec2<f32>(textureDimensions(environment));
-    var u = atan2(w.x, -w.z) / (2.0 * PI);
-    u = u - floor(u);
-    let v = acos(clamp(w.y, -1.0, 1.0)) / PI;
-    // Explicit level: derivatives of u jump at the map's seam.
-    let lod = max(log2(pixel_angle * size.x / (2.0 * PI)), 0.0);
-    return textureSampleLevel(environment, environment_sampler, vec2<f32>(u, v), lod).xyz;
-}
-
 fn shadow_coordinates(light: Light, position: vec3<f32>) -> vec3<f32> {
     let clip = light.shadow_matrix * vec4<f32>(position, 1.0);
     return vec3<f32>(clip.x * 0.5 + 0.5, 0.5 - clip.y * 0.5, clip.z);
@@ -215,28 +198,45 @@ fn visibility(index: u32, position: vec3<f32>, normal: vec3<f32>, phase: f32) ->
     return pcf_source(layer, coords, slope, core, halo, light.source.y, phase);
 }
 
-// The unit direction of the camera ray through `ndc`.
-fn view_ray(ndc: vec2<f32>) -> vec3<f32> {
-    let far = frame.inv_view_proj * vec4<f32>(ndc, 1.0, 1.0);
-    let near = frame.inv_view_proj * vec4<f32>(ndc, 0.0, 1.0);
-    return normalize(far.xyz / far.w - near.xyz / near.w);
-}
-
 @fragment
 fn fs_main(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
     let texel = vec2<i32>(pixel.xy);
     let depth = decode_depth(textureLoad(depth_buffer, texel, 0));
-    let ndc = vec2<f32>(pixel.x * frame.viewport.z * 2.0 - 1.0, 1.0 - pixel.y * frame.viewport.w * 2.0);
     if depth >= 1.0 {
         if (frame.flags & 2u) == 0u {
             return vec4<f32>(0.0);
         }
+        let ndc = pixel_ndc(pixel.xy);
         let direction = view_ray(ndc);
         let next = view_ray(ndc + vec2<f32>(2.0 * frame.viewport.z, 0.0));
         let pixel_angle = acos(clamp(dot(direction, next), -1.0, 1.0));
         return vec4<f32>(environment_radiance(direction, pixel_angle), 0.0);
     }
-    let world = frame.inv_view_proj * vec4<f32>(ndc, depth, 1.0);
+    return vec4<f32>(direct_light(pixel.xy, depth), 0.0);
+}
+
+// The lights on the proxies alone, for the live composite (CONVENTIONS.md, "Compositing"):
+// bound with the proxies' own shadow maps, it adds each light onto the proxies' PRT radiance
+// where the proxy pass marked a pixel (albedo alpha 2), and nothing elsewhere.
+@fragment
+fn fs_without_objects(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
+    let texel = vec2<i32>(pixel.xy);
+    let depth = decode_depth(textureLoad(depth_buffer, texel, 0));
+    if depth >= 1.0 || textureLoad(albedo_buffer, texel, 0).w < 1.5 {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(direct_light(pixel.xy, depth), 0.0);
+}
+
+// Normalised device coordinates of a pixel (its centre when given one).
+fn pixel_ndc(pixel: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(pixel.x * frame.viewport.z * 2.0 - 1.0, 1.0 - pixel.y * frame.viewport.w * 2.0);
+}
+
+// Every light's direct contribution at the surface the G-buffer holds at `pixel`.
+fn direct_light(pixel: vec2<f32>, depth: f32) -> vec3<f32> {
+    let texel = vec2<i32>(pixel);
+    let world = frame.inv_view_proj * vec4<f32>(pixel_ndc(pixel), depth, 1.0);
     let position = world.xyz / world.w;
     let normal_and_material = textureLoad(normal_buffer, texel, 0);
     let normal = normal_and_material.xyz;
@@ -248,7 +248,7 @@ fn fs_main(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
     if glossy {
         r = mirror_direction(normalize(frame.camera_position.xyz - position), normal);
     }
-    let phase = pixel_phase(pixel.xy);
+    let phase = pixel_phase(pixel);
     var sum = vec3<f32>(0.0);
     // A constant trip count with an early break lets the compiler unroll the loop and index
     // the light array with constants.
@@ -278,5 +278,5 @@ fn fs_main(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
             }
         }
     }
-    return vec4<f32>(sum, 0.0);
+    return sum;
 }

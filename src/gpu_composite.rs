@@ -21,7 +21,7 @@ use reference::composite::{
     Composite, PixelKind, composite, composite_with_ratio, environment_backplate, pixel_kinds,
 };
 use runtime::FrameLighting;
-use runtime::render::{GpuContext, Renderer, ShadowSettings};
+use runtime::render::{GpuContext, LiveBackplate, Renderer, ShadowSettings};
 
 /// How the objects' effect on the proxies is composited.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -33,6 +33,10 @@ pub enum CompositeForm {
     /// The mobile-AR paper's simpler peer: the backplate times the proxies' ambient occlusion
     /// by the objects (no lights' shadows).
     Occlusion,
+    /// The viewer's composite: the differential form drawn in the frame on the GPU (the
+    /// proxies' radiance and shadow maps without the objects, the ratio in a GPU pass), pixels
+    /// classified by depth.
+    Live,
 }
 
 /// What the composite of one frame needs besides the whole scene's renderer.
@@ -55,6 +59,45 @@ fn proxies_scene(scene: &Scene, whole: &Transfer) -> Scene {
         bake: whole.settings,
         ..scene.clone()
     }
+}
+
+/// The bake of the proxies alone (cached like any scene's), with the whole scene's settings.
+pub fn proxies_bake(scene: &Scene, whole: &Transfer) -> anyhow::Result<Transfer> {
+    let proxies = proxies_scene(scene, whole);
+    let (_, transfer) = bake_for(&proxies, None).context("cannot bake the proxies alone")?;
+    Ok(transfer)
+}
+
+/// The backplate of the live composite: the environment, or the scene's photograph at its
+/// camera's size.
+pub fn live_backplate(scene: &Scene) -> anyhow::Result<LiveBackplate> {
+    Ok(match &scene.backplate {
+        Some(Backplate::Image(path)) => LiveBackplate::Photograph(load_backplate_image(
+            path,
+            scene.camera.width,
+            scene.camera.height,
+        )?),
+        _ => LiveBackplate::Environment,
+    })
+}
+
+/// The live composite of one frame ([`CompositeForm::Live`]), read back.
+pub fn live_composite_frame(
+    whole: &mut Renderer,
+    transfer: &Transfer,
+    lighting: &FrameLighting,
+    inputs: &CompositeInputs,
+) -> anyhow::Result<RgbImageF32> {
+    let proxies_transfer = proxies_bake(inputs.scene, transfer)?;
+    whole.enable_composite(
+        &inputs.scene.geometry,
+        &proxies_transfer,
+        &live_backplate(inputs.scene)?,
+    )?;
+    whole.set_environment(inputs.map, inputs.rotation_deg);
+    whole.set_lighting(lighting)?;
+    whole.render()?;
+    Ok(whole.read_back()?)
 }
 
 /// The picture composited into, at the camera's size.
@@ -136,8 +179,7 @@ pub fn composite_frame(
         ));
     }
     let proxies = proxies_scene(inputs.scene, transfer);
-    let (_, proxies_transfer) =
-        bake_for(&proxies, None).context("cannot bake the proxies alone")?;
+    let proxies_transfer = proxies_bake(inputs.scene, transfer)?;
     let mut without = Renderer::new(
         gpu,
         &proxies.geometry,

@@ -353,3 +353,68 @@ fn the_occlusion_peer_darkens_the_proxy_by_ambient_occlusion() {
         assert_eq!(occlusion[i], differential[i], "object pixel {i}");
     }
 }
+
+/// The viewer's live composite (`--composite live`: the proxies' radiance and shadow maps
+/// without the objects, the ratio and the pixel kinds on the GPU) is the differential composite
+/// the CPU classifies, on either adapter. A uniform grey photograph as the backplate, so the
+/// two backplates' filtering cannot differ and only the ratio and the pixels' kinds are
+/// compared.
+#[test]
+fn the_live_composite_is_the_differential_one_on_both_adapters() {
+    let (_keep, d) = workspace();
+    let grey = png_bytes(&vec![128u8; 40 * 30 * 3], 40, 30).unwrap();
+    std::fs::write(d.join("grey.png"), grey).unwrap();
+    floor_scene(
+        &d,
+        "composite.toml",
+        "proxy",
+        "[backplate]\nimage = \"grey.png\"",
+    );
+    let cache = d.join("cache");
+    let run = |args: &[&str]| {
+        let out = hprt_with_env(&d, args, &[("HPRT_CACHE", &cache)]);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    };
+    run(&["bake", "composite.toml", "-o", "c.bake", "--samples", "256"]);
+    for backend in ["vulkan", "gl"] {
+        let render = |form: &str| {
+            let exr = format!("{form}-{backend}.exr");
+            run(&[
+                "render",
+                "composite.toml",
+                "--bake",
+                "c.bake",
+                "--backend",
+                backend,
+                "--composite",
+                form,
+                "-o",
+                "x.png",
+                "--exr",
+                &exr,
+            ]);
+            read_exr(&d.join(exr)).unwrap().pixels
+        };
+        let (differential, live) = (render("differential"), render("live"));
+        let backplate = differential[0];
+        let shadowed = differential
+            .iter()
+            .filter(|p| p.max_element() < 0.9 * backplate.max_element())
+            .count();
+        assert!(
+            shadowed > 20,
+            "{backend}: the box casts a shadow ({shadowed} pixels)"
+        );
+        let differ = differential
+            .iter()
+            .zip(&live)
+            .filter(|(a, b)| (**a - **b).abs().max_element() > 0.01 * a.max_element().max(0.01))
+            .count();
+        assert!(
+            differ * 100 <= differential.len(),
+            "{backend}: {differ} of {} pixels differ between the live and the differential \
+             composite",
+            differential.len()
+        );
+    }
+}

@@ -68,7 +68,8 @@ pub struct RenderArgs {
     pub layers: Option<PathBuf>,
     /// For a scene with a [backplate]: how the objects change the proxies. differential: the
     /// ratio with and without the objects (the truth's form); occlusion: the mobile-AR paper's
-    /// peer, the backplate times the proxies' ambient occlusion by the objects.
+    /// peer, the backplate times the proxies' ambient occlusion by the objects; live: the
+    /// differential form as the viewer draws it, on the GPU in the frame.
     #[arg(long, value_enum, default_value_t)]
     pub composite: gpu_composite::CompositeForm,
 }
@@ -177,6 +178,10 @@ fn layer_files(
         "--layers: {} has no [backplate] to composite into",
         scene.path.display()
     );
+    anyhow::ensure!(
+        args.layers.is_none() || args.composite != gpu_composite::CompositeForm::Live,
+        "--layers: the live composite keeps its layers on the GPU; use --composite differential"
+    );
     Ok(args
         .layers
         .iter()
@@ -243,6 +248,10 @@ fn draw(
         shadow: args.render.shadow_settings(),
         form: args.composite,
     };
+    if args.composite == gpu_composite::CompositeForm::Live {
+        let image = gpu_composite::live_composite_frame(&mut renderer, transfer, frame, &inputs)?;
+        return Ok((image, None));
+    }
     let c = gpu_composite::composite_frame(gpu, &mut renderer, transfer, frame, &inputs)?;
     Ok((c.image.clone(), Some(c)))
 }

@@ -209,9 +209,73 @@ pub(crate) const DISPLAY: BindGroupDecl = BindGroupDecl {
     ],
 };
 
+/// `shaders/proxies.wgsl`, group 0 (group 1 is [`ALBEDO_TEXTURE`]'s layout).
+pub(crate) const PROXIES: BindGroupDecl = BindGroupDecl {
+    label: "proxy pass",
+    shader: Shader::Proxies,
+    group: 0,
+    bindings: &[binding("frame", Stages::VERTEX_FRAGMENT, Resource::Uniform)],
+};
+
+/// `shaders/proxies.wgsl`, group 1: the same as the PRT pass's albedo textures.
+#[cfg(test)]
+const PROXIES_TEXTURE: BindGroupDecl = BindGroupDecl {
+    shader: Shader::Proxies,
+    ..ALBEDO_TEXTURE
+};
+
+/// `shaders/composite_floor.wgsl`: the proxies alone, and the sums of the ratio's floor.
+pub(crate) const COMPOSITE_FLOOR: BindGroupDecl = BindGroupDecl {
+    label: "composite floor",
+    shader: Shader::CompositeFloor,
+    group: 0,
+    bindings: &[
+        binding(
+            "without_objects",
+            Stages::COMPUTE,
+            Resource::Texture {
+                dimension: Dim::D2,
+                filterable: false,
+            },
+        ),
+        binding(
+            "sums",
+            Stages::COMPUTE,
+            Resource::Storage { read_only: false },
+        ),
+    ],
+};
+
+/// `shaders/composite.wgsl`: both renders, the depth, the backplates and the floor.
+pub(crate) const COMPOSITE: BindGroupDecl = BindGroupDecl {
+    label: "composite",
+    shader: Shader::Composite,
+    group: 0,
+    bindings: &[
+        binding("frame", FRAGMENT, Resource::Uniform),
+        binding("backplate", FRAGMENT, Resource::Uniform),
+        binding("with_objects", FRAGMENT, FLOAT_2D),
+        binding("without_objects", FRAGMENT, FLOAT_2D),
+        binding("depth_buffer", FRAGMENT, FLOAT_2D),
+        binding("environment", FRAGMENT, FILTERABLE_2D),
+        binding("environment_sampler", FRAGMENT, FILTERING),
+        binding("photograph", FRAGMENT, FILTERABLE_2D),
+        binding("photograph_sampler", FRAGMENT, FILTERING),
+        binding("floor_sums", FRAGMENT, Resource::Uniform),
+    ],
+};
+
+/// `shaders/wireframe.wgsl`: the frame's camera.
+pub(crate) const WIREFRAME: BindGroupDecl = BindGroupDecl {
+    label: "wireframe",
+    shader: Shader::Wireframe,
+    group: 0,
+    bindings: &[binding("frame", Stages::VERTEX, Resource::Uniform)],
+};
+
 /// Every declaration, for the test against the WGSL.
 #[cfg(test)]
-pub(crate) const ALL: [&BindGroupDecl; 7] = [
+pub(crate) const ALL: [&BindGroupDecl; 12] = [
     &TRANSFER,
     &PRT_FRAME,
     &ALBEDO_TEXTURE,
@@ -219,6 +283,11 @@ pub(crate) const ALL: [&BindGroupDecl; 7] = [
     &LIGHTS,
     &PREFILTER,
     &DISPLAY,
+    &PROXIES,
+    &PROXIES_TEXTURE,
+    &COMPOSITE_FLOOR,
+    &COMPOSITE,
+    &WIREFRAME,
 ];
 
 impl Resource {
@@ -401,6 +470,11 @@ mod tests {
             (Shader::Prefilter, "Job", size_of::<reflection_maps::Job>()),
             (Shader::Prefilter, "Job", PREFILTER_JOB_SIZE as usize),
             (Shader::Shadow, "ShadowView", SHADOW_VIEW_SIZE as usize),
+            (
+                Shader::Composite,
+                "Backplate",
+                size_of::<super::super::composite::BackplateUniform>(),
+            ),
             (
                 Shader::Display,
                 "Display",

@@ -30,6 +30,7 @@ impl DisplayPass {
             immediate_size: 0,
         });
         let pipeline = FullscreenPass {
+            entry_point: "fs_main",
             label: "display",
             module: &module,
             layout: Some(&pipeline_layout),

@@ -27,6 +27,16 @@ pub enum BakeMismatch {
     OrderTooHigh { order: usize, max: usize },
     #[error("the transfer ({mb} MB) exceeds the adapter's storage buffer limit ({limit_mb} MB)")]
     TooLarge { mb: usize, limit_mb: usize },
+    #[error(
+        "the proxies' bake has {bake} vertices and SH order {bake_order}; the scene's proxies \
+         have {scene} vertices and its bake order {scene_order}"
+    )]
+    Proxies {
+        bake: usize,
+        bake_order: usize,
+        scene: usize,
+        scene_order: usize,
+    },
 }
 
 /// Why an image could not be copied back from the GPU.

@@ -191,6 +191,37 @@ impl GpuScene {
         }
     }
 
+    /// Draws the triangles of `draws` (index ranges with their texture groups) with
+    /// `radiance` as the per-vertex radiance (the live composite's proxies without the
+    /// objects).
+    pub(crate) fn draw_parts_with(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        radiance: &wgpu::Buffer,
+        draws: &[(std::ops::Range<u32>, usize)],
+    ) {
+        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
+        pass.set_vertex_buffer(1, radiance.slice(..));
+        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+        for (range, group) in draws {
+            pass.set_bind_group(ALBEDO_TEXTURE.group, &self.texture_groups[*group], &[]);
+            pass.draw_indexed(range.clone(), 0, 0..1);
+        }
+    }
+
+    /// Draws the triangles of `ranges` (index ranges) from their vertices alone.
+    pub(crate) fn draw_parts_depth_only(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        ranges: &[(std::ops::Range<u32>, usize)],
+    ) {
+        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
+        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+        for (range, _) in ranges {
+            pass.draw_indexed(range.clone(), 0, 0..1);
+        }
+    }
+
     fn draw_triangles(&self, pass: &mut wgpu::RenderPass) {
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..self.index_count, 0, 0..1);
@@ -252,8 +283,16 @@ fn materials(
 /// Index ranges of consecutive objects sharing a texture group (0: untextured, `i + 1`:
 /// `geometry.textures[i]`): an untextured scene is one draw.
 fn draws(geometry: &SceneMesh) -> Vec<(std::ops::Range<u32>, usize)> {
+    draws_of(geometry, |_| true)
+}
+
+/// [`draws`] of the objects `keep` keeps.
+pub(crate) fn draws_of(
+    geometry: &SceneMesh,
+    keep: impl Fn(&foundation::scene::SceneObject) -> bool,
+) -> Vec<(std::ops::Range<u32>, usize)> {
     let mut draws: Vec<(std::ops::Range<u32>, usize)> = Vec::new();
-    for o in &geometry.objects {
+    for o in geometry.objects.iter().filter(|o| keep(o)) {
         let group = o.texture.map_or(0, |t| t + 1);
         let range = 3 * o.triangles.start..3 * o.triangles.end;
         match draws.last_mut() {

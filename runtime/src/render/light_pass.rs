@@ -31,6 +31,12 @@ pub(crate) struct LightPass {
 
 impl LightPass {
     pub(crate) fn new(device: &wgpu::Device) -> Self {
+        Self::with_entry_point(device, "fs_main")
+    }
+
+    /// The pass of another entry point of `shaders/lights.wgsl` (the same bindings and
+    /// variants), e.g. the lights on the proxies alone.
+    pub(crate) fn with_entry_point(device: &wgpu::Device, entry_point: &str) -> Self {
         let layout = LIGHTS.layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("light pass"),
@@ -46,6 +52,7 @@ impl LightPass {
         let pipelines = (0..4)
             .map(|variant| {
                 FullscreenPass {
+                    entry_point,
                     label: "light pass",
                     module: &module,
                     layout: Some(&pipeline_layout),
@@ -77,6 +84,7 @@ impl LightPass {
         self.bind_group = None;
     }
 
+    /// Adds the lights onto the frame's image.
     pub(crate) fn record(
         &mut self,
         device: &wgpu::Device,
@@ -84,13 +92,26 @@ impl LightPass {
         inputs: &LightPassInputs,
         shadows: bool,
     ) {
+        let target = inputs.targets.color_view.clone();
+        self.record_into(device, encoder, inputs, shadows, &target);
+    }
+
+    /// Adds the lights onto `target`.
+    pub(crate) fn record_into(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &LightPassInputs,
+        shadows: bool,
+        target: &wgpu::TextureView,
+    ) {
         let bind_group = self
             .bind_group
             .get_or_insert_with(|| bind_group(device, &self.layout, inputs));
         let mut pass = begin_pass(
             encoder,
             "light pass",
-            &[color_attachment(&inputs.targets.color_view, None)],
+            &[color_attachment(target, None)],
             None,
         );
         let kernel_from_radius = inputs.shadow_maps.settings().from_angular_radius;

@@ -17,6 +17,7 @@
 //! every pass repeats.
 
 mod bindings;
+mod composite;
 mod display_pass;
 mod environment_texture;
 mod error;
@@ -36,6 +37,8 @@ mod transfer_pass;
 mod uniforms;
 
 use crate::lighting::ShTransfer;
+pub use composite::LiveBackplate;
+use composite::{Compositor, CompositorSource};
 pub use display_pass::{DisplayPass, capture_target};
 use environment_texture::EnvironmentTexture;
 use error::checked;
@@ -104,6 +107,8 @@ pub struct Renderer {
     light_pass: LightPass,
     reflections: ReflectionMaps,
     frame: FrameState,
+    /// The live composite into a backplate, when enabled ([`Self::enable_composite`]).
+    composite: Option<Compositor>,
     /// Show the environment map where no geometry is.
     pub background: bool,
 }
@@ -155,6 +160,7 @@ impl Renderer {
                 radiance_dirty: true,
                 reflections_dirty: true,
             },
+            composite: None,
             background: true,
             queue: gpu.queue.clone(),
             device,
@@ -175,7 +181,55 @@ impl Renderer {
         if self.shadow_maps.set_settings(&self.device, shadow)? {
             self.light_pass.inputs_changed();
         }
+        if let Some(composite) = &mut self.composite {
+            composite.set_shadow_settings(&self.device, shadow)?;
+        }
         Ok(())
+    }
+
+    /// Composites every frame into `backplate` from now on (CONVENTIONS.md, "Compositing"):
+    /// `geometry` is the scene this renderer draws, `proxies` the bake of its proxies alone
+    /// (`SceneMesh::subset`, the same SH order). The images shown and read back become the
+    /// composite.
+    pub fn enable_composite(
+        &mut self,
+        geometry: &SceneMesh,
+        proxies: &Transfer,
+        backplate: &LiveBackplate,
+    ) -> Result<(), RenderError> {
+        let device = self.device.clone();
+        let compositor = checked(&device, || {
+            Compositor::new(
+                &self.device,
+                &self.queue,
+                &CompositorSource {
+                    scene: &self.scene,
+                    geometry,
+                    proxies_transfer: proxies,
+                    backplate,
+                    shadow: self.shadow_maps.settings(),
+                    size: (self.targets.width, self.targets.height),
+                },
+            )
+        })?;
+        self.composite = Some(compositor);
+        Ok(())
+    }
+
+    /// Back to drawing the whole scene.
+    pub fn disable_composite(&mut self) {
+        self.composite = None;
+    }
+
+    pub fn is_compositing(&self) -> bool {
+        self.composite.is_some()
+    }
+
+    /// Draws the proxies' edges over the composite (to line them up with a photograph).
+    pub fn set_wireframe(&mut self, on: bool) {
+        if let Some(composite) = &mut self.composite {
+            composite.wireframe = on;
+        }
     }
 
     /// The environment shown behind the scene (not its lighting: see [`Self::set_lighting`]).
@@ -199,6 +253,9 @@ impl Renderer {
         if resized {
             self.targets = Targets::new(&self.device, camera.width, camera.height);
             self.light_pass.inputs_changed();
+            if let Some(composite) = &mut self.composite {
+                composite.resize(&self.device, camera.width, camera.height);
+            }
         }
         self.frame.camera = *camera;
         Ok(resized)
@@ -267,9 +324,20 @@ impl Renderer {
         Ok(())
     }
 
-    /// The linear HDR image of the last [`Self::render`] (Rgba16Float).
+    /// The linear HDR image of the last [`Self::render`] (Rgba16Float): the composite when
+    /// compositing.
     pub(crate) fn color_view(&self) -> &wgpu::TextureView {
-        &self.targets.color_view
+        match &self.composite {
+            Some(composite) => composite.image().1,
+            None => &self.targets.color_view,
+        }
+    }
+
+    fn color_texture(&self) -> &wgpu::Texture {
+        match &self.composite {
+            Some(composite) => composite.image().0,
+            None => &self.targets.color,
+        }
     }
 
     /// Records and submits one frame; returns without waiting for the GPU.
@@ -291,6 +359,10 @@ impl Renderer {
         if self.frame.radiance_dirty {
             self.scene
                 .update_radiance(&self.queue, &mut encoder, &lighting);
+            if let Some(composite) = &self.composite {
+                let (order, vertices) = (self.scene.order, self.scene.vertex_count);
+                composite.update_radiance(&self.queue, &mut encoder, &lighting, order, vertices);
+            }
             self.frame.radiance_dirty = false;
         }
         let shadow = self.shadow_maps.settings();
@@ -319,12 +391,8 @@ impl Renderer {
         let light_data = uniforms::light_uniforms(lights, &fits);
         self.buffers.write(&self.queue, &frame, &light_data);
         if shadows {
-            if self.shadow_maps.reserve(&self.device, lights.len()) {
-                self.light_pass.inputs_changed();
-            }
             let matrices: Vec<_> = light_data.iter().map(|l| l.shadow_matrix()).collect();
-            self.shadow_maps
-                .render_stale(&self.queue, &mut encoder, &self.scene, &matrices);
+            self.record_shadow_maps(&mut encoder, &matrices);
         }
         self.prt_pass.record(
             &self.device,
@@ -346,8 +414,36 @@ impl Renderer {
         };
         self.light_pass
             .record(&self.device, &mut encoder, &inputs, shadows);
+        if let Some(composite) = &mut self.composite {
+            let frame = composite::FrameInputs {
+                buffers: &self.buffers,
+                targets: &self.targets,
+                environment: &self.environment,
+                materials: &self.scene.materials.uniform,
+                shadows,
+            };
+            composite.record(&self.device, &mut encoder, &self.scene, &frame);
+        }
         self.queue.submit([encoder.finish()]);
         Ok(())
+    }
+
+    /// Each light's shadow map (and the composite's, of the proxies alone) where its matrix
+    /// changed.
+    fn record_shadow_maps(&mut self, encoder: &mut wgpu::CommandEncoder, matrices: &[glam::Mat4]) {
+        if self.shadow_maps.reserve(&self.device, matrices.len()) {
+            self.light_pass.inputs_changed();
+        }
+        let scene = &self.scene;
+        self.shadow_maps.render_stale(
+            &self.queue,
+            encoder,
+            |pass| scene.draw_depth_only(pass),
+            matrices,
+        );
+        if let Some(composite) = &mut self.composite {
+            composite.render_shadow_maps(&self.device, &self.queue, encoder, scene, matrices);
+        }
     }
 
     /// Prefilters the reflection maps now, if the lighting or the materials changed them
@@ -385,7 +481,7 @@ impl Renderer {
     /// Waits for the last frame and copies it to the CPU as linear radiance.
     pub fn read_back(&self) -> Result<RgbImageF32, RenderError> {
         checked(&self.device, || {
-            let bytes = readback::read_texture(&self.device, &self.queue, &self.targets.color, 8)?;
+            let bytes = readback::read_texture(&self.device, &self.queue, self.color_texture(), 8)?;
             let halves: &[half::f16] = bytemuck::cast_slice(&bytes);
             let pixels = halves
                 .chunks_exact(4)

@@ -114,6 +114,20 @@ pub(crate) fn nearest_depth(
     })
 }
 
+/// A depth attachment whose contents are kept: tested against, not written.
+pub(crate) fn depth_attachment_kept(
+    view: &wgpu::TextureView,
+) -> Option<wgpu::RenderPassDepthStencilAttachment<'_>> {
+    Some(wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: wgpu::LoadOp::Load,
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    })
+}
+
 /// A buffer the CPU writes each frame (`COPY_DST` added to `usage`).
 pub(crate) fn writable_buffer(
     device: &wgpu::Device,
@@ -132,6 +146,8 @@ pub(crate) fn writable_buffer(
 /// A pass drawn as one screen-covering triangle (`shaders/fullscreen.wgsl`) into one target.
 pub(crate) struct FullscreenPass<'a> {
     pub label: &'a str,
+    /// The fragment stage's entry point.
+    pub entry_point: &'a str,
     pub module: &'a wgpu::ShaderModule,
     /// `None`: derived from the shader.
     pub layout: Option<&'a wgpu::PipelineLayout>,
@@ -156,7 +172,7 @@ impl FullscreenPass<'_> {
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: self.module,
-                entry_point: Some("fs_main"),
+                entry_point: Some(self.entry_point),
                 compilation_options: wgpu::PipelineCompilationOptions {
                     constants: self.constants,
                     ..Default::default()

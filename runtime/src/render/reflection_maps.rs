@@ -57,6 +57,7 @@ impl ReflectionMaps {
             immediate_size: 0,
         });
         let pipeline = FullscreenPass {
+            entry_point: "fs_main",
             label: "prefilter",
             module: &module,
             layout: Some(&pipeline_layout),

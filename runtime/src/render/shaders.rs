@@ -15,6 +15,10 @@ pub(crate) const MAX_GPU_COEFFS: usize = MAX_GPU_ORDER * MAX_GPU_ORDER;
 pub(crate) const MAX_MATERIALS: usize = 32;
 /// Invocations per workgroup of the per-vertex transfer pass.
 pub(crate) const TRANSFER_WORKGROUP: u32 = 64;
+/// Workgroups (bands of rows) summing the live composite's ratio floor.
+pub(crate) const FLOOR_GROUPS: u32 = 64;
+/// Entries of the floor's sums: one per band, then the total.
+pub(crate) const FLOOR_SUMS: usize = FLOOR_GROUPS as usize + 1;
 
 /// The shaders of `shaders/`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,6 +35,14 @@ pub(crate) enum Shader {
     Display,
     /// Reflection maps prefiltered with the Phong lobe.
     Prefilter,
+    /// The live composite: the proxies without the objects.
+    Proxies,
+    /// The live composite: the ratio's floor (compute).
+    CompositeFloor,
+    /// The live composite: the ratio form into the backplate.
+    Composite,
+    /// The proxies' edges over the composite.
+    Wireframe,
 }
 
 impl Shader {
@@ -42,6 +54,10 @@ impl Shader {
             Shader::Lights => "lights.wgsl",
             Shader::Display => "display.wgsl",
             Shader::Prefilter => "prefilter.wgsl",
+            Shader::Proxies => "proxies.wgsl",
+            Shader::CompositeFloor => "composite_floor.wgsl",
+            Shader::Composite => "composite.wgsl",
+            Shader::Wireframe => "wireframe.wgsl",
         }
     }
 
@@ -53,6 +69,10 @@ impl Shader {
             Shader::Lights => include_str!("../../../shaders/lights.wgsl"),
             Shader::Display => include_str!("../../../shaders/display.wgsl"),
             Shader::Prefilter => include_str!("../../../shaders/prefilter.wgsl"),
+            Shader::Proxies => include_str!("../../../shaders/proxies.wgsl"),
+            Shader::CompositeFloor => include_str!("../../../shaders/composite_floor.wgsl"),
+            Shader::Composite => include_str!("../../../shaders/composite.wgsl"),
+            Shader::Wireframe => include_str!("../../../shaders/wireframe.wgsl"),
         }
     }
 
@@ -63,13 +83,19 @@ impl Shader {
         const COMMON: &str = include_str!("../../../shaders/common.wgsl");
         const FULLSCREEN: &str = include_str!("../../../shaders/fullscreen.wgsl");
         const GLOSSY: &str = include_str!("../../../shaders/glossy.wgsl");
+        const ENVIRONMENT: &str = include_str!("../../../shaders/environment.wgsl");
+        const SH_IRRADIANCE: &str = include_str!("../../../shaders/sh_irradiance.wgsl");
         match self {
             Shader::Transfer => &[],
-            Shader::Geometry => &[COMMON, GLOSSY],
+            Shader::Geometry => &[COMMON, GLOSSY, SH_IRRADIANCE],
             Shader::Shadow => &[COMMON],
-            Shader::Lights => &[COMMON, FULLSCREEN, GLOSSY],
+            Shader::Lights => &[COMMON, FULLSCREEN, GLOSSY, ENVIRONMENT],
             Shader::Display => &[FULLSCREEN],
             Shader::Prefilter => &[FULLSCREEN, GLOSSY],
+            Shader::Proxies => &[COMMON, SH_IRRADIANCE],
+            Shader::Wireframe => &[COMMON],
+            Shader::CompositeFloor => &[],
+            Shader::Composite => &[COMMON, FULLSCREEN, ENVIRONMENT],
         }
     }
 
@@ -103,7 +129,9 @@ fn constants() -> String {
          const MAX_LIGHTS: u32 = {MAX_LIGHTS}u;\n\
          const MAX_SH_COEFFS: u32 = {}u;\n\
          const MAX_MATERIALS: u32 = {MAX_MATERIALS}u;\n\
-         const TRANSFER_WORKGROUP: u32 = {TRANSFER_WORKGROUP}u;\n",
+         const TRANSFER_WORKGROUP: u32 = {TRANSFER_WORKGROUP}u;\n\
+         const FLOOR_GROUPS: u32 = {FLOOR_GROUPS}u;\n\
+         const FLOOR_SUMS: u32 = {FLOOR_SUMS}u;\n",
         num_coeffs(MAX_GPU_ORDER)
     )
 }
@@ -123,6 +151,10 @@ mod tests {
             Shader::Lights,
             Shader::Display,
             Shader::Prefilter,
+            Shader::Proxies,
+            Shader::CompositeFloor,
+            Shader::Composite,
+            Shader::Wireframe,
         ] {
             let source = shader.source();
             let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| {

@@ -10,7 +10,7 @@
 
 use super::bindings::{SHADOW_VIEW, SHADOW_VIEW_SIZE};
 use super::error::RenderError;
-use super::gpu_scene::{self, GpuScene};
+use super::gpu_scene;
 use super::pass_helpers::{
     begin_pass, color_attachment, depth_attachment, nearest_depth, texture, two_sided_triangles,
 };
@@ -214,12 +214,12 @@ impl ShadowMaps {
     }
 
     /// Records the shadow pass of every light whose matrix changed since its map was drawn
-    /// (call [`Self::reserve`] first).
+    /// (call [`Self::reserve`] first), drawing the occluders with `draw`.
     pub(crate) fn render_stale(
         &mut self,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
+        draw: impl Fn(&mut wgpu::RenderPass),
         matrices: &[Mat4],
     ) {
         let layers = &mut self.layers;
@@ -244,7 +244,7 @@ impl ShadowMaps {
             );
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(SHADOW_VIEW.group, &layers.view_bind_group, &[offset as u32]);
-            scene.draw_depth_only(&mut pass);
+            draw(&mut pass);
         }
         layers.rendered = matrices.to_vec();
     }
