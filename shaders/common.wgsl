@@ -4,14 +4,18 @@ struct Frame {
     inv_view_proj: mat4x4<f32>,
     // Width, height, 1/width, 1/height.
     viewport: vec4<f32>,
-    // cos and sin of the environment's rotation about +Y, then unused.
+    // cos and sin of the environment's rotation about +Y, the angle between the rays of the
+    // image centre's neighbouring pixels, then unused.
     env_rotation: vec4<f32>,
     light_count: u32,
     // Bit 1: show the environment behind the scene.
     flags: u32,
     // PCF kernel: taps per side (odd).
     pcf_taps: u32,
-    _pad: u32,
+    // The live composite: the shadow-map layer of the proxies' own map of light i is the
+    // light's layer plus this (0: none, the proxies cannot shadow themselves, or not
+    // compositing).
+    proxy_layers: u32,
     // Bit 2 of flags: the first pass shades by the normal with these (A_l L_k / π, RGB in
     // xyz, bands 0–2) instead of the per-vertex radiance.
     sh_irradiance: array<vec4<f32>, 9>,

@@ -1,23 +1,27 @@
 // The floor ε of the live composite's ratio (CONVENTIONS.md, "Compositing": 10⁻³ × the mean
-// luminance of the proxies alone over the proxy pixels), summed in two steps: each of
-// FLOOR_GROUPS workgroups sums every FLOOR_GROUPS-th row, then one invocation adds the bands
-// into the last entry (luminance sum, pixel count).
+// luminance of the proxies alone over the proxy pixels), for the next frame, estimated from
+// every FLOOR_STRIDE-th pixel of every FLOOR_STRIDE-th row (a guard against dividing by
+// nothing needs no more) and summed in two steps: each of FLOOR_GROUPS workgroups sums a
+// share of those rows, then one invocation adds the shares into the last entry (luminance
+// sum, pixel count).
 
-@group(0) @binding(0) var without_objects: texture_2d<f32>;
+// The composite, whose alpha is B's luminance on the proxy pixels and -1 elsewhere.
+@group(0) @binding(0) var composite_image: texture_2d<f32>;
 @group(0) @binding(1) var<storage, read_write> sums: array<vec4<f32>, FLOOR_SUMS>;
 
 const FLOOR_LANES: u32 = 64u;
+const FLOOR_STRIDE: u32 = 4u;
 var<workgroup> lane_sums: array<vec2<f32>, FLOOR_LANES>;
 
 @compute @workgroup_size(FLOOR_LANES)
 fn partial_sums(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let size = textureDimensions(without_objects);
+    let size = textureDimensions(composite_image);
     var sum = vec2<f32>(0.0);
-    for (var y = group.x; y < size.y; y = y + FLOOR_GROUPS) {
-        for (var x = lane; x < size.x; x = x + FLOOR_LANES) {
-            let b = textureLoad(without_objects, vec2<u32>(x, y), 0);
-            if b.w > 0.5 {
-                sum = sum + vec2<f32>(dot(b.xyz, vec3<f32>(0.2126, 0.7152, 0.0722)), 1.0);
+    for (var y = group.x * FLOOR_STRIDE; y < size.y; y = y + FLOOR_GROUPS * FLOOR_STRIDE) {
+        for (var x = lane * FLOOR_STRIDE; x < size.x; x = x + FLOOR_LANES * FLOOR_STRIDE) {
+            let luminance = textureLoad(composite_image, vec2<u32>(x, y), 0).w;
+            if luminance >= 0.0 {
+                sum = sum + vec2<f32>(luminance, 1.0);
             }
         }
     }

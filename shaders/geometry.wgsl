@@ -31,9 +31,15 @@ struct VertexIn {
     @location(7) indirect: vec4<f32>,
 };
 
+// The live composite's (`vs_composite`): the radiance of the proxies alone (their transfer
+// baked without the virtual objects; zero on the objects) and whether the vertex is a proxy's.
+struct ProxyIn {
+    @location(8) without_objects: vec4<f32>,
+    @location(9) proxy: f32,
+};
+
 struct VertexOut {
-    // Invariant: the proxy pass (`shaders/proxies.wgsl`) finds these depths again, exactly.
-    @builtin(position) @invariant clip: vec4<f32>,
+    @builtin(position) clip: vec4<f32>,
     @location(0) normal: vec3<f32>,
     @location(1) albedo: vec3<f32>,
     @location(2) radiance: vec3<f32>,
@@ -42,10 +48,16 @@ struct VertexOut {
     @location(5) visibility: vec4<f32>,
     @location(6) position: vec3<f32>,
     @location(7) indirect: vec3<f32>,
+    @location(8) without_objects: vec3<f32>,
+    @location(9) @interpolate(flat) proxy: f32,
 };
 
 @vertex
 fn vs_main(in: VertexIn) -> VertexOut {
+    return vertex(in);
+}
+
+fn vertex(in: VertexIn) -> VertexOut {
     var out: VertexOut;
     out.clip = frame.view_proj * vec4<f32>(in.position, 1.0);
     out.normal = in.normal;
@@ -59,6 +71,14 @@ fn vs_main(in: VertexIn) -> VertexOut {
     return out;
 }
 
+@vertex
+fn vs_composite(in: VertexIn, proxy: ProxyIn) -> VertexOut {
+    var out = vertex(in);
+    out.without_objects = proxy.without_objects.xyz;
+    out.proxy = proxy.proxy;
+    return out;
+}
+
 struct FragmentOut {
     @location(0) color: vec4<f32>,
     @location(1) normal: vec4<f32>,
@@ -68,8 +88,59 @@ struct FragmentOut {
     @location(3) depth: vec4<f32>,
 };
 
+// ρ/π E(n) from `frame.sh_irradiance`: the real SH of bands 0–2 at n (CONVENTIONS.md: polar
+// axis +Y, azimuth from +Z toward +X, no Condon–Shortley phase).
+fn sh_irradiance_over_pi(n: vec3<f32>) -> vec3<f32> {
+    let c = frame.sh_irradiance;
+    var e = c[0].xyz * 0.282095;
+    e += 0.488603 * (c[1].xyz * n.x + c[2].xyz * n.y + c[3].xyz * n.z);
+    e += c[4].xyz * (1.092548 * n.z * n.x);
+    e += c[5].xyz * (1.092548 * n.x * n.y);
+    e += c[6].xyz * (0.315392 * (3.0 * n.y * n.y - 1.0));
+    e += c[7].xyz * (1.092548 * n.z * n.y);
+    e += c[8].xyz * (0.546274 * (n.z * n.z - n.x * n.x));
+    return e;
+}
+
 @fragment
 fn fs_main(in: VertexOut) -> FragmentOut {
+    return shade(in);
+}
+
+struct CompositeOut {
+    @location(0) color: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) albedo: vec4<f32>,
+    @location(3) depth: vec4<f32>,
+    // The proxies alone (CONVENTIONS.md, "Compositing"): their PRT radiance without the
+    // objects, alpha 1 where a proxy is nearest, 0 on the objects.
+    @location(4) without_objects: vec4<f32>,
+};
+
+// The live composite's first pass: as `fs_main`, plus the image of the proxies alone (the
+// light pass adds their lights without the objects).
+@fragment
+fn fs_composite(in: VertexOut) -> CompositeOut {
+    let shaded = shade(in);
+    var out: CompositeOut;
+    out.color = shaded.color;
+    out.normal = shaded.normal;
+    out.albedo = shaded.albedo;
+    out.depth = shaded.depth;
+    let texel = textureSample(albedo_texture, albedo_sampler, in.uv).rgb;
+    if in.proxy > 0.5 {
+        var without = in.without_objects * texel;
+        // Unshadowed SH per pixel does not depend on the objects: as the scene's.
+        if (frame.flags & 4u) != 0u {
+            without = shaded.color.xyz;
+        }
+        out.without_objects = vec4<f32>(without, 1.0);
+    }
+    return out;
+}
+
+// The PRT radiance and the G-buffer of one fragment.
+fn shade(in: VertexOut) -> FragmentOut {
     var out: FragmentOut;
     let normal = normalize(in.normal);
     let texel = textureSample(albedo_texture, albedo_sampler, in.uv).rgb;

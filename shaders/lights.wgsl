@@ -17,6 +17,7 @@
 @group(0) @binding(9) var environment_sampler: sampler;
 @group(0) @binding(10) var<uniform> materials: Materials;
 
+
 const PI: f32 = 3.14159265358979;
 
 // Pipeline constants: the renderer builds one pipeline per combination, so the shader run per
@@ -107,8 +108,7 @@ fn receiver_depth_slope(light: Light, normal: vec3<f32>) -> vec2<f32> {
 
 // Fraction of `light` visible at `coords`: a taps × taps grid of hardware-filtered (2×2)
 // comparisons spread over `radius` texels, each against the receiver plane's depth there.
-fn pcf(light: Light, coords: vec3<f32>, slope: vec2<f32>, radius: f32) -> f32 {
-    let layer = i32(light.params.w);
+fn pcf(layer: i32, coords: vec3<f32>, slope: vec2<f32>, radius: f32) -> f32 {
     let size = vec2<f32>(textureDimensions(shadow_maps));
     let taps = i32(frame.pcf_taps);
     let half_taps = taps / 2;
@@ -172,16 +172,16 @@ fn normal_offset(light: Light, normal: vec3<f32>) -> vec3<f32> {
     return normal * (light.params.x * sine);
 }
 
-fn visibility(index: u32, position: vec3<f32>, normal: vec3<f32>, phase: f32) -> f32 {
+// Fraction of light `index` visible at `position` through its shadow map in `layer`.
+fn visibility(index: u32, layer: i32, position: vec3<f32>, normal: vec3<f32>, phase: f32) -> f32 {
     let light = lights[index];
     let coords = shadow_coordinates(light, position + normal_offset(light, normal));
     if coords.x < 0.0 || coords.x > 1.0 || coords.y < 0.0 || coords.y > 1.0 || coords.z > 1.0 {
         return 1.0;
     }
     let slope = receiver_depth_slope(light, normal);
-    let layer = i32(light.params.w);
     if !KERNEL_FROM_RADIUS {
-        return pcf(light, coords, slope, 1.0);
+        return pcf(layer, coords, slope, 1.0);
     }
     // Search as wide as the widest penumbra can be: a distant source of angular radius α
     // behind an occluder at distance d gives a half-width d tan α, d at most the map's depth.
@@ -198,34 +198,25 @@ fn visibility(index: u32, position: vec3<f32>, normal: vec3<f32>, phase: f32) ->
     return pcf_source(layer, coords, slope, core, halo, light.source.y, phase);
 }
 
-@fragment
-fn fs_main(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
-    let texel = vec2<i32>(pixel.xy);
-    let depth = decode_depth(textureLoad(depth_buffer, texel, 0));
-    if depth >= 1.0 {
-        if (frame.flags & 2u) == 0u {
-            return vec4<f32>(0.0);
-        }
-        let ndc = pixel_ndc(pixel.xy);
-        let direction = view_ray(ndc);
-        let next = view_ray(ndc + vec2<f32>(2.0 * frame.viewport.z, 0.0));
-        let pixel_angle = acos(clamp(dot(direction, next), -1.0, 1.0));
-        return vec4<f32>(environment_radiance(direction, pixel_angle), 0.0);
-    }
-    return vec4<f32>(direct_light(pixel.xy, depth), 0.0);
-}
-
-// The lights on the proxies alone, for the live composite (CONVENTIONS.md, "Compositing"):
-// bound with the proxies' own shadow maps, it adds each light onto the proxies' PRT radiance
-// where the proxy pass marked a pixel (albedo alpha 2), and nothing elsewhere.
-@fragment
-fn fs_without_objects(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
-    let texel = vec2<i32>(pixel.xy);
-    let depth = decode_depth(textureLoad(depth_buffer, texel, 0));
-    if depth >= 1.0 || textureLoad(albedo_buffer, texel, 0).w < 1.5 {
+// The background: the environment where no geometry is (when shown).
+fn background(pixel: vec2<f32>) -> vec4<f32> {
+    if (frame.flags & 2u) == 0u {
         return vec4<f32>(0.0);
     }
-    return vec4<f32>(direct_light(pixel.xy, depth), 0.0);
+    let ndc = pixel_ndc(pixel);
+    let direction = view_ray(ndc);
+    let next = view_ray(ndc + vec2<f32>(2.0 * frame.viewport.z, 0.0));
+    let pixel_angle = acos(clamp(dot(direction, next), -1.0, 1.0));
+    return vec4<f32>(environment_radiance(direction, pixel_angle), 0.0);
+}
+
+@fragment
+fn fs_main(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
+    let depth = decode_depth(textureLoad(depth_buffer, vec2<i32>(pixel.xy), 0));
+    if depth >= 1.0 {
+        return background(pixel.xy);
+    }
+    return vec4<f32>(direct_light(pixel.xy, depth, false).with_objects, 0.0);
 }
 
 // Normalised device coordinates of a pixel (its centre when given one).
@@ -233,8 +224,40 @@ fn pixel_ndc(pixel: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(pixel.x * frame.viewport.z * 2.0 - 1.0, 1.0 - pixel.y * frame.viewport.w * 2.0);
 }
 
-// Every light's direct contribution at the surface the G-buffer holds at `pixel`.
-fn direct_light(pixel: vec2<f32>, depth: f32) -> vec3<f32> {
+struct Lit {
+    with_objects: vec3<f32>,
+    // The same lights as the proxies alone receive them (when asked).
+    without_objects: vec3<f32>,
+};
+
+// Light `index`'s visibility through every occluder (x) and, with `proxies_alone`, through
+// the proxies alone (y: their own map, `frame.proxy_layers` layers on). The proxies are among
+// every occluder, so where a light is wholly visible it is through the proxies alone too:
+// their map is read only where the light is shadowed. One call site of `visibility` in a loop
+// whose trip count the compiler cannot know: a second inlined copy made software rasterizers'
+// shaders far slower.
+fn visibilities(index: u32, position: vec3<f32>, normal: vec3<f32>, phase: f32, proxies_alone: bool) -> vec2<f32> {
+    var v = vec2<f32>(1.0);
+    // No layers of their own: the proxies cannot shadow themselves (all light).
+    let maps = select(1u, 2u, proxies_alone && frame.proxy_layers > 0u);
+    for (var k = 0u; k < maps; k = k + 1u) {
+        let layer = i32(lights[index].params.w) + i32(k * frame.proxy_layers);
+        let seen = visibility(index, layer, position, normal, phase);
+        if k == 0u {
+            v = vec2<f32>(seen, 1.0);
+            if seen >= 1.0 {
+                break;
+            }
+        } else {
+            v.y = seen;
+        }
+    }
+    return v;
+}
+
+// Every light's direct contribution at the surface the G-buffer holds at `pixel`, and with
+// `proxies_alone` also as the proxies alone receive it.
+fn direct_light(pixel: vec2<f32>, depth: f32, proxies_alone: bool) -> Lit {
     let texel = vec2<i32>(pixel);
     let world = frame.inv_view_proj * vec4<f32>(pixel_ndc(pixel), depth, 1.0);
     let position = world.xyz / world.w;
@@ -250,6 +273,7 @@ fn direct_light(pixel: vec2<f32>, depth: f32) -> vec3<f32> {
     }
     let phase = pixel_phase(pixel);
     var sum = vec3<f32>(0.0);
+    var without = vec3<f32>(0.0);
     // A constant trip count with an early break lets the compiler unroll the loop and index
     // the light array with constants.
     for (var i = 0u; i < 32u; i = i + 1u) {
@@ -259,9 +283,9 @@ fn direct_light(pixel: vec2<f32>, depth: f32) -> vec3<f32> {
         let direction = lights[i].direction.xyz;
         let cosine = dot(normal, direction);
         if cosine > 0.0 {
-            var v = 1.0;
+            var v = vec2<f32>(1.0);
             if SHADOWED {
-                v = visibility(i, position, normal, phase);
+                v = visibilities(i, position, normal, phase, proxies_alone);
             }
             if glossy {
                 // The source's angular variance per axis: core and halo discs (tangents of
@@ -272,11 +296,13 @@ fn direct_light(pixel: vec2<f32>, depth: f32) -> vec3<f32> {
                 let variance = (share * core * core + (1.0 - share) * halo * halo) / 4.0;
                 let shininess = 1.0 / (1.0 / material.specular.w + variance);
                 let specular = material.specular.rgb * phong_lobe(dot(r, direction), shininess);
-                sum = sum + (diffuse * cosine + specular) * lights[i].power.xyz * v;
+                sum = sum + (diffuse * cosine + specular) * lights[i].power.xyz * v.x;
+                without = without + (diffuse * cosine + specular) * lights[i].power.xyz * v.y;
             } else {
-                sum = sum + diffuse * lights[i].power.xyz * (cosine * v);
+                sum = sum + diffuse * lights[i].power.xyz * (cosine * v.x);
+                without = without + diffuse * lights[i].power.xyz * (cosine * v.y);
             }
         }
     }
-    return sum;
+    return Lit(sum, without);
 }

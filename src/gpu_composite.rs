@@ -96,6 +96,9 @@ pub fn live_composite_frame(
     )?;
     whole.set_environment(inputs.map, inputs.rotation_deg);
     whole.set_lighting(lighting)?;
+    // The ratio's floor comes from the frame before (CONVENTIONS.md, "Compositing"): the
+    // first frame finds it for the second.
+    whole.render()?;
     whole.render()?;
     Ok(whole.read_back()?)
 }

@@ -13,6 +13,31 @@ pub fn load_scene(path: &Path) -> anyhow::Result<Scene> {
     Scene::open(path).context("cannot load the scene")
 }
 
+/// The scene of a command that takes `--backplate`: the file or model given, or the model
+/// composited into the backplate ("environment" or an image), its ground slab the proxy.
+pub fn open_scene(path: &Path, backplate: Option<&Path>) -> anyhow::Result<Scene> {
+    let Some(backplate) = backplate else {
+        return load_scene(path);
+    };
+    anyhow::ensure!(
+        foundation::mesh::is_mesh_file(path),
+        "--backplate is for a model (glTF, OBJ, PLY, BPT); {} is a scene file, which names its \
+         own [backplate]",
+        path.display()
+    );
+    let image = match backplate.to_str() {
+        Some(foundation::scene::BackplateSpec::ENVIRONMENT) => backplate.display().to_string(),
+        _ => {
+            anyhow::ensure!(backplate.exists(), "{}: no such file", backplate.display());
+            std::path::absolute(backplate)
+                .with_context(|| format!("cannot resolve {}", backplate.display()))?
+                .display()
+                .to_string()
+        }
+    };
+    Scene::for_model_with_backplate(path, &image).context("cannot load the scene")
+}
+
 /// Refuses a scene with proxies in a command that cannot composite yet (the viewer's live
 /// composite and the report's are being built; `hprt reference` and `hprt render` composite
 /// such a scene), rather than drawing its proxies as ordinary objects.

@@ -346,3 +346,101 @@ fn view_under_xvfb_with(
         .output()
         .expect("xvfb-run (package xvfb; tests/run.sh installs it)")
 }
+
+/// A model composited into its environment in one command (`--backplate environment`): the
+/// viewer shows the live composite (its panel has a Composite section), the saved command line
+/// draws the same image with `hprt render`, the proxy wireframe shows over it, and turning the
+/// composite off draws the whole scene.
+#[test]
+fn composites_a_model_into_its_environment_under_xvfb() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let model = repo().join("scenes/models/crate.glb");
+    let env = repo().join("scenes/env/city.exr");
+    let cache = d.join("cache");
+    std::fs::write(
+        d.join("composite.script"),
+        "wait-bake\nwait 3\nscreenshot composite.png\ncommand render.sh\nstate on.json\n\
+         set wireframe on\nwait 2\nscreenshot wire.png\nset composite off\nwait 2\n\
+         screenshot whole.png\nstate off.json\nquit\n",
+    )
+    .unwrap();
+    let out = view_under_xvfb_with(
+        d,
+        &model,
+        &[
+            "--env",
+            env.to_str().unwrap(),
+            "--backplate",
+            "environment",
+            "--width",
+            "640",
+            "--height",
+            "400",
+            "--script",
+            "composite.script",
+        ],
+        &[("HPRT_CACHE", cache.as_path())],
+    );
+    assert!(out.status.success(), "viewer failed: {}", stderr(&out));
+    let state = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(d.join(name)).unwrap()).unwrap()
+    };
+    let (on, off) = (state("on.json"), state("off.json"));
+    assert_eq!(on["compositing"], true);
+    assert_eq!(off["compositing"], false);
+    assert!(
+        on["panels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|p| p == "Composite"),
+        "{}",
+        on["panels"]
+    );
+
+    // The command line reproduces the composite the viewer showed.
+    let line = std::fs::read_to_string(d.join("render.sh")).unwrap();
+    assert!(line.contains("--composite live") && line.contains("--backplate environment"));
+    let args: Vec<String> = line
+        .split_whitespace()
+        .skip(1)
+        .map(|w| w.trim_matches('\'').to_owned())
+        .collect();
+    let output = args[args.iter().position(|a| a == "-o").unwrap() + 1].clone();
+    let rendered = hprt_with_env(
+        d,
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &[("HPRT_CACHE", cache.as_path())],
+    );
+    assert!(rendered.status.success(), "{}", stderr(&rendered));
+    let (w, h, shown) = image_rgb(&d.join("composite.png"));
+    let (rw, rh, again) = image_rgb(&d.join(&output));
+    assert_eq!((rw, rh), (w, h));
+    let worst = shown
+        .iter()
+        .zip(&again)
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap();
+    assert!(
+        worst <= 1,
+        "render.sh reproduces the composite (worst {worst})"
+    );
+
+    // The wireframe adds saturated green lines; the whole scene differs from the composite.
+    let green = |rgb: &[u8]| {
+        rgb.chunks_exact(3)
+            .filter(|p| p[1] == 255 && p[0] < 80 && p[2] < 80)
+            .count()
+    };
+    let (_, _, wire) = image_rgb(&d.join("wire.png"));
+    assert!(
+        green(&wire) > 20 * green(&shown).max(10),
+        "wireframe: {} green pixels, composite {}",
+        green(&wire),
+        green(&shown)
+    );
+    let (_, _, whole) = image_rgb(&d.join("whole.png"));
+    assert_ne!(whole, shown, "the whole scene draws the ground");
+}

@@ -8,7 +8,7 @@ use crate::env_sequence::{Sequence, lighting_at_frame};
 use crate::gpu_composite;
 use crate::maps::{default_exposure, scene_rotation};
 use crate::outputs::{check_outputs, open_outputs, scene_inputs, write_outputs};
-use crate::support::load_scene;
+use crate::support::open_scene;
 use anyhow::Context;
 use clap::Args;
 use foundation::image_io::{RgbImageF32, check_finite, exr_bytes, png_bytes, to_display_rgb8};
@@ -72,6 +72,10 @@ pub struct RenderArgs {
     /// differential form as the viewer draws it, on the GPU in the frame.
     #[arg(long, value_enum, default_value_t)]
     pub composite: gpu_composite::CompositeForm,
+    /// For a model: composite it into "environment" (the map as the camera sees it) or an
+    /// image seen through the camera, its ground slab the proxy (as `hprt view --backplate`).
+    #[arg(long)]
+    pub backplate: Option<PathBuf>,
 }
 
 /// The files `--layers DIR` writes.
@@ -84,7 +88,7 @@ const LAYERS: [&str; 5] = [
 ];
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
-    let scene = load_scene(&args.scene)?;
+    let scene = open_scene(&args.scene, args.backplate.as_deref())?;
     let transfer = load_bake(&scene, &args.bake, args.decompose.order)?;
     let rotation_deg = scene_rotation(&scene, args.environment.rotate);
     let mut camera = args.size.camera(&scene)?;

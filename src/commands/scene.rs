@@ -7,7 +7,7 @@ use clap::{Args, Subcommand};
 use foundation::infra::atomic_file::write_atomic;
 use foundation::mesh::is_mesh_file;
 use foundation::scene::model::scene_file_for_model;
-use foundation::scene::{BackplateSpec, EnvironmentSpec, ObjectRole, Scene};
+use foundation::scene::{BackplateSpec, EnvironmentSpec, Scene};
 use std::path::{Path, PathBuf};
 
 #[derive(Subcommand)]
@@ -84,10 +84,7 @@ fn init(args: SceneInitArgs) -> anyhow::Result<()> {
                     .into_owned()
             }
         };
-        file.backplate = Some(BackplateSpec { image });
-        for ground in file.objects.iter_mut().skip(1) {
-            ground.role = ObjectRole::Proxy;
-        }
+        file.composite_into(&image);
     }
     if let Some(env) = &args.env {
         anyhow::ensure!(env.exists(), "{}: no such file", env.display());

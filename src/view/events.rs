@@ -29,6 +29,7 @@ impl App {
         self.poll_bake();
         self.run_script(event_loop)?;
         self.ensure_renderer()?;
+        self.apply_composite()?;
         if self.window.renderer.is_some() {
             self.advance_sequence()?;
         }

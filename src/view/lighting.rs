@@ -179,6 +179,44 @@ impl App {
         Ok(())
     }
 
+    /// Turns the live composite on or off as the settings ask (a scene with a backplate only),
+    /// baking the proxies alone the first time.
+    pub(super) fn apply_composite(&mut self) -> anyhow::Result<()> {
+        let (Some(renderer), Some(transfer)) =
+            (self.window.renderer.as_mut(), self.bake.transfer.as_ref())
+        else {
+            return Ok(());
+        };
+        let wanted = self.settings.composite && self.scene.backplate.is_some();
+        if wanted != renderer.is_compositing() {
+            if wanted {
+                let proxies = match &self.bake.proxies {
+                    Some(p) => p.clone(),
+                    None => {
+                        let p =
+                            Arc::new(crate::gpu_composite::proxies_bake(&self.scene, transfer)?);
+                        self.bake.proxies = Some(p.clone());
+                        p
+                    }
+                };
+                let backplate = crate::gpu_composite::live_backplate(&self.scene)?;
+                if let Err(e) =
+                    renderer.enable_composite(&self.scene.geometry, &proxies, &backplate)
+                {
+                    self.settings.composite = false;
+                    self.stats.message = format!("cannot composite: {e}");
+                }
+            } else {
+                renderer.disable_composite();
+            }
+            if let Some(gpu) = self.window.gpu.as_mut() {
+                gpu.renderer_changed();
+            }
+        }
+        renderer.set_wireframe(self.settings.wireframe);
+        Ok(())
+    }
+
     pub(super) fn ensure_renderer(&mut self) -> anyhow::Result<()> {
         if self.window.renderer.is_some() {
             return Ok(());

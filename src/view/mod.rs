@@ -18,7 +18,6 @@ mod window;
 use crate::bake_cache;
 use crate::env_sequence::Sequence;
 use crate::maps::{maps_beside, scene_rotation};
-use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
 use foundation::scene::Scene;
@@ -62,6 +61,11 @@ pub struct ViewArgs {
     /// Drive the viewer from a script of commands (see src/view/script.rs).
     #[arg(long)]
     pub script: Option<PathBuf>,
+    /// For a model: composite it into a backplate, "environment" (the map as the camera sees
+    /// it) or an image seen through the scene's camera; its ground slab becomes the proxy its
+    /// shadow falls on. A scene file names its own [backplate].
+    #[arg(long)]
+    pub backplate: Option<PathBuf>,
 }
 
 pub struct App {
@@ -99,17 +103,20 @@ fn open_bake(scene: &Scene, path: Option<&Path>) -> anyhow::Result<BakeState> {
             transfer: Some(Arc::new(bake_cache::load_bake(scene, path, None)?)),
             path: path.to_owned(),
             job: None,
+            proxies: None,
         },
         None => match bake_cache::load_cached(scene, &bake_settings) {
             Some((path, transfer)) => BakeState {
                 path,
                 transfer: Some(Arc::new(transfer)),
                 job: None,
+                proxies: None,
             },
             None => BakeState {
                 path: bake_cache::bake_path(scene, &bake_settings),
                 transfer: None,
                 job: None,
+                proxies: None,
             },
         },
     })
@@ -128,7 +135,12 @@ fn read_script(path: Option<&Path>) -> anyhow::Result<VecDeque<script::Command>>
 }
 
 /// What the viewer opens with: the hybrid in consistent mode under `env`, at the bake's order.
-fn initial_settings(scene: &Scene, env: &Path, order: usize) -> ViewSettings {
+fn initial_settings(
+    scene: &Scene,
+    env: &Path,
+    order: usize,
+    backplate: Option<&Path>,
+) -> ViewSettings {
     let decompose_mode = DecomposeMode::Consistent;
     ViewSettings {
         env: env.to_owned(),
@@ -144,13 +156,15 @@ fn initial_settings(scene: &Scene, env: &Path, order: usize) -> ViewSettings {
         median_cut_lights: 8,
         exposure: 1.0,
         materials: scene.geometry.objects.iter().map(|o| o.material).collect(),
+        composite: scene.backplate.is_some(),
+        wireframe: false,
+        backplate: backplate.map(Path::to_owned),
     }
 }
 
 pub fn run(args: ViewArgs) -> anyhow::Result<()> {
     check_display()?;
-    let scene = load_scene(&args.scene)?;
-    crate::support::refuse_proxies(&scene, "view")?;
+    let scene = crate::support::open_scene(&args.scene, args.backplate.as_deref())?;
     let bake = open_bake(&scene, args.bake.as_deref())?;
     let env = match (&args.env, &scene.environment) {
         (Some(p), _) => p.clone(),
@@ -170,7 +184,7 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         .as_ref()
         .map_or(scene.bake.order, |t| t.settings.order);
     let orbit = Orbit::from_camera(&scene.camera);
-    let settings = initial_settings(&scene, &env, order);
+    let settings = initial_settings(&scene, &env, order, args.backplate.as_deref());
     let event_loop = EventLoop::new().map_err(|e| {
         anyhow::anyhow!(
             "cannot open a window ({e}); to draw an image without a window use `hprt render`"
@@ -350,6 +364,11 @@ impl App {
             "light_shares": lights,
             "panels": self.panel.headings,
             "mode": self.settings.mode.name(),
+            "compositing": self
+                .window
+                .renderer
+                .as_ref()
+                .is_some_and(|r| r.is_compositing()),
             "rotation_deg": self.settings.rotation_deg,
             "window": [camera.width, camera.height],
             "command": self.command_line(Path::new("render.png")),
@@ -376,6 +395,7 @@ impl App {
         };
         PanelInfo {
             bake,
+            has_backplate: self.scene.backplate.is_some(),
             environment: self.lighting.environment.as_ref().map(|e| e.map()),
             env_choices: &self.env_choices,
             decomposition: self.lighting.decomposition.as_ref(),

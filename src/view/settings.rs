@@ -28,6 +28,12 @@ pub struct ViewSettings {
     /// Per object of the scene, its specular lobe (edited live; the scene file keeps its
     /// own).
     pub materials: Vec<Material>,
+    /// Composite into the scene's backplate (only a scene with one).
+    pub composite: bool,
+    /// Show the proxies' edges over the composite.
+    pub wireframe: bool,
+    /// The `--backplate` a model was opened with (repeated in the render command line).
+    pub backplate: Option<PathBuf>,
 }
 
 /// `r,g,b` or one value, each in [0, 1].
@@ -91,6 +97,8 @@ impl ViewSettings {
             }
             "exposure" => self.exposure = number()?,
             "env" => self.env = PathBuf::from(value),
+            "composite" => self.composite = switch()?,
+            "wireframe" => self.wireframe = switch()?,
             _ => {
                 // `specular:N r,g,b` (or one value for all three) and `shininess:N s`, for
                 // object N (from 0).
@@ -131,7 +139,16 @@ impl ViewSettings {
     ) -> Vec<String> {
         let v = |v: glam::Vec3| format!("{},{},{}", v.x, v.y, v.z);
         let on_off = |b: bool| if b { "on" } else { "off" }.to_owned();
-        vec![
+        let composite: &[&str] = if self.composite {
+            &["--composite", "live"]
+        } else {
+            &[]
+        };
+        let backplate = self
+            .backplate
+            .iter()
+            .flat_map(|b| ["--backplate".to_owned(), b.display().to_string()]);
+        let mut words: Vec<String> = vec![
             "hprt".into(),
             "render".into(),
             scene.display().to_string(),
@@ -170,7 +187,10 @@ impl ViewSettings {
             self.exposure.to_string(),
             "-o".into(),
             output.display().to_string(),
-        ]
+        ];
+        words.extend(composite.iter().map(|w| w.to_string()));
+        words.extend(backplate);
+        words
     }
 }
 
@@ -206,6 +226,9 @@ mod tests {
             median_cut_lights: 8,
             exposure: 0.6,
             materials: vec![Material::DIFFUSE; 2],
+            composite: false,
+            wireframe: false,
+            backplate: None,
         }
     }
 

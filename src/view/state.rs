@@ -21,6 +21,8 @@ pub(super) struct BakeState {
     pub(super) path: PathBuf,
     pub(super) transfer: Option<Arc<Transfer>>,
     pub(super) job: Option<BakeJob>,
+    /// The bake of the proxies alone, for the live composite (made when first needed).
+    pub(super) proxies: Option<Arc<Transfer>>,
 }
 
 /// A bake running in the background.

@@ -28,6 +28,8 @@ pub enum BakeStatus<'a> {
 /// What the panel shows of the viewer.
 pub struct PanelInfo<'a> {
     pub bake: BakeStatus<'a>,
+    /// The scene composites into a backplate.
+    pub has_backplate: bool,
     pub environment: Option<&'a EnvMap>,
     pub env_choices: &'a [PathBuf],
     pub decomposition: Option<&'a Decomposition>,
@@ -110,6 +112,9 @@ pub fn panel(
                 panel.shadow_section(ui);
                 panel.material_section(ui);
                 panel.display_section(ui);
+                if info.has_backplate {
+                    panel.composite_section(ui);
+                }
                 panel.lights_section(ui);
                 panel.save_section(ui);
                 if !info.message.is_empty() {
@@ -366,6 +371,20 @@ impl Panel<'_> {
         if ui.button("Reset view (R)").clicked() {
             self.actions.push(PanelAction::ResetView);
         }
+    }
+
+    fn composite_section(&mut self, ui: &mut egui::Ui) {
+        self.heading(ui, "Composite");
+        ui.checkbox(&mut self.settings.composite, "into the backplate")
+            .on_hover_text(
+                "The objects, and the change they make to the proxies, over the backplate \
+                 (off: the whole scene, proxies drawn)",
+            );
+        ui.add_enabled(
+            self.settings.composite,
+            egui::Checkbox::new(&mut self.settings.wireframe, "proxy wireframe"),
+        )
+        .on_hover_text("The proxies' edges, to line them up with the picture");
     }
 
     fn lights_section(&mut self, ui: &mut egui::Ui) {

@@ -156,6 +156,19 @@ impl Scene {
         }
     }
 
+    /// The scene for a bare model file composited into `backplate` ("environment", or an
+    /// image path relative to the model's folder or absolute): its ground slab is the proxy
+    /// the model's shadow falls on.
+    pub fn for_model_with_backplate(model: &Path, backplate: &str) -> Result<Self, SceneError> {
+        let name = model
+            .file_name()
+            .map(PathBuf::from)
+            .unwrap_or_else(|| model.to_owned());
+        let mut file = scene_file_for_model(model, name, true)?;
+        file.composite_into(backplate);
+        Self::from_file(model, file)
+    }
+
     /// The scene for a bare model file, with the ground slab.
     pub(crate) fn for_model(model: &Path) -> Result<Self, SceneError> {
         let name = model
@@ -164,6 +177,23 @@ impl Scene {
             .unwrap_or_else(|| model.to_owned());
         let file = scene_file_for_model(model, name, true)?;
         Self::from_file(model, file)
+    }
+}
+
+impl SceneFile {
+    /// Composites a model's scene into `backplate`: every object after the model (its ground
+    /// slab) becomes a proxy, the slab's top alone (a plane: proxies in one plane cannot
+    /// shadow themselves, so the live composite draws no shadow maps of their own).
+    pub fn composite_into(&mut self, backplate: &str) {
+        self.backplate = Some(super::BackplateSpec {
+            image: backplate.to_owned(),
+        });
+        for ground in self.objects.iter_mut().skip(1) {
+            ground.role = super::ObjectRole::Proxy;
+            if let Some(shape) = &mut ground.box_shape {
+                shape.skip_faces = ["-y", "+x", "-x", "+z", "-z"].map(String::from).to_vec();
+            }
+        }
     }
 }
 

@@ -209,29 +209,15 @@ pub(crate) const DISPLAY: BindGroupDecl = BindGroupDecl {
     ],
 };
 
-/// `shaders/proxies.wgsl`, group 0 (group 1 is [`ALBEDO_TEXTURE`]'s layout).
-pub(crate) const PROXIES: BindGroupDecl = BindGroupDecl {
-    label: "proxy pass",
-    shader: Shader::Proxies,
-    group: 0,
-    bindings: &[binding("frame", Stages::VERTEX_FRAGMENT, Resource::Uniform)],
-};
-
-/// `shaders/proxies.wgsl`, group 1: the same as the PRT pass's albedo textures.
-#[cfg(test)]
-const PROXIES_TEXTURE: BindGroupDecl = BindGroupDecl {
-    shader: Shader::Proxies,
-    ..ALBEDO_TEXTURE
-};
-
-/// `shaders/composite_floor.wgsl`: the proxies alone, and the sums of the ratio's floor.
+/// `shaders/composite_floor.wgsl`: the composite (B's luminance in its alpha), and the sums of
+/// the ratio's floor.
 pub(crate) const COMPOSITE_FLOOR: BindGroupDecl = BindGroupDecl {
     label: "composite floor",
     shader: Shader::CompositeFloor,
     group: 0,
     bindings: &[
         binding(
-            "without_objects",
+            "composite_image",
             Stages::COMPUTE,
             Resource::Texture {
                 dimension: Dim::D2,
@@ -246,19 +232,15 @@ pub(crate) const COMPOSITE_FLOOR: BindGroupDecl = BindGroupDecl {
     ],
 };
 
-/// `shaders/composite.wgsl`: both renders, the depth, the backplates and the floor.
+/// `shaders/composite.wgsl` (part of the light pass), group 1: the live composite's inputs.
 pub(crate) const COMPOSITE: BindGroupDecl = BindGroupDecl {
     label: "composite",
-    shader: Shader::Composite,
-    group: 0,
+    shader: Shader::Lights,
+    group: 1,
     bindings: &[
-        binding("frame", FRAGMENT, Resource::Uniform),
         binding("backplate", FRAGMENT, Resource::Uniform),
         binding("with_objects", FRAGMENT, FLOAT_2D),
         binding("without_objects", FRAGMENT, FLOAT_2D),
-        binding("depth_buffer", FRAGMENT, FLOAT_2D),
-        binding("environment", FRAGMENT, FILTERABLE_2D),
-        binding("environment_sampler", FRAGMENT, FILTERING),
         binding("photograph", FRAGMENT, FILTERABLE_2D),
         binding("photograph_sampler", FRAGMENT, FILTERING),
         binding("floor_sums", FRAGMENT, Resource::Uniform),
@@ -275,7 +257,7 @@ pub(crate) const WIREFRAME: BindGroupDecl = BindGroupDecl {
 
 /// Every declaration, for the test against the WGSL.
 #[cfg(test)]
-pub(crate) const ALL: [&BindGroupDecl; 12] = [
+pub(crate) const ALL: [&BindGroupDecl; 10] = [
     &TRANSFER,
     &PRT_FRAME,
     &ALBEDO_TEXTURE,
@@ -283,8 +265,6 @@ pub(crate) const ALL: [&BindGroupDecl; 12] = [
     &LIGHTS,
     &PREFILTER,
     &DISPLAY,
-    &PROXIES,
-    &PROXIES_TEXTURE,
     &COMPOSITE_FLOOR,
     &COMPOSITE,
     &WIREFRAME,
@@ -471,7 +451,7 @@ mod tests {
             (Shader::Prefilter, "Job", PREFILTER_JOB_SIZE as usize),
             (Shader::Shadow, "ShadowView", SHADOW_VIEW_SIZE as usize),
             (
-                Shader::Composite,
+                Shader::Lights,
                 "Backplate",
                 size_of::<super::super::composite::BackplateUniform>(),
             ),

@@ -34,7 +34,7 @@ impl DisplayPass {
             label: "display",
             module: &module,
             layout: Some(&pipeline_layout),
-            target: format.into(),
+            targets: &[Some(format.into())],
             constants: &[],
         }
         .pipeline(device);

@@ -70,6 +70,22 @@ pub(crate) const INDIRECT_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::Vert
     attributes: &wgpu::vertex_attr_array![7 => Float32x4],
 };
 
+/// The live composite's per-vertex radiance of the proxies alone (`ProxyIn` in
+/// `shaders/geometry.wgsl`).
+pub(crate) const WITHOUT_OBJECTS_LAYOUT: wgpu::VertexBufferLayout<'static> =
+    wgpu::VertexBufferLayout {
+        array_stride: 16,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &wgpu::vertex_attr_array![8 => Float32x4],
+    };
+
+/// Whether each vertex is a proxy's (1) or an object's (0).
+pub(crate) const PROXY_FLAG_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 4,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![9 => Float32],
+};
+
 impl GpuScene {
     pub(crate) fn new(
         device: &wgpu::Device,
@@ -179,31 +195,23 @@ impl GpuScene {
 
     /// Draws every triangle with its vertices' PRT radiance and its albedo texture (group 1)
     /// (the PRT pass).
-    pub(crate) fn draw_with_radiance(&self, pass: &mut wgpu::RenderPass) {
+    /// With `composite`, the live composite's vertex buffers of the proxies alone too (the
+    /// radiance without the objects, the proxy flags).
+    pub(crate) fn draw_with_radiance(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        composite: Option<(&wgpu::Buffer, &wgpu::Buffer)>,
+    ) {
+        if let Some((without, flags)) = composite {
+            pass.set_vertex_buffer(4, without.slice(..));
+            pass.set_vertex_buffer(5, flags.slice(..));
+        }
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, self.radiance_buffer.slice(..));
         pass.set_vertex_buffer(2, self.materials.vertex_buffer.slice(..));
         pass.set_vertex_buffer(3, self.indirect_buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
         for (range, group) in &self.draws {
-            pass.set_bind_group(ALBEDO_TEXTURE.group, &self.texture_groups[*group], &[]);
-            pass.draw_indexed(range.clone(), 0, 0..1);
-        }
-    }
-
-    /// Draws the triangles of `draws` (index ranges with their texture groups) with
-    /// `radiance` as the per-vertex radiance (the live composite's proxies without the
-    /// objects).
-    pub(crate) fn draw_parts_with(
-        &self,
-        pass: &mut wgpu::RenderPass,
-        radiance: &wgpu::Buffer,
-        draws: &[(std::ops::Range<u32>, usize)],
-    ) {
-        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
-        pass.set_vertex_buffer(1, radiance.slice(..));
-        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
-        for (range, group) in draws {
             pass.set_bind_group(ALBEDO_TEXTURE.group, &self.texture_groups[*group], &[]);
             pass.draw_indexed(range.clone(), 0, 0..1);
         }

@@ -3,7 +3,7 @@
 //! image, and the environment behind the scene (`shaders/lights.wgsl`). Summing the lights in
 //! one pass gives the same image as one pass per light and reads the G-buffer once.
 
-use super::bindings::LIGHTS;
+use super::bindings::{COMPOSITE, LIGHTS};
 use super::environment_texture::EnvironmentTexture;
 use super::pass_helpers::{FullscreenPass, begin_pass, color_attachment};
 use super::shaders::Shader;
@@ -19,61 +19,94 @@ pub(crate) struct LightPassInputs<'a> {
     pub environment: &'a EnvironmentTexture,
     /// The materials' table (`Materials` in `shaders/glossy.wgsl`).
     pub materials: &'a wgpu::Buffer,
+    /// The live composite's: then the pass draws the composite (`fs_composite`).
+    pub composite: Option<CompositeLightInputs<'a>>,
 }
 
-pub(crate) struct LightPass {
-    /// Indexed by `2 · shadowed + kernel from radius` (pipeline constants of the shader).
-    pipelines: Vec<wgpu::RenderPipeline>,
-    layout: wgpu::BindGroupLayout,
-    /// Made on first use after its inputs change (see [`Self::inputs_changed`]).
-    bind_group: Option<wgpu::BindGroup>,
+/// What the light pass reads and writes to draw the live composite (`shaders/composite.wgsl`).
+pub(crate) struct CompositeLightInputs<'a> {
+    pub backplate: &'a wgpu::Buffer,
+    /// The PRT pass's image of the proxies alone (alpha 1 on proxy pixels).
+    pub without_objects: &'a wgpu::TextureView,
+    pub photograph: &'a wgpu::TextureView,
+    pub photograph_sampler: &'a wgpu::Sampler,
+    pub floor_sums: &'a wgpu::Buffer,
+    /// The composite image drawn.
+    pub target: &'a wgpu::TextureView,
 }
 
-impl LightPass {
-    pub(crate) fn new(device: &wgpu::Device) -> Self {
-        Self::with_entry_point(device, "fs_main")
-    }
+/// The pass's pipelines of one entry point, indexed by `2 · shadowed + kernel from radius`
+/// (pipeline constants of the shader).
+struct Variants(Vec<wgpu::RenderPipeline>);
 
-    /// The pass of another entry point of `shaders/lights.wgsl` (the same bindings and
-    /// variants), e.g. the lights on the proxies alone.
-    pub(crate) fn with_entry_point(device: &wgpu::Device, entry_point: &str) -> Self {
-        let layout = LIGHTS.layout(device);
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("light pass"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+impl Variants {
+    fn new(
+        device: &wgpu::Device,
+        layout: &wgpu::PipelineLayout,
+        entry_point: &str,
+        blend: bool,
+    ) -> Self {
         let module = Shader::Lights.module(device);
         let additive = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
             dst_factor: wgpu::BlendFactor::One,
             operation: wgpu::BlendOperation::Add,
         };
-        let pipelines = (0..4)
-            .map(|variant| {
-                FullscreenPass {
-                    entry_point,
-                    label: "light pass",
-                    module: &module,
-                    layout: Some(&pipeline_layout),
-                    target: wgpu::ColorTargetState {
-                        format: COLOR_FORMAT,
-                        blend: Some(wgpu::BlendState {
-                            color: additive,
-                            alpha: additive,
-                        }),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    },
-                    constants: &[
-                        ("SHADOWED", f64::from(variant >= 2)),
-                        ("KERNEL_FROM_RADIUS", f64::from(variant % 2 == 1)),
-                    ],
-                }
-                .pipeline(device)
-            })
-            .collect();
+        let targets = [Some(wgpu::ColorTargetState {
+            format: COLOR_FORMAT,
+            blend: blend.then_some(wgpu::BlendState {
+                color: additive,
+                alpha: additive,
+            }),
+            write_mask: wgpu::ColorWrites::ALL,
+        })];
+        Self(
+            (0..4)
+                .map(|variant| {
+                    FullscreenPass {
+                        entry_point,
+                        label: "light pass",
+                        module: &module,
+                        layout: Some(layout),
+                        targets: &targets,
+                        constants: &[
+                            ("SHADOWED", f64::from(variant >= 2)),
+                            ("KERNEL_FROM_RADIUS", f64::from(variant % 2 == 1)),
+                        ],
+                    }
+                    .pipeline(device)
+                })
+                .collect(),
+        )
+    }
+
+    fn get(&self, shadows: bool, kernel_from_radius: bool) -> &wgpu::RenderPipeline {
+        &self.0[usize::from(shadows) * 2 + usize::from(kernel_from_radius)]
+    }
+}
+
+pub(crate) struct LightPass {
+    pipelines: Variants,
+    /// `fs_composite`'s, made when first compositing.
+    composite_pipelines: Option<Variants>,
+    layout: wgpu::BindGroupLayout,
+    composite_layout: wgpu::BindGroupLayout,
+    /// Made on first use after its inputs change (see [`Self::inputs_changed`]).
+    bind_group: Option<wgpu::BindGroup>,
+}
+
+impl LightPass {
+    pub(crate) fn new(device: &wgpu::Device) -> Self {
+        let layout = LIGHTS.layout(device);
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("light pass"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
         Self {
-            pipelines,
+            pipelines: Variants::new(device, &pipeline_layout, "fs_main", true),
+            composite_pipelines: None,
+            composite_layout: COMPOSITE.layout(device),
             layout,
             bind_group: None,
         }
@@ -84,7 +117,7 @@ impl LightPass {
         self.bind_group = None;
     }
 
-    /// Adds the lights onto the frame's image.
+    /// Adds the lights onto the frame's image, or, compositing, draws the composite.
     pub(crate) fn record(
         &mut self,
         device: &wgpu::Device,
@@ -92,34 +125,70 @@ impl LightPass {
         inputs: &LightPassInputs,
         shadows: bool,
     ) {
-        let target = inputs.targets.color_view.clone();
-        self.record_into(device, encoder, inputs, shadows, &target);
-    }
-
-    /// Adds the lights onto `target`.
-    pub(crate) fn record_into(
-        &mut self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        inputs: &LightPassInputs,
-        shadows: bool,
-        target: &wgpu::TextureView,
-    ) {
         let bind_group = self
             .bind_group
             .get_or_insert_with(|| bind_group(device, &self.layout, inputs));
+        let kernel_from_radius = inputs.shadow_maps.settings().from_angular_radius;
+        let Some(composite) = &inputs.composite else {
+            let mut pass = begin_pass(
+                encoder,
+                "light pass",
+                &[color_attachment(&inputs.targets.color_view, None)],
+                None,
+            );
+            pass.set_pipeline(self.pipelines.get(shadows, kernel_from_radius));
+            pass.set_bind_group(LIGHTS.group, &*bind_group, &[]);
+            pass.draw(0..3, 0..1);
+            return;
+        };
+        let group = composite_group(device, &self.composite_layout, inputs, composite);
+        let (layout, composite_layout) = (&self.layout, &self.composite_layout);
+        let pipelines = self.composite_pipelines.get_or_insert_with(|| {
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("composite light pass"),
+                bind_group_layouts: &[Some(layout), Some(composite_layout)],
+                immediate_size: 0,
+            });
+            Variants::new(device, &pipeline_layout, "fs_composite", false)
+        });
         let mut pass = begin_pass(
             encoder,
-            "light pass",
-            &[color_attachment(target, None)],
+            "composite light pass",
+            &[color_attachment(
+                composite.target,
+                Some(wgpu::Color::TRANSPARENT),
+            )],
             None,
         );
-        let kernel_from_radius = inputs.shadow_maps.settings().from_angular_radius;
-        let variant = usize::from(shadows) * 2 + usize::from(kernel_from_radius);
-        pass.set_pipeline(&self.pipelines[variant]);
+        pass.set_pipeline(pipelines.get(shadows, kernel_from_radius));
         pass.set_bind_group(LIGHTS.group, &*bind_group, &[]);
+        pass.set_bind_group(COMPOSITE.group, &group, &[]);
         pass.draw(0..3, 0..1);
     }
+}
+
+fn composite_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    inputs: &LightPassInputs,
+    composite: &CompositeLightInputs,
+) -> wgpu::BindGroup {
+    let view = wgpu::BindingResource::TextureView;
+    COMPOSITE.bind_group(
+        device,
+        layout,
+        &[
+            ("backplate", composite.backplate.as_entire_binding()),
+            ("with_objects", view(&inputs.targets.color_view)),
+            ("without_objects", view(composite.without_objects)),
+            ("photograph", view(composite.photograph)),
+            (
+                "photograph_sampler",
+                wgpu::BindingResource::Sampler(composite.photograph_sampler),
+            ),
+            ("floor_sums", composite.floor_sums.as_entire_binding()),
+        ],
+    )
 }
 
 fn bind_group(

@@ -88,6 +88,8 @@ struct FrameState {
     radiance_dirty: bool,
     /// The reflection maps must be prefiltered again (glossy scenes only).
     reflections_dirty: bool,
+    /// The light count the shadow-map layers were laid out for.
+    shadow_layers: Option<usize>,
 }
 
 /// Face size of the reflection maps unless set otherwise.
@@ -159,6 +161,7 @@ impl Renderer {
                 lighting: None,
                 radiance_dirty: true,
                 reflections_dirty: true,
+                shadow_layers: None,
             },
             composite: None,
             background: true,
@@ -180,9 +183,6 @@ impl Renderer {
     pub fn set_shadow_settings(&mut self, shadow: ShadowSettings) -> Result<(), RenderError> {
         if self.shadow_maps.set_settings(&self.device, shadow)? {
             self.light_pass.inputs_changed();
-        }
-        if let Some(composite) = &mut self.composite {
-            composite.set_shadow_settings(&self.device, shadow)?;
         }
         Ok(())
     }
@@ -207,18 +207,21 @@ impl Renderer {
                     geometry,
                     proxies_transfer: proxies,
                     backplate,
-                    shadow: self.shadow_maps.settings(),
                     size: (self.targets.width, self.targets.height),
                 },
             )
         })?;
         self.composite = Some(compositor);
+        // The shadow-map array gains the proxies' own maps.
+        self.shadow_maps.invalidate();
         Ok(())
     }
 
     /// Back to drawing the whole scene.
     pub fn disable_composite(&mut self) {
         self.composite = None;
+        self.shadow_maps.invalidate();
+        self.light_pass.inputs_changed();
     }
 
     pub fn is_compositing(&self) -> bool {
@@ -372,8 +375,14 @@ impl Renderer {
             view_proj,
             environment_rotation: self.environment.rotation,
             light_count: lights.len(),
-            background: self.background,
+            // The composite draws its own backplate.
+            background: self.background && self.composite.is_none(),
             pcf_taps: shadow.pcf_taps,
+            // 0: no maps of the proxies alone (they cannot shadow themselves).
+            proxy_layers: match &self.composite {
+                Some(c) if c.self_shadowing => lights.len() as u32,
+                _ => 0,
+            },
             sh_per_pixel: (lighting.sh_transfer == ShTransfer::Unshadowed).then_some(&lighting.sh),
             reflection_to_map: match &lighting.reflections {
                 crate::reflection::ReflectedEnvironment::Remainder { orientation, .. } => {
@@ -403,47 +412,56 @@ impl Renderer {
                 frame: &self.buffers.frame,
                 materials: &self.scene.materials.uniform,
                 reflections: &self.reflections,
+                composite: self.composite.as_ref().map(|c| c.prt_pass_inputs()),
             },
         );
+        if self.composite.is_some() {
+            // The proxies' maps and the composite's images are bound afresh each frame.
+            self.light_pass.inputs_changed();
+        }
         let inputs = LightPassInputs {
             buffers: &self.buffers,
             targets: &self.targets,
             shadow_maps: &self.shadow_maps,
             environment: &self.environment,
             materials: &self.scene.materials.uniform,
+            composite: self.composite.as_ref().map(|c| c.light_pass_inputs()),
         };
         self.light_pass
             .record(&self.device, &mut encoder, &inputs, shadows);
-        if let Some(composite) = &mut self.composite {
-            let frame = composite::FrameInputs {
-                buffers: &self.buffers,
-                targets: &self.targets,
-                environment: &self.environment,
-                materials: &self.scene.materials.uniform,
-                shadows,
-            };
-            composite.record(&self.device, &mut encoder, &self.scene, &frame);
+        if let Some(composite) = &self.composite {
+            composite.record(&self.device, &mut encoder, &self.scene, &self.buffers);
         }
         self.queue.submit([encoder.finish()]);
         Ok(())
     }
 
-    /// Each light's shadow map (and the composite's, of the proxies alone) where its matrix
-    /// changed.
+    /// Each light's shadow map where its matrix changed; compositing, then each light's map
+    /// of the proxies alone, in the layers after the scene's.
     fn record_shadow_maps(&mut self, encoder: &mut wgpu::CommandEncoder, matrices: &[glam::Mat4]) {
-        if self.shadow_maps.reserve(&self.device, matrices.len()) {
+        let lights = matrices.len();
+        let layers: Vec<glam::Mat4> = match &self.composite {
+            Some(c) if c.self_shadowing => matrices.iter().chain(matrices).copied().collect(),
+            _ => matrices.to_vec(),
+        };
+        if self.shadow_maps.reserve(&self.device, layers.len()) {
             self.light_pass.inputs_changed();
         }
-        let scene = &self.scene;
+        if self.frame.shadow_layers != Some(lights) {
+            // The proxies' layers moved with the light count.
+            self.shadow_maps.invalidate();
+            self.frame.shadow_layers = Some(lights);
+        }
+        let (scene, composite) = (&self.scene, &self.composite);
         self.shadow_maps.render_stale(
             &self.queue,
             encoder,
-            |pass| scene.draw_depth_only(pass),
-            matrices,
+            |pass, layer| match composite {
+                Some(c) if layer >= lights => c.draw_proxies_depth_only(scene, pass),
+                _ => scene.draw_depth_only(pass),
+            },
+            &layers,
         );
-        if let Some(composite) = &mut self.composite {
-            composite.render_shadow_maps(&self.device, &self.queue, encoder, scene, matrices);
-        }
     }
 
     /// Prefilters the reflection maps now, if the lighting or the materials changed them

@@ -114,20 +114,6 @@ pub(crate) fn nearest_depth(
     })
 }
 
-/// A depth attachment whose contents are kept: tested against, not written.
-pub(crate) fn depth_attachment_kept(
-    view: &wgpu::TextureView,
-) -> Option<wgpu::RenderPassDepthStencilAttachment<'_>> {
-    Some(wgpu::RenderPassDepthStencilAttachment {
-        view,
-        depth_ops: Some(wgpu::Operations {
-            load: wgpu::LoadOp::Load,
-            store: wgpu::StoreOp::Store,
-        }),
-        stencil_ops: None,
-    })
-}
-
 /// A buffer the CPU writes each frame (`COPY_DST` added to `usage`).
 pub(crate) fn writable_buffer(
     device: &wgpu::Device,
@@ -143,7 +129,7 @@ pub(crate) fn writable_buffer(
     })
 }
 
-/// A pass drawn as one screen-covering triangle (`shaders/fullscreen.wgsl`) into one target.
+/// A pass drawn as one screen-covering triangle (`shaders/fullscreen.wgsl`).
 pub(crate) struct FullscreenPass<'a> {
     pub label: &'a str,
     /// The fragment stage's entry point.
@@ -151,7 +137,7 @@ pub(crate) struct FullscreenPass<'a> {
     pub module: &'a wgpu::ShaderModule,
     /// `None`: derived from the shader.
     pub layout: Option<&'a wgpu::PipelineLayout>,
-    pub target: wgpu::ColorTargetState,
+    pub targets: &'a [Option<wgpu::ColorTargetState>],
     /// Values of the fragment stage's `override` constants.
     pub constants: &'a [(&'a str, f64)],
 }
@@ -177,7 +163,7 @@ impl FullscreenPass<'_> {
                     constants: self.constants,
                     ..Default::default()
                 },
-                targets: &[Some(self.target.clone())],
+                targets: self.targets,
             }),
             multiview_mask: None,
             cache: None,

@@ -61,7 +61,7 @@ impl ReflectionMaps {
             label: "prefilter",
             module: &module,
             layout: Some(&pipeline_layout),
-            target: REFLECTION_FORMAT.into(),
+            targets: &[Some(REFLECTION_FORMAT.into())],
             constants: &[],
         }
         .pipeline(device);

@@ -35,12 +35,8 @@ pub(crate) enum Shader {
     Display,
     /// Reflection maps prefiltered with the Phong lobe.
     Prefilter,
-    /// The live composite: the proxies without the objects.
-    Proxies,
     /// The live composite: the ratio's floor (compute).
     CompositeFloor,
-    /// The live composite: the ratio form into the backplate.
-    Composite,
     /// The proxies' edges over the composite.
     Wireframe,
 }
@@ -54,9 +50,7 @@ impl Shader {
             Shader::Lights => "lights.wgsl",
             Shader::Display => "display.wgsl",
             Shader::Prefilter => "prefilter.wgsl",
-            Shader::Proxies => "proxies.wgsl",
             Shader::CompositeFloor => "composite_floor.wgsl",
-            Shader::Composite => "composite.wgsl",
             Shader::Wireframe => "wireframe.wgsl",
         }
     }
@@ -69,9 +63,7 @@ impl Shader {
             Shader::Lights => include_str!("../../../shaders/lights.wgsl"),
             Shader::Display => include_str!("../../../shaders/display.wgsl"),
             Shader::Prefilter => include_str!("../../../shaders/prefilter.wgsl"),
-            Shader::Proxies => include_str!("../../../shaders/proxies.wgsl"),
             Shader::CompositeFloor => include_str!("../../../shaders/composite_floor.wgsl"),
-            Shader::Composite => include_str!("../../../shaders/composite.wgsl"),
             Shader::Wireframe => include_str!("../../../shaders/wireframe.wgsl"),
         }
     }
@@ -84,18 +76,17 @@ impl Shader {
         const FULLSCREEN: &str = include_str!("../../../shaders/fullscreen.wgsl");
         const GLOSSY: &str = include_str!("../../../shaders/glossy.wgsl");
         const ENVIRONMENT: &str = include_str!("../../../shaders/environment.wgsl");
-        const SH_IRRADIANCE: &str = include_str!("../../../shaders/sh_irradiance.wgsl");
+        const COMPOSITE: &str = include_str!("../../../shaders/composite.wgsl");
+
         match self {
             Shader::Transfer => &[],
-            Shader::Geometry => &[COMMON, GLOSSY, SH_IRRADIANCE],
+            Shader::Geometry => &[COMMON, GLOSSY],
             Shader::Shadow => &[COMMON],
-            Shader::Lights => &[COMMON, FULLSCREEN, GLOSSY, ENVIRONMENT],
+            Shader::Lights => &[COMMON, FULLSCREEN, GLOSSY, ENVIRONMENT, COMPOSITE],
             Shader::Display => &[FULLSCREEN],
             Shader::Prefilter => &[FULLSCREEN, GLOSSY],
-            Shader::Proxies => &[COMMON, SH_IRRADIANCE],
             Shader::Wireframe => &[COMMON],
             Shader::CompositeFloor => &[],
-            Shader::Composite => &[COMMON, FULLSCREEN, ENVIRONMENT],
         }
     }
 
@@ -151,9 +142,7 @@ mod tests {
             Shader::Lights,
             Shader::Display,
             Shader::Prefilter,
-            Shader::Proxies,
             Shader::CompositeFloor,
-            Shader::Composite,
             Shader::Wireframe,
         ] {
             let source = shader.source();

@@ -213,13 +213,19 @@ impl ShadowMaps {
         &self.layers.depth_copy_array_view
     }
 
-    /// Records the shadow pass of every light whose matrix changed since its map was drawn
-    /// (call [`Self::reserve`] first), drawing the occluders with `draw`.
+    /// Forgets what the maps hold: each is drawn again at the next [`Self::render_stale`]
+    /// (what a layer holds changed).
+    pub(crate) fn invalidate(&mut self) {
+        self.layers.rendered.clear();
+    }
+
+    /// Records the shadow pass of every layer whose matrix changed since its map was drawn
+    /// (call [`Self::reserve`] first), drawing layer `k`'s occluders with `draw(pass, k)`.
     pub(crate) fn render_stale(
         &mut self,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
-        draw: impl Fn(&mut wgpu::RenderPass),
+        draw: impl Fn(&mut wgpu::RenderPass, usize),
         matrices: &[Mat4],
     ) {
         let layers = &mut self.layers;
@@ -244,7 +250,7 @@ impl ShadowMaps {
             );
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(SHADOW_VIEW.group, &layers.view_bind_group, &[offset as u32]);
-            draw(&mut pass);
+            draw(&mut pass, i);
         }
         layers.rendered = matrices.to_vec();
     }

@@ -22,7 +22,8 @@ pub(crate) struct FrameUniform {
     light_count: u32,
     flags: u32,
     pcf_taps: u32,
-    _pad: u32,
+    /// Layer offset of the proxies' own shadow maps (the live composite; 0 otherwise).
+    proxy_layers: u32,
     /// Per-pixel irradiance of bands 0–2 over π, `A_l L_k / π` (RGB in xyz), when flag bit 2.
     sh_irradiance: [[f32; 4]; 9],
     camera_position: [f32; 4],
@@ -76,11 +77,19 @@ pub(crate) struct FrameParameters<'a> {
     pub light_count: usize,
     pub background: bool,
     pub pcf_taps: u32,
+    pub proxy_layers: u32,
     /// SH lighting (bands 0–2 used) applied per pixel by the normal, unshadowed, instead of
     /// the per-vertex transfer ([`crate::lighting::ShTransfer::Unshadowed`]).
     pub sh_per_pixel: Option<&'a ShCoeffs<Rgb>>,
     /// World → the reflection maps' frame.
     pub reflection_to_map: Mat4,
+}
+
+/// The angle between the rays of neighbouring pixels at the image centre (a pixel's pitch on
+/// the image plane at distance 1 is `2 tan(fov/2) / height`).
+fn centre_pixel_angle(camera: &Camera) -> f32 {
+    let tan_half = (camera.fov_y_deg.to_radians() * 0.5).tan();
+    (2.0 * tan_half / camera.height as f32).atan()
 }
 
 /// World → clip space of `camera`, its depth range fitted to the scene's bounding sphere.
@@ -100,11 +109,11 @@ impl FrameUniform {
             view_proj: view_proj.to_cols_array_2d(),
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
             viewport: [w, h, 1.0 / w, 1.0 / h],
-            env_rotation: [cos, sin, 0.0, 0.0],
+            env_rotation: [cos, sin, centre_pixel_angle(p.camera), 0.0],
             light_count: p.light_count as u32,
             flags: (u32::from(p.background) << 1) | (u32::from(p.sh_per_pixel.is_some()) << 2),
             pcf_taps: p.pcf_taps,
-            _pad: 0,
+            proxy_layers: p.proxy_layers,
             sh_irradiance: p.sh_per_pixel.map_or([[0.0; 4]; 9], irradiance_over_pi),
             camera_position: p.camera.position.extend(1.0).to_array(),
             reflection_to_map: p.reflection_to_map.to_cols_array_2d(),

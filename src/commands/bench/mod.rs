@@ -1,6 +1,7 @@
 //! `hprt bench`: benchmarks anyone can rerun; they print medians over repeats.
 
 mod bake;
+mod composite;
 mod reference;
 mod reflections;
 mod render;
@@ -8,6 +9,7 @@ mod turn;
 
 use bake::{BenchBakeArgs, bench_bake};
 use clap::Subcommand;
+use composite::{BenchCompositeArgs, bench_composite};
 use reference::{BenchReferenceArgs, bench_reference};
 use reflections::{BenchReflectionsArgs, bench_reflections};
 use render::{BenchRenderArgs, bench_render};
@@ -26,6 +28,9 @@ pub enum BenchCommand {
     /// variation, direction error) when the decomposition is rotated, against decomposing the
     /// turned map again every frame; and the per-frame cost of each.
     Turn(BenchTurnArgs),
+    /// The live composite: frame times composited and of the same scene drawn whole, static
+    /// and with the map turning.
+    Composite(BenchCompositeArgs),
     /// Glossy reflections: the GPU time of prefiltering the map's remainder per lighting
     /// change, at each face size.
     Reflections(BenchReflectionsArgs),
@@ -38,5 +43,6 @@ pub fn run(command: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Render(args) => bench_render(args),
         BenchCommand::Turn(args) => bench_turn(args),
         BenchCommand::Reflections(args) => bench_reflections(args),
+        BenchCommand::Composite(args) => bench_composite(args),
     }
 }

@@ -49,7 +49,7 @@ pub struct BenchRenderArgs {
 }
 
 /// Median milliseconds of `frames` calls of `frame` (after one untimed call).
-fn time_frames(
+pub(super) fn time_frames(
     frames: usize,
     mut frame: impl FnMut() -> anyhow::Result<()>,
 ) -> anyhow::Result<f64> {

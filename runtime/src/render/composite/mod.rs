@@ -3,36 +3,36 @@
 //! with the objects; `B`, the proxies alone, comes from what the hybrid has without them:
 //!
 //! 1. the proxies' transfer baked alone (their PRT radiance without the objects' shadows and
-//!    bounced light), drawn again where the proxies are the nearest surface ([`passes`]'s
-//!    proxy pass, `shaders/proxies.wgsl`);
-//! 2. each light's shadow map of the proxies alone, added by the light pass's
-//!    `fs_without_objects` on those pixels;
+//!    bounced light), written by the PRT pass beside the scene's where a proxy is the nearest
+//!    surface (`fs_composite` in `shaders/geometry.wgsl`);
+//! 2. each light's shadow map of the proxies alone (layers of the scene's shadow-map array
+//!    after the scene's own), read by the light pass's `fs_composite` on proxy pixels where
+//!    the light is shadowed (where it is not, it is not without the objects either);
 //! 3. the ratio's floor, a reduction over `B` (`shaders/composite_floor.wgsl`);
 //! 4. the ratio form into the backplate (`shaders/composite.wgsl`), then optionally the
 //!    proxies' wireframe over it.
 //!
-//! A pixel is an object pixel when the objects hide the proxies there (the proxy pass's
-//! equal-depth test fails), as the reference classifies pixels by their centre's ray.
+//! A pixel is a proxy pixel when a proxy is the nearest surface there (the PRT pass's depth
+//! test), as the reference classifies pixels by their centre's ray.
 
 mod passes;
 
-use super::environment_texture::{EnvironmentTexture, mip_chain_of, next_level, upload_mip_chain};
+use super::environment_texture::{mip_chain_of, next_level, upload_mip_chain};
 use super::error::{BakeMismatch, RenderError};
 use super::gpu_scene::{GpuScene, draws_of};
-use super::light_pass::LightPassInputs;
+use super::light_pass::CompositeLightInputs;
 use super::pass_helpers::texture;
-use super::shadow_maps::ShadowMaps;
-use super::targets::{COLOR_FORMAT, Targets};
+use super::pass_helpers::writable_buffer;
+use super::prt_pass::PrtComposite;
+use super::targets::COLOR_FORMAT;
 use super::transfer_pass::TransferPass;
 use super::uniforms::FrameBuffers;
-use super::{ShadowSettings, pass_helpers::writable_buffer};
 use crate::lighting::{FrameLighting, ShTransfer};
 use bytemuck::{Pod, Zeroable};
 use foundation::Rgb;
 use foundation::image_io::RgbImageF32;
 use foundation::scene::{ObjectRole, SceneMesh};
 use foundation::settings::InvalidSettings;
-use glam::Mat4;
 use passes::CompositePasses;
 use precompute::bake::{Transfer, TransferVectors};
 use std::ops::Range;
@@ -94,6 +94,67 @@ fn without_transfer(
         indirect: spread(&proxies.indirect),
         textured_vertices: proxies.textured_vertices,
     })
+}
+
+/// Most vertex-plane tests [`proxies_may_shadow_themselves`] makes before it assumes they may
+/// (distinct planes times vertices).
+const MAX_CONVEXITY_TESTS: usize = 10_000_000;
+
+/// Whether the proxies can cast shadows on themselves. They cannot when they all lie in one
+/// plane, or when they are the closed surface of one convex body (a floor slab): every proxy
+/// vertex on one side of each proxy triangle's plane, and the triangles' oriented areas
+/// summing to nothing. A point on such a body's outside that faces a light sees it past the
+/// body (only its inside, unseen, is shadowed). Then their own shadow maps would be all light
+/// and are not drawn.
+fn proxies_may_shadow_themselves(geometry: &SceneMesh) -> bool {
+    let proxies: Vec<&foundation::scene::SceneObject> = geometry
+        .objects
+        .iter()
+        .filter(|o| o.role == ObjectRole::Proxy)
+        .collect();
+    let points: Vec<glam::Vec3> = proxies
+        .iter()
+        .flat_map(|o| &geometry.mesh.positions[o.vertices.start as usize..o.vertices.end as usize])
+        .copied()
+        .collect();
+    let triangles: Vec<[glam::Vec3; 3]> = proxies
+        .iter()
+        .flat_map(|o| {
+            &geometry.mesh.triangles[o.triangles.start as usize..o.triangles.end as usize]
+        })
+        .map(|t| t.map(|i| geometry.mesh.positions[i as usize]))
+        .collect();
+    let tolerance = 1e-5 * geometry.diagonal().max(f32::MIN_POSITIVE);
+    // The triangles' planes, each once (a subdivided slab has six).
+    let mut planes: Vec<(glam::Vec3, f32)> = Vec::new();
+    let (mut oriented, mut total) = (glam::Vec3::ZERO, 0.0f32);
+    for [a, b, c] in &triangles {
+        let area = (*b - *a).cross(*c - *a);
+        oriented += area;
+        total += area.length();
+        let normal = area.normalize_or_zero();
+        let plane = (normal, normal.dot(*a));
+        let same = |(n, d): &(glam::Vec3, f32)| {
+            (*n - plane.0).length() < 1e-4 && (d - plane.1).abs() < tolerance
+        };
+        if normal != glam::Vec3::ZERO && !planes.iter().any(same) {
+            if planes.len().saturating_mul(points.len()) >= MAX_CONVEXITY_TESTS {
+                return true;
+            }
+            planes.push(plane);
+        }
+    }
+    let (mut convex, mut coplanar) = (true, true);
+    for (normal, offset) in &planes {
+        let (below, above) = points.iter().fold((false, false), |(below, above), p| {
+            let d = normal.dot(*p) - offset;
+            (below || d < -tolerance, above || d > tolerance)
+        });
+        convex &= !(below && above);
+        coplanar &= !(below || above);
+    }
+    let closed = oriented.length() <= 1e-4 * total;
+    !(coplanar || (convex && closed))
 }
 
 /// Each edge of the proxies' triangles once, as index pairs (the wireframe).
@@ -178,27 +239,22 @@ impl CompositeTargets {
     }
 }
 
-/// What the composite reads of the frame besides its own resources.
-pub(crate) struct FrameInputs<'a> {
-    pub buffers: &'a FrameBuffers,
-    pub targets: &'a Targets,
-    pub environment: &'a EnvironmentTexture,
-    pub materials: &'a wgpu::Buffer,
-    pub shadows: bool,
-}
-
 /// The live composite of one scene: the proxies' radiance without the objects, their shadow
 /// maps, the backplate and the passes.
 pub(crate) struct Compositor {
     /// The proxies' index ranges with their texture groups.
     proxies: Vec<(Range<u32>, usize)>,
+    /// Per vertex, 1 for a proxy's, 0 for an object's (a vertex buffer).
+    proxy_flags: wgpu::Buffer,
+    /// The proxies can shadow themselves: their own shadow maps are drawn.
+    pub(crate) self_shadowing: bool,
     /// Per-vertex radiance of the proxies without the objects (vec4, a vertex buffer).
     without_radiance: wgpu::Buffer,
     transfer_pass: TransferPass,
-    shadow_maps: ShadowMaps,
     passes: CompositePasses,
     targets: CompositeTargets,
     photograph_view: wgpu::TextureView,
+    photograph_sampler: wgpu::Sampler,
     backplate_uniform: wgpu::Buffer,
     floor_sums: wgpu::Buffer,
     edges: wgpu::Buffer,
@@ -213,7 +269,6 @@ pub(crate) struct CompositorSource<'a> {
     pub geometry: &'a SceneMesh,
     pub proxies_transfer: &'a Transfer,
     pub backplate: &'a LiveBackplate,
-    pub shadow: ShadowSettings,
     pub size: (u32, u32),
 }
 
@@ -272,23 +327,51 @@ impl Compositor {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::UNIFORM,
             mapped_at_creation: false,
         });
+        let flags: Vec<f32> = geometry
+            .objects
+            .iter()
+            .flat_map(|o| {
+                let flag = f32::from(u8::from(is_proxy(o)));
+                std::iter::repeat_n(flag, o.vertices.len())
+            })
+            .collect();
+        let init = |label, contents: &[u8], usage| {
+            wgpu::util::DeviceExt::create_buffer_init(
+                device,
+                &wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage,
+                },
+            )
+        };
+        let proxy_flags = init(
+            "proxy flags",
+            bytemuck::cast_slice(&flags),
+            wgpu::BufferUsages::VERTEX,
+        );
         let edges = proxy_edges(geometry);
-        let edge_buffer = wgpu::util::DeviceExt::create_buffer_init(
-            device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("proxy edges"),
-                contents: bytemuck::cast_slice(&edges),
-                usage: wgpu::BufferUsages::INDEX,
-            },
+        let edge_buffer = init(
+            "proxy edges",
+            bytemuck::cast_slice(&edges),
+            wgpu::BufferUsages::INDEX,
         );
         Ok(Self {
             proxies: draws_of(geometry, is_proxy),
+            self_shadowing: proxies_may_shadow_themselves(geometry),
+            proxy_flags,
             without_radiance,
             transfer_pass,
-            shadow_maps: ShadowMaps::new(device, source.shadow)?,
-            passes: CompositePasses::new(device, &source.scene.texture_layout),
+            passes: CompositePasses::new(device),
             targets: CompositeTargets::new(device, source.size.0, source.size.1),
             photograph_view: photograph.create_view(&Default::default()),
+            photograph_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("photograph"),
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                mipmap_filter: wgpu::MipmapFilterMode::Linear,
+                ..Default::default()
+            }),
             backplate_uniform,
             floor_sums,
             edges: edge_buffer,
@@ -304,15 +387,6 @@ impl Compositor {
 
     pub(crate) fn resize(&mut self, device: &wgpu::Device, width: u32, height: u32) {
         self.targets = CompositeTargets::new(device, width, height);
-    }
-
-    pub(crate) fn set_shadow_settings(
-        &mut self,
-        device: &wgpu::Device,
-        shadow: ShadowSettings,
-    ) -> Result<(), RenderError> {
-        self.shadow_maps.set_settings(device, shadow)?;
-        Ok(())
     }
 
     /// Recomputes the proxies' radiance without the objects (with the scene's, when the
@@ -332,74 +406,47 @@ impl Compositor {
         }
     }
 
-    /// The proxies' own shadow maps, seen by the same light matrices as the scene's.
-    pub(crate) fn render_shadow_maps(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        matrices: &[Mat4],
-    ) {
-        self.shadow_maps.reserve(device, matrices.len());
-        let proxies = &self.proxies;
-        self.shadow_maps.render_stale(
-            queue,
-            encoder,
-            |pass| scene.draw_parts_depth_only(pass, proxies),
-            matrices,
-        );
+    /// Draws the proxies alone from their vertices (their own shadow maps).
+    pub(crate) fn draw_proxies_depth_only(&self, scene: &GpuScene, pass: &mut wgpu::RenderPass) {
+        scene.draw_parts_depth_only(pass, &self.proxies);
     }
 
-    /// Records steps 1–4 (after the frame's light pass).
+    /// What the PRT pass needs for step 1.
+    pub(crate) fn prt_pass_inputs(&self) -> PrtComposite<'_> {
+        PrtComposite {
+            target: &self.targets.without_view,
+            without_objects: &self.without_radiance,
+            proxy_flags: &self.proxy_flags,
+        }
+    }
+
+    /// What the light pass needs to draw the composite.
+    pub(crate) fn light_pass_inputs(&self) -> CompositeLightInputs<'_> {
+        CompositeLightInputs {
+            backplate: &self.backplate_uniform,
+            without_objects: &self.targets.without_view,
+            photograph: &self.photograph_view,
+            photograph_sampler: &self.photograph_sampler,
+            floor_sums: &self.floor_sums,
+            target: &self.targets.image_view,
+        }
+    }
+
+    /// After the light pass: the floor's sums for the next frame, and the wireframe.
     pub(crate) fn record(
-        &mut self,
+        &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
-        frame: &FrameInputs,
+        buffers: &FrameBuffers,
     ) {
         self.passes
-            .record_proxies(device, encoder, frame, &self.targets.without_view, |pass| {
-                scene.draw_parts_with(pass, &self.without_radiance, &self.proxies)
-            });
-        let lights = LightPassInputs {
-            buffers: frame.buffers,
-            targets: frame.targets,
-            shadow_maps: &self.shadow_maps,
-            environment: frame.environment,
-            materials: frame.materials,
-        };
-        self.passes.record_lights_without_objects(
-            device,
-            encoder,
-            &lights,
-            frame.shadows,
-            &self.targets.without_view,
-        );
-        self.passes.record_floor(
-            device,
-            encoder,
-            &self.targets.without_view,
-            &self.floor_sums,
-        );
-        self.passes.record_composite(
-            device,
-            encoder,
-            &passes::CompositeBindings {
-                frame,
-                backplate: &self.backplate_uniform,
-                without: &self.targets.without_view,
-                photograph: &self.photograph_view,
-                floor_sums: &self.floor_sums,
-            },
-            &self.targets.image_view,
-        );
+            .record_floor(device, encoder, &self.targets.image_view, &self.floor_sums);
         if self.wireframe {
             self.passes.record_wireframe(
                 device,
                 encoder,
-                frame.buffers,
+                buffers,
                 &self.targets.image_view,
                 |pass| {
                     pass.set_vertex_buffer(0, scene.vertex_buffer.slice(..));
@@ -493,6 +540,41 @@ mod tests {
         let geometry = scene();
         assert!(without_transfer(&geometry, &bake(7, 2), 2).is_err());
         assert!(without_transfer(&geometry, &bake(8, 3), 2).is_err());
+    }
+
+    #[test]
+    fn only_proxies_that_are_not_one_convex_body_can_shadow_themselves() {
+        // Two parallel squares one above the other: the upper shadows the lower.
+        assert!(proxies_may_shadow_themselves(&scene()));
+        let mut one = SceneMesh::default();
+        one.push_object("floor".into(), &square(0.0), Rgb::ONE);
+        one.objects[0].role = ObjectRole::Proxy;
+        assert!(!proxies_may_shadow_themselves(&one), "a plane");
+        // A closed box (a floor slab) is convex; without its top it is open (its inside seen);
+        // a second box beside it is not convex with it.
+        let mut slab = SceneMesh::default();
+        let cube = foundation::mesh::box_mesh(Vec3::ZERO, Vec3::ONE, [2, 1, 2], [false; 6]);
+        slab.push_object("slab".into(), &cube, Rgb::ONE);
+        slab.objects[0].role = ObjectRole::Proxy;
+        assert!(!proxies_may_shadow_themselves(&slab), "a box");
+        let mut open = SceneMesh::default();
+        let no_top = foundation::mesh::box_mesh(
+            Vec3::ZERO,
+            Vec3::ONE,
+            [2, 1, 2],
+            [false, false, true, false, false, false],
+        );
+        open.push_object("tray".into(), &no_top, Rgb::ONE);
+        open.objects[0].role = ObjectRole::Proxy;
+        assert!(proxies_may_shadow_themselves(&open), "an open box");
+        let mut shifted = cube.clone();
+        shifted
+            .positions
+            .iter_mut()
+            .for_each(|p| *p += Vec3::new(3.0, 0.5, 0.0));
+        slab.push_object("table".into(), &shifted, Rgb::ONE);
+        slab.objects[1].role = ObjectRole::Proxy;
+        assert!(proxies_may_shadow_themselves(&slab), "two boxes");
     }
 
     #[test]
