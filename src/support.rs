@@ -38,20 +38,6 @@ pub fn open_scene(path: &Path, backplate: Option<&Path>) -> anyhow::Result<Scene
     Scene::for_model_with_backplate(path, &image).context("cannot load the scene")
 }
 
-/// Refuses a scene with proxies in a command that cannot composite yet (the viewer's live
-/// composite and the report's are being built; `hprt reference` and `hprt render` composite
-/// such a scene), rather than drawing its proxies as ordinary objects.
-pub fn refuse_proxies(scene: &Scene, command: &str) -> anyhow::Result<()> {
-    anyhow::ensure!(
-        !scene.geometry.has_proxies(),
-        "{}: the scene has proxies (role = \"proxy\") and a backplate; `hprt {command}` does not \
-         composite yet: `hprt reference` renders its true composite, `hprt render` the GPU \
-         methods'",
-        scene.path.display()
-    );
-    Ok(())
-}
-
 /// Runs `f` on a rayon pool of `threads` threads (all cores when `None`).
 pub fn with_threads<T: Send>(
     threads: Option<usize>,

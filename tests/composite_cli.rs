@@ -418,3 +418,68 @@ fn the_live_composite_is_the_differential_one_on_both_adapters() {
         );
     }
 }
+
+/// `hprt report` on a scene with a backplate: each method's composite against the true one,
+/// over the objects, the changed region and the frame, beside the truth's noise. Under the
+/// box's shadow the hybrid (lights with shadow maps) is closer to the truth than the
+/// occlusion peer (no lights' shadows).
+#[test]
+fn the_report_measures_every_composite_against_the_truth() {
+    let (_keep, d) = workspace();
+    floor_scene(&d, "composite.toml", "proxy", ENVIRONMENT);
+    let cache = d.join("cache");
+    let out = hprt_with_env(
+        &d,
+        &[
+            "report",
+            "composite.toml",
+            "--envs",
+            "map.exr",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--spp",
+            "128",
+            "-o",
+            "report",
+        ],
+        &[("HPRT_CACHE", &cache)],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("changed"), "{}", stdout(&out));
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("report/stats.json")).unwrap())
+            .unwrap();
+    let map = &stats["maps"][0];
+    assert!(map["pixels"]["changed"].as_u64().unwrap() > 20, "{map}");
+    let changed = |name: &str| -> f64 {
+        map["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["method"] == name)
+            .unwrap_or_else(|| panic!("{name} in {map}"))["errors"]["changed"]
+            .as_f64()
+            .unwrap()
+    };
+    let (hybrid, occlusion) = (
+        changed("hybrid/consistent"),
+        changed("occlusion (mobile AR)"),
+    );
+    assert!(hybrid < occlusion, "hybrid {hybrid}, occlusion {occlusion}");
+    let noise = map["noise"]["changed"].as_f64().unwrap();
+    assert!(
+        noise > 0.0 && noise < hybrid,
+        "noise {noise}, hybrid {hybrid}"
+    );
+    for file in [
+        "truth.png",
+        "hybrid-consistent.png",
+        "occlusion.png",
+        "changed_mask.exr",
+    ] {
+        assert!(d.join("report/map").join(file).exists(), "{file}");
+    }
+    assert!(d.join("report/report.html").exists());
+}

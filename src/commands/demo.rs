@@ -55,8 +55,14 @@ const MODEL_SAMPLE_MAP: &str = "scenes/env/city.exr";
 /// floor is stated in the report).
 const MODEL_SAMPLE_SPP: u32 = 512;
 /// Compositing: the teapot composited into the sunrise map (its proxy floor takes the
-/// shadow), path-traced with and without it; light paths per pixel of that truth.
+/// shadow), and into two more maps, each method's composite against the path-traced one;
+/// light paths per pixel of that truth.
 const COMPOSITE: &str = "scenes/teapot_composite.toml";
+const COMPOSITE_MAPS: [&str; 3] = [
+    "scenes/env/sunrise.exr",
+    "scenes/env/city.exr",
+    "scenes/env/interior.exr",
+];
 const COMPOSITE_SPP: u32 = 512;
 /// Glossy materials: the teapot (shininess 60) under every bundled map, and the dragon under
 /// one, with a quick reference.
@@ -114,9 +120,22 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
 
     if bundled_scenes {
-        let dir = args.output.join("composite");
-        composite_truth(&dir, args.width, args.height)?;
-        composite_methods(&dir, args.width, args.height, args.backend)?;
+        println!("\nthe composite {COMPOSITE}:");
+        let composite = load_scene(&bundled(COMPOSITE))?;
+        let composite_options = ReportOptions {
+            spp: COMPOSITE_SPP,
+            target_noise: None,
+            thresholds: Vec::new(),
+            frames: 1,
+            ..options.clone()
+        };
+        let maps = COMPOSITE_MAPS.map(bundled);
+        write_report(
+            &composite,
+            &maps,
+            &composite_options,
+            &args.output.join("composite"),
+        )?;
     }
 
     // A model as users bring theirs: the textured glTF sample, placed on its own, through
@@ -136,78 +155,4 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         &sample_options,
         &args.output.join("crate"),
     )
-}
-
-/// The true composite of the bundled compositing example into `dir`: the composite, its PNG,
-/// and its masks and layers (`aux/`). The GPU methods' composites are being built.
-fn composite_truth(dir: &Path, width: u32, height: u32) -> anyhow::Result<()> {
-    println!("\nthe composite {COMPOSITE} (path-traced truth):");
-    crate::support::create_folder(dir)?;
-    crate::commands::reference::run(crate::commands::reference::ReferenceArgs {
-        scene: bundled(COMPOSITE),
-        environment: Default::default(),
-        size: ImageSizeArgs {
-            width: Some(width),
-            height: Some(height),
-        },
-        spp: COMPOSITE_SPP,
-        bounces: 3,
-        seed: 0,
-        sampler: Default::default(),
-        threads: None,
-        exposure: None,
-        output: dir.join("composite.exr"),
-        png: Some(dir.join("composite.png")),
-        aux: Some(dir.join("aux")),
-    })
-}
-
-/// The GPU methods' composites of the bundled compositing example beside its truth: the
-/// hybrid, plain PRT and the mobile-AR paper's occlusion peer (`hybrid.png`, `prt.png`,
-/// `occlusion.png`, with their EXRs).
-fn composite_methods(
-    dir: &Path,
-    width: u32,
-    height: u32,
-    backend: runtime::render::Backend,
-) -> anyhow::Result<()> {
-    #[derive(clap::Parser)]
-    struct Line {
-        #[command(flatten)]
-        args: crate::commands::render::RenderArgs,
-    }
-    let scene = load_scene(&bundled(COMPOSITE))?;
-    let (bake, _) = crate::bake_cache::bake_for(&scene, None)?;
-    for (name, extra) in [
-        ("hybrid", &["--mode", "hybrid"][..]),
-        ("prt", &["--mode", "prt"]),
-        (
-            "occlusion",
-            &["--mode", "hybrid", "--composite", "occlusion"],
-        ),
-    ] {
-        let (png, exr) = (
-            dir.join(format!("{name}.png")),
-            dir.join(format!("{name}.exr")),
-        );
-        let size = (width.to_string(), height.to_string());
-        let mut line: Vec<std::ffi::OsString> = ["hprt", "--bake"].map(Into::into).to_vec();
-        line.push(bake.clone().into());
-        line.push(scene.path.clone().into());
-        for arg in [
-            "--width",
-            &size.0,
-            "--height",
-            &size.1,
-            "--backend",
-            backend.name(),
-        ] {
-            line.push(arg.into());
-        }
-        line.extend(extra.iter().map(Into::into));
-        line.extend(["-o".into(), png.into(), "--exr".into(), exr.into()]);
-        let parsed = <Line as clap::Parser>::try_parse_from(line)?;
-        crate::commands::render::run(parsed.args)?;
-    }
-    Ok(())
 }

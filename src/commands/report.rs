@@ -35,8 +35,13 @@ pub struct ReportArgs {
 
 pub fn run(args: ReportArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
-    crate::support::refuse_proxies(&scene, "report")?;
     if let Some(sequence) = &args.env_sequence {
+        anyhow::ensure!(
+            scene.backplate.is_none(),
+            "{}: a scene with a [backplate] reports one map at a time (its composite); \
+             sequences of composites are not reported yet",
+            scene.path.display()
+        );
         return write_sequence_report(&scene, sequence, &args.options, &args.output);
     }
     let envs = if args.envs.is_empty() {
@@ -73,6 +78,9 @@ pub(crate) fn write_report(
     let (bake_path, transfer) = bake_cache::bake_for(scene, options.bake.as_deref())?;
     let camera = options.size.camera(scene)?;
     let settings = options.report_settings(&camera, &transfer);
+    if scene.backplate.is_some() {
+        return write_composite_report(scene, &transfer, envs, &settings, output);
+    }
     // Written beside the destination and moved into place at the end: an interrupted or
     // failed report leaves the previous one untouched, and nothing new.
     let folder = AtomicFolder::create(output)
@@ -87,6 +95,26 @@ pub(crate) fn write_report(
     if failed == report.maps.len() {
         anyhow::bail!("every map failed; see the messages above (nothing written)");
     }
+    folder
+        .commit()
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    println!("\nwrote {}", output.join("report.html").display());
+    Ok(())
+}
+
+/// A scene with a [backplate]: its composites' report (`report::composite`).
+fn write_composite_report(
+    scene: &Scene,
+    transfer: &precompute::bake::Transfer,
+    envs: &[PathBuf],
+    settings: &report::ReportSettings,
+    output: &Path,
+) -> anyhow::Result<()> {
+    let folder = AtomicFolder::create(output)
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    let report =
+        report::composite::run_composite_report(scene, transfer, envs, settings, folder.path())?;
+    report::composite::print_composite_summary(&report);
     folder
         .commit()
         .with_context(|| format!("cannot write {}", output.display()))?;

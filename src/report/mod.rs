@@ -3,6 +3,7 @@
 //! decomposition modes, their error images and statistics, and the error against the Weber
 //! threshold; written as `report.html`, `stats.json` and `stats.csv`.
 
+pub mod composite;
 mod csv;
 pub mod figures;
 mod html;

@@ -1,0 +1,402 @@
+//! A composite's report (issue 31): for each map, the true composite (the scene path-traced
+//! with and without its virtual objects, in two independent halves) and every GPU method's
+//! composite (`crate::gpu_composite`, the truth's ratio form), with their errors over the
+//! objects, over the changed region (proxy pixels the objects change by more than 2%) and over
+//! the whole frame, beside the truth's own noise there.
+
+use super::{Method, ReportSettings, method_lighting};
+use crate::gpu_composite::{CompositeForm, CompositeInputs, composite_frame};
+use crate::maps::{default_exposure, load_map, scene_rotation};
+use foundation::Rgb;
+use foundation::camera::Camera;
+use foundation::color::luminance;
+use foundation::image_io::{RgbImageF32, write_exr, write_png};
+use foundation::infra::atomic_file::write_atomic;
+use foundation::infra::progress::NoProgress;
+use foundation::scene::{Backplate, Scene, load_backplate_image};
+use precompute::bake::Transfer;
+use reference::composite::{PixelKind, composite, render_composite};
+use reference::{EnvironmentLight, ReferenceSettings};
+use runtime::render::{GpuContext, Renderer, ShadowSettings};
+use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
+use std::path::{Path, PathBuf};
+
+/// Relative luminance RMS errors of a composite over the report's three regions:
+/// `√mean((Y − Y_truth)²) / mean(Y_truth)` over each.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct RegionErrors {
+    pub object: f64,
+    pub changed: f64,
+    pub frame: f64,
+}
+
+/// The pixels of each region.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct RegionPixels {
+    pub object: usize,
+    pub changed: usize,
+    pub frame: usize,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CompositeMethodResult {
+    pub method: String,
+    /// Its images' file name, without the extension.
+    pub file_stem: String,
+    pub errors: RegionErrors,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CompositeMapReport {
+    pub name: String,
+    pub path: String,
+    pub exposure: f32,
+    pub reference_spp: u32,
+    pub pixels: RegionPixels,
+    /// The truth's noise: its two halves' difference, halved (the noise of their mean).
+    pub noise: RegionErrors,
+    pub methods: Vec<CompositeMethodResult>,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CompositeReport {
+    pub scene: String,
+    pub adapter: String,
+    pub settings: ReportSettings,
+    pub maps: Vec<CompositeMapReport>,
+}
+
+/// The regions' masks: object pixels, and the truth's changed region.
+struct Regions {
+    object: Vec<bool>,
+    changed: Vec<bool>,
+}
+
+/// `√mean((Y(image) − Y(truth))²) / mean(Y(truth))` over the pixels `mask` keeps (0 when it
+/// keeps none).
+fn relative_rmse(image: &[Rgb], truth: &[Rgb], mask: impl Fn(usize) -> bool) -> f64 {
+    let (mut squared, mut sum, mut n) = (0.0f64, 0.0f64, 0usize);
+    for i in (0..truth.len()).filter(|&i| mask(i)) {
+        let t = f64::from(luminance(truth[i]));
+        squared += (f64::from(luminance(image[i])) - t).powi(2);
+        sum += t;
+        n += 1;
+    }
+    if n == 0 || sum <= 0.0 {
+        return 0.0;
+    }
+    (squared / n as f64).sqrt() / (sum / n as f64)
+}
+
+fn region_errors(image: &[Rgb], truth: &[Rgb], regions: &Regions) -> RegionErrors {
+    RegionErrors {
+        object: relative_rmse(image, truth, |i| regions.object[i]),
+        changed: relative_rmse(image, truth, |i| regions.changed[i]),
+        frame: relative_rmse(image, truth, |_| true),
+    }
+}
+
+/// The picture composited into, at the camera's size (`None`: the environment).
+fn photograph(scene: &Scene, camera: &Camera) -> anyhow::Result<Option<RgbImageF32>> {
+    Ok(match &scene.backplate {
+        Some(Backplate::Image(path)) => {
+            Some(load_backplate_image(path, camera.width, camera.height)?)
+        }
+        _ => None,
+    })
+}
+
+/// The true composite from two independent halves (each half the paths): the composite of
+/// their mean renders, the regions, and the two halves' composites (for the noise).
+struct Truth {
+    image: RgbImageF32,
+    regions: Regions,
+    halves: [RgbImageF32; 2],
+}
+
+fn true_composite(
+    scene: &Scene,
+    camera: &Camera,
+    light: &EnvironmentLight,
+    settings: &ReportSettings,
+) -> anyhow::Result<Truth> {
+    let backplate = photograph(scene, camera)?;
+    let halves: Vec<_> = [settings.seed, settings.seed ^ 0x9e37_79b9_7f4a_7c15]
+        .into_iter()
+        .map(|seed| {
+            let reference = ReferenceSettings {
+                sampler: settings.sampler,
+                ..ReferenceSettings::new((settings.spp / 2).max(1), settings.bounces, seed)
+            };
+            render_composite(
+                &scene.geometry,
+                light,
+                camera,
+                &reference,
+                backplate.as_ref(),
+                &NoProgress,
+            )
+        })
+        .collect();
+    let mean = |a: &RgbImageF32, b: &RgbImageF32| {
+        let pixels = a.pixels.iter().zip(&b.pixels).map(|(x, y)| (*x + *y) * 0.5);
+        RgbImageF32::new(a.width, a.height, pixels.collect())
+    };
+    let with = mean(
+        &halves[0].with_objects.radiance,
+        &halves[1].with_objects.radiance,
+    );
+    let without = mean(
+        &halves[0].without_objects.radiance,
+        &halves[1].without_objects.radiance,
+    );
+    let kinds = halves[0].composite.kinds.clone();
+    let backplate = match backplate {
+        Some(image) => image,
+        None => reference::composite::environment_backplate(light, camera),
+    };
+    let truth = composite(&kinds, &with, &without, &backplate);
+    let regions = Regions {
+        object: kinds.iter().map(|k| *k == PixelKind::Object).collect(),
+        changed: truth.changed.clone(),
+    };
+    let [a, b]: [_; 2] = halves.try_into().ok().expect("two halves were rendered");
+    Ok(Truth {
+        image: truth.image,
+        regions,
+        halves: [a.composite.image, b.composite.image],
+    })
+}
+
+/// The methods composited, with their images' file stems: every report method in the
+/// differential form, and the mobile-AR paper's occlusion peer lit by the hybrid.
+fn methods() -> Vec<(&'static str, &'static str, Method, CompositeForm)> {
+    let mut all: Vec<_> = Method::ALL
+        .iter()
+        .map(|m| (m.name(), m.file_stem(), *m, CompositeForm::Differential))
+        .collect();
+    all.push((
+        "occlusion (mobile AR)",
+        "occlusion",
+        Method::Hybrid(DecomposeMode::Consistent),
+        CompositeForm::Occlusion,
+    ));
+    all
+}
+
+/// One map's section, its images written into `dir`.
+fn report_map(
+    scene: &Scene,
+    gpu: &GpuContext,
+    renderer: &mut Renderer,
+    transfer: &Transfer,
+    (env, name): (&Path, &str),
+    settings: &ReportSettings,
+    dir: &Path,
+) -> anyhow::Result<CompositeMapReport> {
+    crate::support::create_folder(dir)?;
+    let map = load_map(env, None)?.map;
+    let rotation = scene_rotation(scene, None);
+    let exposure = default_exposure(&map);
+    let camera = scene.camera.with_size(settings.width, settings.height);
+    println!(
+        "{name}: the true composite ({}x{}, {} spp)",
+        camera.width, camera.height, settings.spp
+    );
+    let light = EnvironmentLight::new(&map, rotation);
+    let truth = true_composite(scene, &camera, &light, settings)?;
+    write_exr(&dir.join("truth.exr"), &truth.image)?;
+    write_png(&dir.join("truth.png"), &truth.image, exposure)?;
+    let (w, h) = (truth.image.width, truth.image.height);
+    let mask = |m: &[bool]| {
+        RgbImageF32::from_grey(
+            w,
+            h,
+            &m.iter()
+                .map(|b| f32::from(u8::from(*b)))
+                .collect::<Vec<_>>(),
+        )
+    };
+    write_exr(&dir.join("object_mask.exr"), &mask(&truth.regions.object))?;
+    write_exr(&dir.join("changed_mask.exr"), &mask(&truth.regions.changed))?;
+    let noise = region_errors(
+        &truth.halves[0].pixels,
+        &truth.halves[1].pixels,
+        &truth.regions,
+    );
+    let noise = RegionErrors {
+        object: noise.object / 2.0,
+        changed: noise.changed / 2.0,
+        frame: noise.frame / 2.0,
+    };
+    let mut lighting = EnvironmentLighting::new(&map, DecomposeSettings::default())?;
+    lighting.set_rotation(rotation);
+    let mut results = Vec::new();
+    for (label, stem, method, form) in methods() {
+        let threshold = DecomposeSettings::default().threshold;
+        let (frame, _, _) = method_lighting(&mut lighting, renderer.order(), method, threshold)?;
+        let inputs = CompositeInputs {
+            scene,
+            camera: &camera,
+            map: &map,
+            rotation_deg: rotation,
+            shadow: ShadowSettings::default(),
+            form,
+        };
+        let image = composite_frame(gpu, renderer, transfer, &frame, &inputs)?.image;
+        write_exr(&dir.join(format!("{stem}.exr")), &image)?;
+        write_png(&dir.join(format!("{stem}.png")), &image, exposure)?;
+        results.push(CompositeMethodResult {
+            method: label.to_owned(),
+            file_stem: stem.to_owned(),
+            errors: region_errors(&image.pixels, &truth.image.pixels, &truth.regions),
+        });
+    }
+    Ok(CompositeMapReport {
+        name: name.to_owned(),
+        path: env.display().to_string(),
+        exposure,
+        reference_spp: 2 * (settings.spp / 2).max(1),
+        pixels: RegionPixels {
+            object: truth.regions.object.iter().filter(|b| **b).count(),
+            changed: truth.regions.changed.iter().filter(|b| **b).count(),
+            frame: w * h,
+        },
+        noise,
+        methods: results,
+    })
+}
+
+/// Writes the composite report of `scene` under each of `envs` into `out`.
+pub fn run_composite_report(
+    scene: &Scene,
+    transfer: &Transfer,
+    envs: &[PathBuf],
+    settings: &ReportSettings,
+    out: &Path,
+) -> anyhow::Result<CompositeReport> {
+    anyhow::ensure!(
+        settings.target_noise.is_none(),
+        "--target-noise: a composite's report renders its truth at --spp paths per pixel"
+    );
+    crate::support::create_folder(out)?;
+    let camera = scene.camera.with_size(settings.width, settings.height);
+    camera.validate()?;
+    let gpu = GpuContext::headless(settings.backend)?;
+    println!("adapter: {}", gpu.description());
+    let mut renderer = Renderer::new(
+        &gpu,
+        &scene.geometry,
+        transfer,
+        &camera,
+        ShadowSettings::default(),
+    )?;
+    let mut maps = Vec::new();
+    for (env, name) in envs.iter().zip(super::unique_map_names(envs)) {
+        let dir = out.join(&name);
+        let map = report_map(
+            scene,
+            &gpu,
+            &mut renderer,
+            transfer,
+            (env, &name),
+            settings,
+            &dir,
+        )?;
+        maps.push(map);
+    }
+    let report = CompositeReport {
+        scene: scene.path.display().to_string(),
+        adapter: gpu.description().to_string(),
+        settings: settings.clone(),
+        maps,
+    };
+    write_atomic(
+        &out.join("stats.json"),
+        serde_json::to_string_pretty(&report)?.as_bytes(),
+    )?;
+    write_atomic(&out.join("report.html"), html(&report).as_bytes())?;
+    Ok(report)
+}
+
+/// Prints every map's table: each method's errors over the three regions, the truth's noise
+/// first.
+pub fn print_composite_summary(report: &CompositeReport) {
+    for map in &report.maps {
+        println!(
+            "\n{} ({} spp; {} object, {} changed, {} pixels): relative luminance RMSE",
+            map.name, map.reference_spp, map.pixels.object, map.pixels.changed, map.pixels.frame
+        );
+        println!(
+            "{:<24} {:>8} {:>8} {:>8}",
+            "method", "object", "changed", "frame"
+        );
+        let row = |name: &str, e: &RegionErrors| {
+            println!(
+                "{name:<24} {:>8.4} {:>8.4} {:>8.4}",
+                e.object, e.changed, e.frame
+            );
+        };
+        row("(truth's noise)", &map.noise);
+        for m in &map.methods {
+            row(&m.method, &m.errors);
+        }
+    }
+}
+
+/// A page of tables and images.
+fn html(report: &CompositeReport) -> String {
+    let mut page = format!(
+        "<!doctype html><meta charset=utf-8><title>hprt composite report</title>\
+         <h1>Composite report: {}</h1><p>adapter: {}. Errors: relative luminance RMSE against \
+         the path-traced composite, over the objects, over the changed region (proxy pixels \
+         the objects change by more than 2% in the truth) and over the frame; the truth's \
+         noise first.</p>",
+        report.scene, report.adapter
+    );
+    for map in &report.maps {
+        page += &format!(
+            "<h2>{}</h2><p>{} ({} spp)</p><table border=1 cellpadding=4>\
+             <tr><th>method</th><th>object</th><th>changed</th><th>frame</th></tr>",
+            map.name, map.path, map.reference_spp
+        );
+        let row = |name: &str, e: &RegionErrors| {
+            format!(
+                "<tr><td>{name}</td><td>{:.4}</td><td>{:.4}</td><td>{:.4}</td></tr>",
+                e.object, e.changed, e.frame
+            )
+        };
+        page += &row("(truth's noise)", &map.noise);
+        for m in &map.methods {
+            page += &row(&m.method, &m.errors);
+        }
+        page += "</table><p>";
+        let images = std::iter::once("truth".to_owned())
+            .chain(map.methods.iter().map(|m| m.file_stem.clone()));
+        for stem in images {
+            page += &format!(
+                "<figure style=\"display:inline-block\"><img src=\"{}/{stem}.png\">\
+                 <figcaption>{stem}</figcaption></figure>",
+                map.name
+            );
+        }
+        page += "</p>";
+    }
+    page
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_rmse_is_the_rms_luminance_error_over_the_mean() {
+        let truth = vec![Rgb::splat(2.0), Rgb::splat(2.0), Rgb::splat(100.0)];
+        let image = vec![Rgb::splat(1.0), Rgb::splat(3.0), Rgb::ZERO];
+        // Over the first two: errors ±1, mean 2.
+        let e = relative_rmse(&image, &truth, |i| i < 2);
+        assert!((e - 0.5).abs() < 1e-9, "{e}");
+        assert_eq!(relative_rmse(&image, &truth, |_| false), 0.0);
+        assert_eq!(relative_rmse(&truth, &truth, |_| true), 0.0);
+    }
+}
