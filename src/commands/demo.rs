@@ -64,6 +64,8 @@ const COMPOSITE_MAPS: [&str; 3] = [
     "scenes/env/interior.exr",
 ];
 const COMPOSITE_SPP: u32 = 512;
+/// The teapot composited into a photograph of the city square taken through its camera.
+const PHOTO_COMPOSITE: &str = "scenes/teapot_photo.toml";
 /// Glossy materials: the teapot (shininess 60) under every bundled map, and the dragon under
 /// one, with a quick reference.
 const GLOSSY_TEAPOT: &str = "scenes/teapot_glossy.toml";
@@ -135,6 +137,15 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
             &maps,
             &composite_options,
             &args.output.join("composite"),
+        )?;
+        println!("\nthe composite into a photograph {PHOTO_COMPOSITE}:");
+        let photo = load_scene(&bundled(PHOTO_COMPOSITE))?;
+        let city = bundled(COMPOSITE_MAPS[1]);
+        write_report(
+            &photo,
+            &[city],
+            &composite_options,
+            &args.output.join("composite-photo"),
         )?;
     }
 
