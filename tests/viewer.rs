@@ -361,6 +361,8 @@ fn composites_a_model_into_its_environment_under_xvfb() {
     std::fs::write(
         d.join("composite.script"),
         "wait-bake\nwait 3\nscreenshot composite.png\ncommand render.sh\nstate on.json\n\
+         move 0.5 0 0\nwait-bake\nwait 3\nscreenshot moved.png\ncommand moved.sh\n\
+         state moved.json\n\
          set wireframe on\nwait 2\nscreenshot wire.png\nset composite off\nwait 2\n\
          screenshot whole.png\nstate off.json\nquit\n",
     )
@@ -399,33 +401,49 @@ fn composites_a_model_into_its_environment_under_xvfb() {
         on["panels"]
     );
 
-    // The command line reproduces the composite the viewer showed.
-    let line = std::fs::read_to_string(d.join("render.sh")).unwrap();
-    assert!(line.contains("--composite live") && line.contains("--backplate environment"));
-    let args: Vec<String> = line
-        .split_whitespace()
-        .skip(1)
-        .map(|w| w.trim_matches('\'').to_owned())
-        .collect();
-    let output = args[args.iter().position(|a| a == "-o").unwrap() + 1].clone();
-    let rendered = hprt_with_env(
-        d,
-        &args.iter().map(String::as_str).collect::<Vec<_>>(),
-        &[("HPRT_CACHE", cache.as_path())],
-    );
-    assert!(rendered.status.success(), "{}", stderr(&rendered));
-    let (w, h, shown) = image_rgb(&d.join("composite.png"));
-    let (rw, rh, again) = image_rgb(&d.join(&output));
-    assert_eq!((rw, rh), (w, h));
-    let worst = shown
+    // The command lines reproduce the composites the viewer showed, before and after the
+    // objects moved (re-baked).
+    let (_, _, shown) = image_rgb(&d.join("composite.png"));
+    for (script, screenshot) in [("render.sh", "composite.png"), ("moved.sh", "moved.png")] {
+        let line = std::fs::read_to_string(d.join(script)).unwrap();
+        assert!(line.contains("--composite live") && line.contains("--backplate environment"));
+        let args: Vec<String> = line
+            .split_whitespace()
+            .skip(1)
+            .map(|w| w.trim_matches('\'').to_owned())
+            .collect();
+        let output = args[args.iter().position(|a| a == "-o").unwrap() + 1].clone();
+        let rendered = hprt_with_env(
+            d,
+            &args.iter().map(String::as_str).collect::<Vec<_>>(),
+            &[("HPRT_CACHE", cache.as_path())],
+        );
+        assert!(rendered.status.success(), "{}", stderr(&rendered));
+        let (w, h, viewed) = image_rgb(&d.join(screenshot));
+        let (rw, rh, again) = image_rgb(&d.join(&output));
+        assert_eq!((rw, rh), (w, h));
+        let worst = viewed
+            .iter()
+            .zip(&again)
+            .map(|(a, b)| a.abs_diff(*b))
+            .max()
+            .unwrap();
+        assert!(
+            worst <= 1,
+            "{script} reproduces {screenshot} (worst {worst})"
+        );
+    }
+    let moved = state("moved.json");
+    assert_eq!(moved["object_offset"][0], 0.5);
+    let (_, _, after) = image_rgb(&d.join("moved.png"));
+    let differ = shown
         .iter()
-        .zip(&again)
-        .map(|(a, b)| a.abs_diff(*b))
-        .max()
-        .unwrap();
+        .zip(&after)
+        .filter(|(a, b)| a.abs_diff(**b) > 8)
+        .count();
     assert!(
-        worst <= 1,
-        "render.sh reproduces the composite (worst {worst})"
+        differ > shown.len() / 100,
+        "the moved crate is drawn elsewhere ({differ})"
     );
 
     // The wireframe adds saturated green lines; the whole scene differs from the composite.

@@ -76,6 +76,10 @@ pub struct RenderArgs {
     /// image seen through the camera, its ground slab the proxy (as `hprt view --backplate`).
     #[arg(long)]
     pub backplate: Option<PathBuf>,
+    /// Move the virtual objects (not the proxies) by x,y,z, as the viewer's panel does (the
+    /// bake must be of the moved scene).
+    #[arg(long, value_parser = crate::cli::parse_vec3)]
+    pub move_objects: Option<glam::Vec3>,
 }
 
 /// The files `--layers DIR` writes.
@@ -88,7 +92,10 @@ const LAYERS: [&str; 5] = [
 ];
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
-    let scene = open_scene(&args.scene, args.backplate.as_deref())?;
+    let mut scene = open_scene(&args.scene, args.backplate.as_deref())?;
+    if let Some(offset) = args.move_objects {
+        scene.geometry.move_objects(offset);
+    }
     let transfer = load_bake(&scene, &args.bake, args.decompose.order)?;
     let rotation_deg = scene_rotation(&scene, args.environment.rotate);
     let mut camera = args.size.camera(&scene)?;

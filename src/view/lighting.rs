@@ -57,6 +57,16 @@ impl App {
         self.lighting.environment = Some(lighting);
     }
 
+    /// Moves the virtual objects (not the proxies) by `offset` and re-bakes in the background;
+    /// the frame shown keeps the old placement until the new bake lands.
+    pub(super) fn move_objects(&mut self, offset: glam::Vec3) {
+        self.scene.geometry.move_objects(offset);
+        self.settings.object_offset += offset;
+        self.bake.path = crate::bake_cache::bake_path(&self.scene, &self.scene.bake);
+        self.stats.message = format!("moved the objects by {offset}: baking again");
+        self.start_bake();
+    }
+
     pub(super) fn start_bake(&mut self) {
         let scene = self.scene.clone();
         let progress = Arc::new(SharedProgress::default());
@@ -77,6 +87,8 @@ impl App {
         let Some(job) = &self.bake.job else { return };
         match job.result.try_recv() {
             Ok(Ok(transfer)) => {
+                // Drawn again from the new bake (the objects may have moved).
+                self.window.renderer = None;
                 self.settings.order = transfer.settings.order;
                 self.bake.transfer = Some(Arc::new(transfer));
                 self.bake.job = None;

@@ -159,6 +159,7 @@ fn initial_settings(
         composite: scene.backplate.is_some(),
         wireframe: false,
         backplate: backplate.map(Path::to_owned),
+        object_offset: glam::Vec3::ZERO,
     }
 }
 
@@ -281,6 +282,7 @@ impl App {
                         format!("{line}\n").as_bytes(),
                     )?;
                 }
+                C::Move(offset) => self.move_objects(offset),
                 C::State(path) => {
                     let json = serde_json::to_string_pretty(&self.state_json())?;
                     foundation::infra::atomic_file::write_atomic(&path, json.as_bytes())?;
@@ -364,6 +366,7 @@ impl App {
             "light_shares": lights,
             "panels": self.panel.headings,
             "mode": self.settings.mode.name(),
+            "object_offset": self.settings.object_offset.to_array(),
             "compositing": self
                 .window
                 .renderer
@@ -431,6 +434,7 @@ impl App {
                 self.load_environment();
             }
             PanelAction::StartBake => self.start_bake(),
+            PanelAction::MoveObjects(offset) => self.move_objects(offset),
             PanelAction::ResetView => self.reset_view(),
             PanelAction::SaveScreenshot => {
                 let name = format!("hprt-{}-{}.png", self.scene.name, self.stats.frames);

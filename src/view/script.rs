@@ -12,6 +12,7 @@
 //! screenshot scene.png      # the rendered image, tone-mapped
 //! window-screenshot ui.png  # the whole window, panels included
 //! command render.sh         # the equivalent `hprt render` command line
+//! move 1 0 -0.5             # move the virtual objects by (dx, dy, dz) (re-baked)
 //! state state.json          # lights, timings and visible panels, as JSON
 //! quit
 //! ```
@@ -31,6 +32,8 @@ pub enum Command {
     WindowScreenshot(PathBuf),
     SaveRenderLine(PathBuf),
     State(PathBuf),
+    /// Move the virtual objects (not the proxies) by this offset.
+    Move(glam::Vec3),
     Quit,
 }
 
@@ -74,6 +77,7 @@ pub fn parse(path: &Path, text: &str) -> anyhow::Result<Vec<Command>> {
             "screenshot" => Command::Screenshot(path_at(1)?),
             "window-screenshot" => Command::WindowScreenshot(path_at(1)?),
             "command" => Command::SaveRenderLine(path_at(1)?),
+            "move" => Command::Move(glam::Vec3::new(number_at(1)?, number_at(2)?, number_at(3)?)),
             "state" => Command::State(path_at(1)?),
             "quit" => Command::Quit,
             _ => return Err(error("unknown command")),

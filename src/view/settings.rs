@@ -34,6 +34,8 @@ pub struct ViewSettings {
     pub wireframe: bool,
     /// The `--backplate` a model was opened with (repeated in the render command line).
     pub backplate: Option<PathBuf>,
+    /// How far the virtual objects were moved (repeated in the render command line).
+    pub object_offset: glam::Vec3,
 }
 
 /// `r,g,b` or one value, each in [0, 1].
@@ -190,6 +192,9 @@ impl ViewSettings {
         ];
         words.extend(composite.iter().map(|w| w.to_string()));
         words.extend(backplate);
+        if self.object_offset != glam::Vec3::ZERO {
+            words.push(format!("--move-objects={}", v(self.object_offset)));
+        }
         words
     }
 }
@@ -229,6 +234,7 @@ mod tests {
             composite: false,
             wireframe: false,
             backplate: None,
+            object_offset: glam::Vec3::ZERO,
         }
     }
 

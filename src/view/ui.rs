@@ -55,6 +55,8 @@ pub enum PanelAction {
     StartBake,
     ResetView,
     SaveScreenshot,
+    /// Move the virtual objects by this offset (then re-bake).
+    MoveObjects(glam::Vec3),
 }
 
 /// The panel's own state between frames.
@@ -385,6 +387,24 @@ impl Panel<'_> {
             egui::Checkbox::new(&mut self.settings.wireframe, "proxy wireframe"),
         )
         .on_hover_text("The proxies' edges, to line them up with the picture");
+        ui.horizontal(|ui| {
+            ui.label("move the objects");
+            let step = 0.25;
+            for (label, offset) in [
+                ("-x", glam::Vec3::new(-step, 0.0, 0.0)),
+                ("+x", glam::Vec3::new(step, 0.0, 0.0)),
+                ("-z", glam::Vec3::new(0.0, 0.0, -step)),
+                ("+z", glam::Vec3::new(0.0, 0.0, step)),
+            ] {
+                if ui
+                    .button(label)
+                    .on_hover_text("Moves the virtual objects over the proxies; re-bakes")
+                    .clicked()
+                {
+                    self.actions.push(PanelAction::MoveObjects(offset));
+                }
+            }
+        });
     }
 
     fn lights_section(&mut self, ui: &mut egui::Ui) {

@@ -193,6 +193,16 @@ impl SceneMesh {
         out
     }
 
+    /// Moves the virtual objects (not the proxies) by `offset`.
+    pub fn move_objects(&mut self, offset: glam::Vec3) {
+        for o in self.objects.iter().filter(|o| o.role == ObjectRole::Object) {
+            let range = o.vertices.start as usize..o.vertices.end as usize;
+            for p in &mut self.mesh.positions[range] {
+                *p += offset;
+            }
+        }
+    }
+
     /// Whether any object has a specular lobe.
     pub fn is_glossy(&self) -> bool {
         self.objects.iter().any(|o| o.material.is_glossy())
