@@ -128,10 +128,26 @@ fn bad_backplates_and_roles_are_refused_naming_the_file() {
     );
     assert_clean_failure(&out, &["no_plate.toml", "[backplate]"]);
 
-    // The report says it cannot composite yet rather than drawing the proxies.
+    // A composite's report renders its truth at --spp: a noise target is refused, and nothing
+    // is written.
     floor_scene(&d, "composite.toml", "proxy", ENVIRONMENT);
-    let out = hprt(&d, &["report", "composite.toml", "-o", "report"]);
-    assert_clean_failure(&out, &["composite.toml", "proxies", "hprt reference"]);
+    let out = hprt_with_env(
+        &d,
+        &[
+            "report",
+            "composite.toml",
+            "--target-noise",
+            "0.01",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "-o",
+            "report",
+        ],
+        &[("HPRT_CACHE", &d.join("cache"))],
+    );
+    assert_clean_failure(&out, &["--target-noise", "--spp"]);
     assert!(!d.join("report").exists());
 }
 
