@@ -280,17 +280,7 @@ pub fn run_composite_report(
         "--target-noise: a composite's report renders its truth at --spp paths per pixel"
     );
     crate::support::create_folder(out)?;
-    let camera = scene.camera.with_size(settings.width, settings.height);
-    camera.validate()?;
-    let gpu = GpuContext::headless(settings.backend)?;
-    println!("adapter: {}", gpu.description());
-    let mut renderer = Renderer::new(
-        &gpu,
-        &scene.geometry,
-        transfer,
-        &camera,
-        ShadowSettings::default(),
-    )?;
+    let (gpu, _, mut renderer) = super::report_renderer(scene, transfer, settings)?;
     let mut maps = Vec::new();
     for (env, name) in envs.iter().zip(super::unique_map_names(envs)) {
         let dir = out.join(&name);

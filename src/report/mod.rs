@@ -382,6 +382,26 @@ fn warn_if_noisy(name: &str, noise: &NoiseFloor, methods: &[MethodResult]) -> bo
     noisy
 }
 
+/// The report's adapter, camera and renderer of `scene`'s bake, at the report's image size.
+fn report_renderer(
+    scene: &Scene,
+    transfer: &Transfer,
+    settings: &ReportSettings,
+) -> anyhow::Result<(GpuContext, Camera, Renderer)> {
+    let camera = scene.camera.with_size(settings.width, settings.height);
+    camera.validate()?;
+    let gpu = GpuContext::headless(settings.backend)?;
+    println!("adapter: {}", gpu.description());
+    let renderer = Renderer::new(
+        &gpu,
+        &scene.geometry,
+        transfer,
+        &camera,
+        ShadowSettings::default(),
+    )?;
+    Ok((gpu, camera, renderer))
+}
+
 /// Writes the whole report into `out`; maps that fail are reported as failed.
 pub fn run_report(
     scene: &Scene,
@@ -392,17 +412,7 @@ pub fn run_report(
     out: &Path,
 ) -> anyhow::Result<Report> {
     crate::support::create_folder(out)?;
-    let camera = scene.camera.with_size(settings.width, settings.height);
-    camera.validate()?;
-    let gpu = GpuContext::headless(settings.backend)?;
-    println!("adapter: {}", gpu.description());
-    let mut renderer = Renderer::new(
-        &gpu,
-        &scene.geometry,
-        transfer,
-        &camera,
-        ShadowSettings::default(),
-    )?;
+    let (gpu, camera, mut renderer) = report_renderer(scene, transfer, settings)?;
     let mut maps = Vec::new();
     for (env, name) in envs.iter().zip(unique_map_names(envs)) {
         let mut cx = MapJob {

@@ -412,7 +412,7 @@ impl Compositor {
         order: usize,
         vertex_count: u32,
     ) {
-        // Unshadowed SH is shaded per pixel by the proxy pass.
+        // Unshadowed SH is shaded per pixel by the PRT pass.
         if lighting.sh_transfer != ShTransfer::Unshadowed {
             self.transfer_pass
                 .record(queue, encoder, lighting, order, vertex_count);
