@@ -224,17 +224,17 @@ pub struct ReportOptions {
 
 impl ReportOptions {
     /// The settings `options` ask for at `camera`'s size; the reference's bounces default to
-    /// the bake's, so both see the same light.
+    /// the bake's (`bake_bounces`), so both see the same light.
     pub fn report_settings(
         &self,
         camera: &foundation::camera::Camera,
-        transfer: &precompute::bake::Transfer,
+        bake_bounces: u32,
     ) -> ReportSettings {
         ReportSettings {
             width: camera.width,
             height: camera.height,
             spp: self.spp,
-            bounces: self.bounces.unwrap_or(transfer.settings.bounces),
+            bounces: self.bounces.unwrap_or(bake_bounces),
             seed: self.seed,
             sampler: self.sampler,
             target_noise: self.target_noise,

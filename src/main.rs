@@ -46,6 +46,8 @@ enum Command {
     Scene(commands::scene::SceneCommand),
     /// Open the real-time viewer (needs a display; see `hprt render` otherwise).
     View(view::ViewArgs),
+    /// Run a bake, reference or report as a Slurm array job of shards and a merge job.
+    Slurm(commands::slurm::SlurmArgs),
     /// Benchmarks anyone can rerun (bake throughput, ...).
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
@@ -83,6 +85,7 @@ fn main() {
         Command::Render(args) => commands::render::run(args),
         Command::View(args) => view::run(args),
         Command::Export(args) => commands::export::run(args),
+        Command::Slurm(args) => commands::slurm::run(args),
     };
     if let Err(error) = result {
         eprintln!("error: {error:#}");

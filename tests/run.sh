@@ -1,21 +1,30 @@
 #!/usr/bin/env bash
 # The whole test suite on a fresh Debian machine with Rust: installs the system packages the
-# tests need (software Vulkan, a virtual X server, numpy for the bake-format test) and Mitsuba 3
-# (pip, into target/mitsuba-venv), then runs every test of the workspace.
+# tests need (software Vulkan, a virtual X server, numpy for the bake-format test, Slurm and
+# munge), starts a one-node Slurm cluster on localhost, installs Mitsuba 3 (pip, into
+# target/mitsuba-venv), then runs every test of the workspace.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth python3 python3-numpy python3-venv)
+packages=(mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth python3 python3-numpy python3-venv slurm-wlm munge)
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if ((${#missing[@]})); then
-    sudo=""
-    [ "$(id -u)" -eq 0 ] || sudo="sudo"
     echo "installing ${missing[*]}"
     $sudo apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# A one-node Slurm cluster for tests/slurm.rs. If it cannot start, that test fails and says
+# why; it never skips.
+slurm_log="$PWD/target/slurm-start.log"
+mkdir -p target
+if ! $sudo tests/slurm/start-cluster.sh >"$slurm_log" 2>&1; then
+    echo "Slurm could not be started (see $slurm_log); tests/slurm.rs will fail"
 fi
 
 # Mitsuba 3 for the cross-check in tests/mitsuba.rs, in a private virtual environment. If it

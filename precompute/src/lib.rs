@@ -10,3 +10,4 @@
 
 pub mod bake;
 pub mod bakefile;
+pub mod shardfile;

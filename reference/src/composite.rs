@@ -4,7 +4,7 @@
 //! multiplied by `L(with) / L(without)`, object pixels show the rendered objects, and every
 //! other pixel keeps the backplate.
 
-use crate::{EnvironmentLight, NO_HIT, ReferenceImage, ReferenceSettings, render};
+use crate::{EnvironmentLight, NO_HIT, ReferenceImage, ReferenceSettings};
 use foundation::bvh::SceneBvh;
 use foundation::camera::Camera;
 use foundation::color::{Rgb, luminance};
@@ -194,13 +194,47 @@ pub fn render_composite(
     backplate: Option<&RgbImageF32>,
     progress: &dyn Progress,
 ) -> CompositeRender {
+    let rows: Vec<usize> = (0..camera.height as usize).collect();
+    let [with_objects, without_objects] =
+        render_composite_rows(geometry, light, camera, settings, &rows, progress);
+    composite_renders(
+        geometry,
+        light,
+        camera,
+        with_objects,
+        without_objects,
+        backplate,
+    )
+}
+
+/// The rows `rows` of both path traces of [`render_composite`]: the whole scene, and the
+/// proxies alone.
+pub fn render_composite_rows(
+    geometry: &SceneMesh,
+    light: &EnvironmentLight,
+    camera: &Camera,
+    settings: &ReferenceSettings,
+    rows: &[usize],
+    progress: &dyn Progress,
+) -> [ReferenceImage; 2] {
     let proxies = geometry.subset(|o| o.role == ObjectRole::Proxy);
     let trace = |scene: &SceneMesh| {
         let bvh = SceneBvh::build(&scene.mesh);
-        render(scene, &bvh, light, camera, settings, progress)
+        crate::render_rows(scene, &bvh, light, camera, settings, rows, progress)
     };
-    let with_objects = trace(geometry);
-    let without_objects = trace(&proxies);
+    [trace(geometry), trace(&proxies)]
+}
+
+/// The composite of the two whole path traces of [`render_composite`] into `backplate`
+/// (`None`: the environment map as the camera sees it).
+pub fn composite_renders(
+    geometry: &SceneMesh,
+    light: &EnvironmentLight,
+    camera: &Camera,
+    with_objects: ReferenceImage,
+    without_objects: ReferenceImage,
+    backplate: Option<&RgbImageF32>,
+) -> CompositeRender {
     let environment;
     let backplate = match backplate {
         Some(image) => image,

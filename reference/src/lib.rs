@@ -103,6 +103,56 @@ pub struct RenderStats {
     pub seconds: f64,
 }
 
+impl ReferenceImage {
+    /// The `width` × `height` image whose rows `rows` each part holds (as [`render_rows`]
+    /// rendered them), their statistics summed. `None` unless the parts fill every row once.
+    pub fn assemble(
+        width: usize,
+        height: usize,
+        parts: &[(Vec<usize>, ReferenceImage)],
+    ) -> Option<ReferenceImage> {
+        let mut source: Vec<Option<(usize, usize)>> = vec![None; height];
+        for (p, (rows, image)) in parts.iter().enumerate() {
+            if image.radiance.width != width || image.radiance.height != rows.len() {
+                return None;
+            }
+            for (k, &j) in rows.iter().enumerate() {
+                match source.get_mut(j) {
+                    Some(slot @ None) => *slot = Some((p, k)),
+                    _ => return None,
+                }
+            }
+        }
+        let source: Vec<(usize, usize)> = source.into_iter().collect::<Option<_>>()?;
+        // Row j of the image is row k of part p.
+        fn gather<T: Copy>(
+            source: &[(usize, usize)],
+            width: usize,
+            parts: &[(Vec<usize>, ReferenceImage)],
+            at: impl Fn(&ReferenceImage) -> &[T],
+        ) -> Vec<T> {
+            source
+                .iter()
+                .flat_map(|&(p, k)| at(&parts[p].1)[k * width..(k + 1) * width].iter().copied())
+                .collect()
+        }
+        let rgb = |at: fn(&ReferenceImage) -> &[Rgb]| {
+            RgbImageF32::new(width, height, gather(&source, width, parts, at))
+        };
+        Some(ReferenceImage {
+            radiance: rgb(|i| &i.radiance.pixels),
+            specular: rgb(|i| &i.specular.pixels),
+            coverage: gather(&source, width, parts, |i| &i.coverage),
+            visibility: gather(&source, width, parts, |i| &i.visibility),
+            primary: gather(&source, width, parts, |i| &i.primary),
+            stats: RenderStats {
+                rays: parts.iter().map(|(_, i)| i.stats.rays).sum(),
+                seconds: parts.iter().map(|(_, i)| i.stats.seconds).sum(),
+            },
+        })
+    }
+}
+
 impl RenderStats {
     pub fn rays_per_second(&self) -> f64 {
         self.rays as f64 / self.seconds.max(1e-9)
@@ -133,14 +183,31 @@ pub fn render(
     settings: &ReferenceSettings,
     progress: &dyn Progress,
 ) -> ReferenceImage {
+    let rows: Vec<usize> = (0..camera.height as usize).collect();
+    render_rows(geometry, bvh, light, camera, settings, &rows, progress)
+}
+
+/// Renders the image rows `rows` (in that order, one below the other) of [`render`]'s
+/// image, each pixel exactly as the whole image has it (a pixel's samples depend only on its
+/// index and the seed), so rows rendered apart and [assembled](ReferenceImage::assemble)
+/// equal the whole image.
+pub fn render_rows(
+    geometry: &SceneMesh,
+    bvh: &SceneBvh,
+    light: &EnvironmentLight,
+    camera: &Camera,
+    settings: &ReferenceSettings,
+    rows: &[usize],
+    progress: &dyn Progress,
+) -> ReferenceImage {
     let start = Instant::now();
-    let (width, height) = (camera.width as usize, camera.height as usize);
+    let (width, height) = (camera.width as usize, rows.len());
     let basis = camera.basis();
     let integrator = Integrator::new(geometry, bvh, light, settings.bounces);
     progress.start(height as u64);
-    let rows: Vec<(Vec<PixelResult>, u64)> = (0..height)
-        .into_par_iter()
-        .map(|j| {
+    let rows: Vec<(Vec<PixelResult>, u64)> = rows
+        .par_iter()
+        .map(|&j| {
             let mut rays = 0u64;
             let row = (0..width)
                 .map(|i| {

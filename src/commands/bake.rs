@@ -1,26 +1,31 @@
-//! `hprt bake`: the offline transfer bake.
+//! `hprt bake`: the offline transfer bake, on one machine or as shards (`--shard I/N`) that
+//! `hprt bake merge` joins.
 
 use crate::bake_cache::print_bake_stats;
 use crate::outputs::{check_outputs, scene_inputs};
-use crate::support::{TerminalProgress, load_scene, with_threads};
+use crate::support::{TerminalProgress, create_folder, load_scene, with_threads};
 use anyhow::Context;
-use clap::Args;
+use clap::{Args, Subcommand};
 use foundation::bvh::SceneBvh;
 use foundation::infra::atomic_file::AtomicOutput;
+use foundation::infra::shard::{ProcessEnvironment, ShardSpec};
 use foundation::scene::Scene;
-use precompute::bake::{self, BakeSettings};
-use precompute::bakefile;
-use std::path::PathBuf;
+use precompute::bake::{self, BakeSettings, BakeStats, Transfer};
+use precompute::{bakefile, shardfile};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 #[derive(Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct BakeArgs {
     /// Scene file (TOML), whose [bake] table gives the defaults of the options below; or a
     /// model (glTF, OBJ, PLY, BPT) placed in a default scene.
-    pub scene: PathBuf,
-    /// Output bake file (written atomically: an interrupted bake leaves no file).
-    #[arg(short, long)]
-    pub output: PathBuf,
+    #[arg(required = true)]
+    pub scene: Option<PathBuf>,
+    /// Output bake file (written atomically: an interrupted bake leaves no file); with
+    /// --shard, the folder the shard file goes into.
+    #[arg(short, long, required = true)]
+    pub output: Option<PathBuf>,
     /// SH order n (n² coefficients per channel), 1..=20.
     #[arg(long)]
     pub order: Option<usize>,
@@ -33,6 +38,36 @@ pub struct BakeArgs {
     /// Seed of the per-vertex sample rotations.
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Trace only the I-th of N shares of the vertices (balanced by cost) into
+    /// `-o DIR/bake-I-of-N.hprtshard`; `hprt bake merge DIR` joins them. I and N may be
+    /// `auto`: from SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT, or Kubernetes'
+    /// JOB_COMPLETION_INDEX (write auto/N).
+    #[arg(long)]
+    pub shard: Option<String>,
+    #[command(subcommand)]
+    pub merge: Option<BakeCommand>,
+}
+
+#[derive(Subcommand)]
+pub enum BakeCommand {
+    /// Join the shards of `hprt bake --shard` and sum the bounces: the same file, byte for
+    /// byte, as one `hprt bake`.
+    Merge(MergeArgs),
+}
+
+#[derive(Args)]
+pub struct MergeArgs {
+    /// The folder of the shards (`*.hprtshard`).
+    pub shards: PathBuf,
+    /// Output bake file.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// The scene (default: the one the shards name; it must be the same scene).
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -51,12 +86,37 @@ pub fn settings_for(scene: &Scene, args: &BakeArgs) -> anyhow::Result<BakeSettin
 }
 
 pub fn run(args: BakeArgs) -> anyhow::Result<()> {
-    let scene = load_scene(&args.scene)?;
+    if let Some(BakeCommand::Merge(merge)) = args.merge {
+        return run_merge(merge);
+    }
+    let (Some(scene_path), Some(output)) = (&args.scene, &args.output) else {
+        anyhow::bail!("hprt bake needs a scene and -o");
+    };
+    let scene = load_scene(scene_path)?;
     let settings = settings_for(&scene, &args)?;
-    check_outputs(&scene_inputs(&scene, &[]), &[("-o", Some(&args.output))])?;
+    if let Some(shard) = &args.shard {
+        let spec = ShardSpec::parse(shard, &ProcessEnvironment)?;
+        return run_shard(&scene, &settings, spec, output, args.threads);
+    }
+    check_outputs(&scene_inputs(&scene, &[]), &[("-o", Some(output))])?;
     // Fail on an unwritable destination before spending minutes baking.
-    let output = AtomicOutput::create(&args.output)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    let file = AtomicOutput::create(output)
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    warn_above_gpu_order(&settings);
+    announce(&scene, &settings, "");
+    let baked = with_threads(args.threads, || {
+        let start = Instant::now();
+        let bvh = SceneBvh::build(&scene.geometry.mesh);
+        let bvh_seconds = start.elapsed().as_secs_f64();
+        let progress = TerminalProgress::new("baking");
+        bake::bake(&scene.geometry, &bvh, &settings, &progress).map(|r| (r, bvh_seconds))
+    })??;
+    let ((transfer, stats), bvh_seconds) = baked;
+    println!("BVH built in {bvh_seconds:.2} s");
+    write_bake(file, output, &scene, &transfer, &stats)
+}
+
+fn warn_above_gpu_order(settings: &BakeSettings) {
     if settings.order > runtime::render::MAX_GPU_ORDER {
         log::warn!(
             "SH order {} is above the GPU renderer's maximum ({}): this bake can be used by the \
@@ -66,9 +126,12 @@ pub fn run(args: BakeArgs) -> anyhow::Result<()> {
             runtime::render::MAX_GPU_ORDER
         );
     }
+}
+
+fn announce(scene: &Scene, settings: &BakeSettings, what: &str) {
     let mesh = &scene.geometry.mesh;
     println!(
-        "{}: {} vertices, {} triangles; order {}, {} samples, {} bounces",
+        "{}: {} vertices, {} triangles; order {}, {} samples, {} bounces{what}",
         scene.name,
         mesh.vertex_count(),
         mesh.triangle_count(),
@@ -76,24 +139,119 @@ pub fn run(args: BakeArgs) -> anyhow::Result<()> {
         settings.samples,
         settings.bounces
     );
-    let baked = with_threads(args.threads, || {
-        let start = Instant::now();
-        let bvh = SceneBvh::build(mesh);
-        let bvh_seconds = start.elapsed().as_secs_f64();
-        let progress = TerminalProgress::new("baking");
-        bake::bake(&scene.geometry, &bvh, &settings, &progress).map(|r| (r, bvh_seconds))
-    })??;
-    let ((transfer, stats), bvh_seconds) = baked;
-    println!("BVH built in {bvh_seconds:.2} s");
-    let bytes = bakefile::encode(&transfer, &scene.geometry.content_hash());
-    output
-        .commit(&bytes)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
-    print_bake_stats(&stats);
+}
+
+fn write_bake(
+    file: AtomicOutput,
+    output: &Path,
+    scene: &Scene,
+    transfer: &Transfer,
+    stats: &BakeStats,
+) -> anyhow::Result<()> {
+    let bytes = bakefile::encode(transfer, &scene.geometry.content_hash());
+    file.commit(&bytes)
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    print_bake_stats(stats);
     println!(
         "wrote {} ({:.1} MB)",
-        args.output.display(),
+        output.display(),
         bytes.len() as f64 / 1e6
     );
     Ok(())
+}
+
+/// `hprt bake SCENE --shard I/N -o DIR`: one shard's tracing pass.
+fn run_shard(
+    scene: &Scene,
+    settings: &BakeSettings,
+    spec: ShardSpec,
+    dir: &Path,
+    threads: Option<usize>,
+) -> anyhow::Result<()> {
+    let path = dir.join(shardfile::file_name(spec));
+    check_outputs(&scene_inputs(scene, &[]), &[("-o", Some(&path))])?;
+    create_folder(dir)?;
+    let file =
+        AtomicOutput::create(&path).with_context(|| format!("cannot write {}", path.display()))?;
+    announce(scene, settings, &format!("; shard {spec}"));
+    // The merge reloads the scene by this path, perhaps from another folder.
+    let scene_path = std::path::absolute(&scene.path)
+        .with_context(|| format!("cannot resolve {}", scene.path.display()))?;
+    let shard = with_threads(threads, || {
+        let bvh = SceneBvh::build(&scene.geometry.mesh);
+        let progress = TerminalProgress::new("tracing");
+        let name = scene_path.to_string_lossy();
+        bake::shard::trace_shard(&scene.geometry, &bvh, settings, spec, &name, &progress)
+    })??;
+    let bytes = shardfile::encode(&shard);
+    file.commit(&bytes)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    println!(
+        "traced vertices {}..{} of {} in {:.2} s; wrote {} ({:.1} MB)",
+        shard.vertices.start,
+        shard.vertices.end,
+        shard.vertex_count,
+        shard.seconds,
+        path.display(),
+        bytes.len() as f64 / 1e6
+    );
+    Ok(())
+}
+
+/// The shard files in `dir`, in name order.
+fn shard_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    let entries = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot read the folder {}", dir.display()))?;
+    let mut files = Vec::new();
+    for entry in entries {
+        let path = entry
+            .with_context(|| format!("cannot read the folder {}", dir.display()))?
+            .path();
+        if path.extension().is_some_and(|e| e == shardfile::EXTENSION) {
+            files.push(path);
+        }
+    }
+    files.sort();
+    anyhow::ensure!(
+        !files.is_empty(),
+        "{} holds no bake shards (*.{}); make them with `hprt bake SCENE --shard I/N -o {}`",
+        dir.display(),
+        shardfile::EXTENSION,
+        dir.display()
+    );
+    Ok(files)
+}
+
+/// `hprt bake merge DIR -o FILE`.
+fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
+    let files = shard_files(&args.shards)?;
+    let shards = files
+        .iter()
+        .map(|f| shardfile::read(f))
+        .collect::<Result<Vec<_>, _>>()
+        .context("cannot merge the shards")?;
+    let scene_path = match &args.scene {
+        Some(path) => path.clone(),
+        None => PathBuf::from(&shards[0].scene_path),
+    };
+    let scene = load_scene(&scene_path)?;
+    check_outputs(&scene_inputs(&scene, &[]), &[("-o", Some(&args.output))])?;
+    let file = AtomicOutput::create(&args.output)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    let settings = shards[0].settings;
+    announce(
+        &scene,
+        &settings,
+        &format!("; merging {} shards", files.len()),
+    );
+    let (transfer, stats) = with_threads(args.threads, || {
+        let progress = TerminalProgress::new("merging");
+        bake::shard::merge(&scene.geometry, shards, &progress)
+    })?
+    .with_context(|| format!("cannot merge the shards in {}", args.shards.display()))?;
+    println!(
+        "tracing took {:.2} s summed over the shards",
+        stats.direct_seconds
+    );
+    write_bake(file, &args.output, &scene, &transfer, &stats)
 }

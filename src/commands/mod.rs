@@ -1,6 +1,7 @@
 //! One module per subcommand; each parses its arguments and calls library code. Commands do
 //! not import each other: what several share lives in `cli`, `environment`, `bake_cache`,
-//! `support`, `report` and `view`.
+//! `support`, `report` and `view`. The exception is `slurm`, which writes other commands'
+//! command lines and checks them with their own argument parsers.
 
 pub mod bake;
 pub mod bench;
@@ -12,3 +13,4 @@ pub mod reference;
 pub mod render;
 pub mod report;
 pub mod scene;
+pub mod slurm;

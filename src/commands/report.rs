@@ -7,10 +7,13 @@ use crate::env_sequence::Sequence;
 use crate::maps::maps_beside;
 use crate::outputs::{check_folder_spares_inputs, scene_inputs};
 use crate::report;
+use crate::report::NoiseTarget;
+use crate::report::shard::ReportMaps;
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
 use foundation::infra::atomic_file::AtomicFolder;
+use foundation::infra::shard::{ProcessEnvironment, ShardSpec};
 use foundation::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -29,12 +32,25 @@ pub struct ReportArgs {
     #[command(flatten)]
     pub options: ReportOptions,
     /// Output folder: report.html, stats.json, stats.csv and one folder of images per map.
-    #[arg(short, long)]
-    pub output: PathBuf,
+    #[arg(short, long, required_unless_present = "shard")]
+    pub output: Option<PathBuf>,
+    /// Render only the references of the I-th of N shares of the (map, frame) pairs into the
+    /// cache, and write no report: the unsharded report afterwards finds them all cached and
+    /// renders only the GPU methods. I and N may be `auto`: from SLURM_ARRAY_TASK_ID/
+    /// SLURM_ARRAY_TASK_COUNT, or Kubernetes' JOB_COMPLETION_INDEX (write auto/N).
+    #[arg(long, conflicts_with = "output")]
+    pub shard: Option<String>,
 }
 
 pub fn run(args: ReportArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
+    if let Some(shard) = &args.shard {
+        let spec = ShardSpec::parse(shard, &ProcessEnvironment)?;
+        return render_reference_share(&scene, &args, spec);
+    }
+    let Some(output) = &args.output else {
+        anyhow::bail!("hprt report needs -o");
+    };
     if let Some(sequence) = &args.env_sequence {
         anyhow::ensure!(
             scene.backplate.is_none(),
@@ -42,9 +58,15 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
              sequences of composites are not reported yet",
             scene.path.display()
         );
-        return write_sequence_report(&scene, sequence, &args.options, &args.output);
+        return write_sequence_report(&scene, sequence, &args.options, output);
     }
-    let envs = if args.envs.is_empty() {
+    let envs = report_maps(&scene, &args)?;
+    write_report(&scene, &envs, &args.options, output)
+}
+
+/// `--envs`, or the scene's map and those beside it.
+fn report_maps(scene: &Scene, args: &ReportArgs) -> anyhow::Result<Vec<PathBuf>> {
+    Ok(if args.envs.is_empty() {
         let Some(environment) = &scene.environment else {
             anyhow::bail!(
                 "{} names no [environment]; pass --envs MAP...",
@@ -54,8 +76,36 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
         maps_beside(&environment.map)
     } else {
         args.envs.clone()
+    })
+}
+
+/// `hprt report --shard I/N`: a share of the references, into the cache.
+fn render_reference_share(scene: &Scene, args: &ReportArgs, spec: ShardSpec) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        !matches!(args.options.target_noise, Some(NoiseTarget::ShareOfBest(_))),
+        "--target-noise as a share of the best method's error needs the methods' images, which \
+         report shards do not render; give a floor (0.001) or --spp"
+    );
+    // The bake's bounces, without baking: a shard needs only the reference.
+    let bounces = match &args.options.bake {
+        Some(path) => bake_cache::load_bake(scene, path, None)?.settings.bounces,
+        None => scene.bake.bounces,
     };
-    write_report(&scene, &envs, &args.options, &args.output)
+    let camera = args.options.size.camera(scene)?;
+    let settings = args.options.report_settings(&camera, bounces);
+    let (sequence, envs);
+    let maps = match &args.env_sequence {
+        Some(path) => {
+            sequence = Sequence::load(path)?;
+            ReportMaps::Sequence(&sequence)
+        }
+        None => {
+            envs = report_maps(scene, args)?;
+            anyhow::ensure!(!envs.is_empty(), "no environment maps to report on");
+            ReportMaps::Maps(&envs)
+        }
+    };
+    report::shard::render_share(scene, &maps, &camera, &settings, spec)
 }
 
 /// Checks the options, bakes (or reuses) the transfer, writes the report and prints a summary.
@@ -77,7 +127,7 @@ pub(crate) fn write_report(
     check_folder_spares_inputs(&inputs, "-o", output)?;
     let (bake_path, transfer) = bake_cache::bake_for(scene, options.bake.as_deref())?;
     let camera = options.size.camera(scene)?;
-    let settings = options.report_settings(&camera, &transfer);
+    let settings = options.report_settings(&camera, transfer.settings.bounces);
     if scene.backplate.is_some() {
         return write_composite_report(scene, &transfer, envs, &settings, output);
     }
@@ -139,7 +189,7 @@ fn write_sequence_report(
     let camera = options.size.camera(scene)?;
     let settings = report::ReportSettings {
         thresholds: Vec::new(),
-        ..options.report_settings(&camera, &transfer)
+        ..options.report_settings(&camera, transfer.settings.bounces)
     };
     let folder =
         AtomicFolder::create(out).with_context(|| format!("cannot write {}", out.display()))?;

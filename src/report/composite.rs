@@ -4,19 +4,16 @@
 //! objects, over the changed region (proxy pixels the objects change by more than 2%) and over
 //! the whole frame, beside the truth's own noise there.
 
+use super::composite_truth::{Regions, true_composite};
 use super::{Method, ReportSettings, method_lighting};
 use crate::gpu_composite::{CompositeForm, CompositeInputs, composite_frame};
 use crate::maps::{default_exposure, load_map, scene_rotation};
 use foundation::Rgb;
-use foundation::camera::Camera;
 use foundation::color::luminance;
 use foundation::image_io::{RgbImageF32, write_exr, write_png};
 use foundation::infra::atomic_file::write_atomic;
-use foundation::infra::progress::NoProgress;
-use foundation::scene::{Backplate, Scene, load_backplate_image};
+use foundation::scene::Scene;
 use precompute::bake::Transfer;
-use reference::composite::{PixelKind, composite, render_composite};
-use reference::{EnvironmentLight, ReferenceSettings};
 use runtime::render::{GpuContext, Renderer, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
 use std::path::{Path, PathBuf};
@@ -66,12 +63,6 @@ pub struct CompositeReport {
     pub maps: Vec<CompositeMapReport>,
 }
 
-/// The regions' masks: object pixels, and the truth's changed region.
-struct Regions {
-    object: Vec<bool>,
-    changed: Vec<bool>,
-}
-
 /// `√mean((Y(image) − Y(truth))²) / mean(Y(truth))` over the pixels `mask` keeps (0 when it
 /// keeps none).
 fn relative_rmse(image: &[Rgb], truth: &[Rgb], mask: impl Fn(usize) -> bool) -> f64 {
@@ -97,77 +88,6 @@ fn region_errors(image: &[Rgb], truth: &[Rgb], regions: &Regions) -> RegionError
 }
 
 /// The picture composited into, at the camera's size (`None`: the environment).
-fn photograph(scene: &Scene, camera: &Camera) -> anyhow::Result<Option<RgbImageF32>> {
-    Ok(match &scene.backplate {
-        Some(Backplate::Image(path)) => {
-            Some(load_backplate_image(path, camera.width, camera.height)?)
-        }
-        _ => None,
-    })
-}
-
-/// The true composite from two independent halves (each half the paths): the composite of
-/// their mean renders, the regions, and the two halves' composites (for the noise).
-struct Truth {
-    image: RgbImageF32,
-    regions: Regions,
-    halves: [RgbImageF32; 2],
-}
-
-fn true_composite(
-    scene: &Scene,
-    camera: &Camera,
-    light: &EnvironmentLight,
-    settings: &ReportSettings,
-) -> anyhow::Result<Truth> {
-    let backplate = photograph(scene, camera)?;
-    let halves: Vec<_> = [settings.seed, settings.seed ^ 0x9e37_79b9_7f4a_7c15]
-        .into_iter()
-        .map(|seed| {
-            let reference = ReferenceSettings {
-                sampler: settings.sampler,
-                ..ReferenceSettings::new((settings.spp / 2).max(1), settings.bounces, seed)
-            };
-            render_composite(
-                &scene.geometry,
-                light,
-                camera,
-                &reference,
-                backplate.as_ref(),
-                &NoProgress,
-            )
-        })
-        .collect();
-    let mean = |a: &RgbImageF32, b: &RgbImageF32| {
-        let pixels = a.pixels.iter().zip(&b.pixels).map(|(x, y)| (*x + *y) * 0.5);
-        RgbImageF32::new(a.width, a.height, pixels.collect())
-    };
-    let with = mean(
-        &halves[0].with_objects.radiance,
-        &halves[1].with_objects.radiance,
-    );
-    let without = mean(
-        &halves[0].without_objects.radiance,
-        &halves[1].without_objects.radiance,
-    );
-    let kinds = halves[0].composite.kinds.clone();
-    let backplate = match backplate {
-        Some(image) => image,
-        None => reference::composite::environment_backplate(light, camera),
-    };
-    let truth = composite(&kinds, &with, &without, &backplate);
-    let regions = Regions {
-        object: kinds.iter().map(|k| *k == PixelKind::Object).collect(),
-        changed: truth.changed.clone(),
-    };
-    let [a, b]: [_; 2] = halves.try_into().ok().expect("two halves were rendered");
-    Ok(Truth {
-        image: truth.image,
-        regions,
-        halves: [a.composite.image, b.composite.image],
-    })
-}
-
 /// The methods composited, with their images' file stems: every report method in the
 /// differential form, and the mobile-AR paper's occlusion peer lit by the hybrid.
 fn methods() -> Vec<(&'static str, &'static str, Method, CompositeForm)> {
@@ -203,8 +123,10 @@ fn report_map(
         "{name}: the true composite ({}x{}, {} spp)",
         camera.width, camera.height, settings.spp
     );
-    let light = EnvironmentLight::new(&map, rotation);
-    let truth = true_composite(scene, &camera, &light, settings)?;
+    let truth = true_composite(scene, &camera, &map, rotation, settings)?;
+    if truth.cached {
+        println!("{name}: the true composite from the cache");
+    }
     write_exr(&dir.join("truth.exr"), &truth.image)?;
     write_png(&dir.join("truth.png"), &truth.image, exposure)?;
     let (w, h) = (truth.image.width, truth.image.height);

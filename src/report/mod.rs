@@ -4,12 +4,14 @@
 //! threshold; written as `report.html`, `stats.json` and `stats.csv`.
 
 pub mod composite;
+mod composite_truth;
 mod csv;
 pub mod figures;
 mod html;
 mod results;
 pub mod sequence;
 mod settings;
+pub mod shard;
 pub mod stats;
 mod truth;
 

@@ -115,7 +115,7 @@ fn reference_key(
     request: &ReferenceRequest,
 ) -> anyhow::Result<String> {
     let mut hasher = blake3::Hasher::new();
-    hasher.update(b"hprt reference v3 (halves)");
+    hasher.update(b"hprt reference v4 (halves, files by sample count)");
     hasher.update(&scene.geometry.content_hash());
     hasher.update(serde_json::to_string(camera)?.as_bytes());
     hasher.update(&(map.width() as u64).to_le_bytes());
@@ -133,46 +133,63 @@ struct CacheMeta {
     samples_per_half: u32,
 }
 
+/// A cache entry: a JSON file naming the sample count, and images named by it. Every file
+/// is written to a temporary name and renamed into place, and the images of one sample count
+/// are the same whoever renders them (the samples are deterministic), so processes on many
+/// machines sharing the cache (report shards on NFS) never see a mixed entry: the JSON,
+/// renamed last, names images that are complete.
 struct CachePaths {
+    dir: PathBuf,
+    key: String,
+    meta: PathBuf,
+}
+
+/// The images of one cache entry.
+struct EntryFiles {
     halves: [PathBuf; 2],
     coverage: PathBuf,
     visibility: PathBuf,
     specular: PathBuf,
-    meta: PathBuf,
 }
 
 impl CachePaths {
     fn new(key: &str) -> Self {
         let dir = cache_dir().join("references");
-        let file = |kind: &str| dir.join(format!("{key}.{kind}"));
         Self {
+            meta: dir.join(format!("{key}.json")),
+            dir,
+            key: key.to_owned(),
+        }
+    }
+
+    fn files(&self, samples_per_half: u32) -> EntryFiles {
+        let file = |kind: &str| {
+            self.dir
+                .join(format!("{}.{samples_per_half}spp.{kind}", self.key))
+        };
+        EntryFiles {
             halves: [file("half0.exr"), file("half1.exr")],
             coverage: file("coverage.exr"),
             visibility: file("visibility.exr"),
             specular: file("specular.exr"),
-            meta: file("json"),
         }
     }
 
     /// `glossy`: the entry must have its specular part.
     fn load(&self, glossy: bool) -> anyhow::Result<ReferenceImages> {
         let meta: CacheMeta = serde_json::from_slice(&std::fs::read(&self.meta)?)?;
-        let halves = [read_exr(&self.halves[0])?, read_exr(&self.halves[1])?];
+        let files = self.files(meta.samples_per_half);
+        let halves = [read_exr(&files.halves[0])?, read_exr(&files.halves[1])?];
+        let grey = |path: &PathBuf| -> anyhow::Result<Vec<f32>> {
+            Ok(read_exr(path)?.pixels.iter().map(|p| p.x).collect())
+        };
         Ok(ReferenceImages {
             radiance: weighted_image(&halves[0], 1, &halves[1], 1),
             halves,
-            coverage: read_exr(&self.coverage)?
-                .pixels
-                .iter()
-                .map(|p| p.x)
-                .collect(),
-            visibility: read_exr(&self.visibility)?
-                .pixels
-                .iter()
-                .map(|p| p.x)
-                .collect(),
+            coverage: grey(&files.coverage)?,
+            visibility: grey(&files.visibility)?,
             specular: if glossy {
-                Some(read_exr(&self.specular)?)
+                Some(read_exr(&files.specular)?)
             } else {
                 None
             },
@@ -182,28 +199,39 @@ impl CachePaths {
         })
     }
 
-    /// Writes the images, then the sample count that makes them a cache entry.
-    fn store(&self, images: &ReferenceImages) -> anyhow::Result<()> {
-        bake_cache::create_cache_folder(self.meta.parent().expect("a cache folder"))?;
+    /// Writes the images, then the sample count that makes them the entry, then removes the
+    /// images of the count it replaced.
+    fn store(&self, images: &ReferenceImages, replaced: Option<u32>) -> anyhow::Result<()> {
+        bake_cache::create_cache_folder(&self.dir)?;
         let (w, h) = (images.radiance.width, images.radiance.height);
-        let _ = std::fs::remove_file(&self.meta);
-        write_exr(&self.halves[0], &images.halves[0])?;
-        write_exr(&self.halves[1], &images.halves[1])?;
+        let files = self.files(images.samples_per_half);
+        write_exr(&files.halves[0], &images.halves[0])?;
+        write_exr(&files.halves[1], &images.halves[1])?;
         write_exr(
-            &self.coverage,
+            &files.coverage,
             &RgbImageF32::from_grey(w, h, &images.coverage),
         )?;
         write_exr(
-            &self.visibility,
+            &files.visibility,
             &RgbImageF32::from_grey(w, h, &images.visibility),
         )?;
         if let Some(specular) = &images.specular {
-            write_exr(&self.specular, specular)?;
+            write_exr(&files.specular, specular)?;
         }
         let meta = CacheMeta {
             samples_per_half: images.samples_per_half,
         };
         foundation::infra::atomic_file::write_atomic(&self.meta, &serde_json::to_vec(&meta)?)?;
+        if let Some(old) = replaced.filter(|&n| n != images.samples_per_half) {
+            let old = self.files(old);
+            for path in old
+                .halves
+                .iter()
+                .chain([&old.coverage, &old.visibility, &old.specular])
+            {
+                let _ = std::fs::remove_file(path);
+            }
+        }
         Ok(())
     }
 }
@@ -411,7 +439,7 @@ pub(crate) fn reference_images(
     }
     let rendered = images.samples_per_half > have;
     if rendered {
-        paths.store(&images)?;
+        paths.store(&images, (have > 0).then_some(have))?;
     }
     images.cached = !rendered;
     images.seconds = start.elapsed().as_secs_f64();

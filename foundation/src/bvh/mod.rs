@@ -148,6 +148,28 @@ impl SceneBvh {
         tmax: f32,
         skip: Skip,
     ) -> Option<Hit> {
+        self.closest_hit_tallied(origin, direction, tmin, tmax, skip, &mut NoTally)
+    }
+
+    /// The work [`Self::closest_hit`] does for this ray: the nodes it visits, inner nodes and
+    /// leaves. Deterministic (a property of the tree and the ray, not of the
+    /// machine), so shards can split a job by it.
+    pub fn closest_hit_work(&self, origin: Vec3, direction: Vec3, skip: Skip) -> u32 {
+        let mut work = 0;
+        self.closest_hit_tallied(origin, direction, 0.0, f32::INFINITY, skip, &mut work);
+        work
+    }
+
+    #[inline(always)]
+    fn closest_hit_tallied(
+        &self,
+        origin: Vec3,
+        direction: Vec3,
+        tmin: f32,
+        tmax: f32,
+        skip: Skip,
+        tally: &mut impl Tally,
+    ) -> Option<Hit> {
         let mut ray = SegmentRay {
             origin: origin.into(),
             direction: direction.into(),
@@ -158,6 +180,7 @@ impl SceneBvh {
         let mut stack = Stack::new();
         let mut current = self.tree.root()?;
         loop {
+            tally.add(1);
             if current.is_inner() {
                 let (t_near, mut entered) = self.tree.enter(current.index, &wide, ray.tmax);
                 if entered != 0 {
@@ -309,6 +332,25 @@ pub enum Skip {
     Triangle(u32),
     /// Every triangle sharing a vertex (a vertex never shadows itself).
     VertexTriangles(u32),
+}
+
+/// Counts the work of a traversal (or, as [`NoTally`], nothing at no cost).
+trait Tally {
+    fn add(&mut self, n: u32);
+}
+
+struct NoTally;
+
+impl Tally for NoTally {
+    #[inline(always)]
+    fn add(&mut self, _: u32) {}
+}
+
+impl Tally for u32 {
+    #[inline(always)]
+    fn add(&mut self, n: u32) {
+        *self += n;
+    }
 }
 
 #[cfg(test)]

@@ -1,5 +1,5 @@
 //! Infrastructure under the domain code: files written atomically, huge-page tables, cache
-//! prefetching, progress bars, and enums named in settings files.
+//! prefetching, progress bars, enums named in settings files, and shards of a job.
 
 pub mod atomic_file;
 pub mod huge_pages;
@@ -8,6 +8,7 @@ pub mod limits;
 pub mod named_enum;
 pub mod prefetch;
 pub mod progress;
+pub mod shard;
 
 /// Logs `message` as a warning unless this process already has: a file read twice (a model
 /// measured, then loaded) must not repeat its warnings.

@@ -10,13 +10,13 @@ use rayon::prelude::*;
 ///
 /// Stored as consecutive blocks of compressed rows, exactly as the tracing pass produced
 /// them, so the (large) operator is never copied.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct InterreflectionOperator {
     blocks: Vec<OperatorBlock>,
 }
 
 /// Compressed rows of `rows` consecutive vertices.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub(crate) struct OperatorBlock {
     /// `row_starts[r]..row_starts[r + 1]` indexes `columns`/`weights` of the block's row `r`.
     pub row_starts: Vec<u32>,
@@ -67,6 +67,16 @@ impl InterreflectionOperator {
     /// Blocks covering consecutive vertex ranges, in order.
     pub(crate) fn from_blocks(blocks: Vec<OperatorBlock>) -> Self {
         Self { blocks }
+    }
+
+    /// The blocks, in order.
+    pub(crate) fn into_blocks(self) -> Vec<OperatorBlock> {
+        self.blocks
+    }
+
+    /// The blocks, in order.
+    pub(crate) fn blocks(&self) -> &[OperatorBlock] {
+        &self.blocks
     }
 
     /// Number of stored (vertex, vertex) weights.

@@ -9,6 +9,7 @@
 
 mod bounce;
 mod inside;
+pub mod shard;
 mod transfer;
 mod visibility;
 
@@ -136,31 +137,50 @@ pub fn trace(
 ) -> Result<TracedScene, InvalidSettings> {
     settings.validate()?;
     let start = Instant::now();
-    progress.start(geometry.mesh.vertex_count() as u64);
-    let traced = visibility::trace_vertices(geometry, bvh, settings, progress);
-    let neighbours = VertexNeighbours::new(&geometry.mesh);
-    let reflected_albedo = geometry.reflected_albedo();
-    let mut reflected_direct = traced.direct_transfer(&reflected_albedo, settings.order);
-    fill_inside(&mut reflected_direct, &traced.inside, &neighbours);
-    // Textured and glossy scenes reflect toward other surfaces another albedo than the one
-    // their vertices' transfer is stored with.
-    let (direct, textured) = if geometry.is_textured() || geometry.is_glossy() {
-        let albedo = geometry.albedo.clone();
-        let mut direct = traced.direct_transfer(&albedo, settings.order);
-        fill_inside(&mut direct, &traced.inside, &neighbours);
-        (direct, Some((reflected_direct, albedo)))
-    } else {
-        (reflected_direct, None)
-    };
-    Ok(TracedScene {
-        direct,
-        operator: traced.operator,
-        reflected_albedo,
-        textured,
-        inside: traced.inside,
-        neighbours,
-        seconds: start.elapsed().as_secs_f64(),
-    })
+    let vertex_count = geometry.mesh.vertex_count();
+    progress.start(vertex_count as u64);
+    let traced = visibility::trace_vertices(geometry, bvh, settings, 0..vertex_count, progress);
+    Ok(TracedScene::new(
+        geometry,
+        settings,
+        traced,
+        start.elapsed().as_secs_f64(),
+    ))
+}
+
+impl TracedScene {
+    /// The scene's tracing results (every vertex's), their direct transfer with albedo, and
+    /// the inside vertices filled from their neighbours.
+    fn new(
+        geometry: &SceneMesh,
+        settings: &BakeSettings,
+        traced: visibility::TracedVertices,
+        seconds: f64,
+    ) -> Self {
+        let neighbours = VertexNeighbours::new(&geometry.mesh);
+        let reflected_albedo = geometry.reflected_albedo();
+        let mut reflected_direct = traced.direct_transfer(&reflected_albedo, settings.order);
+        fill_inside(&mut reflected_direct, &traced.inside, &neighbours);
+        // Textured and glossy scenes reflect toward other surfaces another albedo than the one
+        // their vertices' transfer is stored with.
+        let (direct, textured) = if geometry.is_textured() || geometry.is_glossy() {
+            let albedo = geometry.albedo.clone();
+            let mut direct = traced.direct_transfer(&albedo, settings.order);
+            fill_inside(&mut direct, &traced.inside, &neighbours);
+            (direct, Some((reflected_direct, albedo)))
+        } else {
+            (reflected_direct, None)
+        };
+        TracedScene {
+            direct,
+            operator: traced.operator,
+            reflected_albedo,
+            textured,
+            inside: traced.inside,
+            neighbours,
+            seconds,
+        }
+    }
 }
 
 /// Bakes the transfer of every vertex of `geometry`. `progress` counts vertices of the
@@ -173,6 +193,19 @@ pub fn bake(
 ) -> Result<(Transfer, BakeStats), InvalidSettings> {
     let start = Instant::now();
     let traced = trace(geometry, bvh, settings, progress)?;
+    let (transfer, mut stats) = sum_bounces(geometry, settings, traced, progress);
+    stats.total_seconds = start.elapsed().as_secs_f64();
+    Ok((transfer, stats))
+}
+
+/// The Neumann series over a traced scene: the finished bake.
+fn sum_bounces(
+    geometry: &SceneMesh,
+    settings: &BakeSettings,
+    traced: TracedScene,
+    progress: &dyn Progress,
+) -> (Transfer, BakeStats) {
+    let start = Instant::now();
     let vertex_count = geometry.mesh.vertex_count();
     let mut stats = BakeStats {
         vertices: vertex_count,
@@ -191,9 +224,9 @@ pub fn bake(
         indirect = sum;
         bounce_start = Instant::now();
     }
-    stats.total_seconds = start.elapsed().as_secs_f64();
+    stats.total_seconds = traced.seconds + start.elapsed().as_secs_f64();
     progress.finish();
-    Ok((
+    (
         Transfer {
             settings: *settings,
             direct: traced.direct,
@@ -206,7 +239,7 @@ pub fn bake(
                 .sum(),
         },
         stats,
-    ))
+    )
 }
 
 #[cfg(test)]

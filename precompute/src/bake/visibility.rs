@@ -13,15 +13,17 @@ use foundation::sh::{ShBasis, num_coeffs};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-/// What the tracing pass found.
-pub(super) struct TracedVertices {
-    order: usize,
+/// What the tracing pass found for a run of vertices (all of them, or a shard's).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct TracedVertices {
+    pub(crate) order: usize,
     /// Per vertex, `(1/N) Σ_{escaping rays} Y_k(ω)`: the scalar direct transfer before albedo.
-    visibility: Vec<f32>,
-    /// Where the other rays landed, as interpolation weights over vertices.
-    pub operator: InterreflectionOperator,
+    pub(crate) visibility: Vec<f32>,
+    /// Where the other rays landed, as interpolation weights over vertices (one row per
+    /// traced vertex; columns index the whole scene).
+    pub(crate) operator: InterreflectionOperator,
     /// Vertices inside a solid: most of their rays reach the back of a surface.
-    pub inside: Vec<bool>,
+    pub(crate) inside: Vec<bool>,
 }
 
 /// A vertex counts as inside a solid when more than this fraction of its rays reach back
@@ -30,7 +32,7 @@ pub const INSIDE_BACKFACE_FRACTION: f32 = 0.5;
 
 impl TracedVertices {
     /// `T_direct,c(v) = ρ_c(v) · visibility(v)`.
-    pub(super) fn direct_transfer(&self, albedo: &[Rgb], order: usize) -> TransferVectors {
+    pub(crate) fn direct_transfer(&self, albedo: &[Rgb], order: usize) -> TransferVectors {
         debug_assert_eq!(order, self.order);
         let n = num_coeffs(order);
         let mut out = TransferVectors::zeros(order, albedo.len());
@@ -81,31 +83,23 @@ struct Chunk {
     inside: Vec<bool>,
 }
 
-const CHUNK: usize = 32;
+/// Vertices per parallel work item (and per block of the interreflection operator).
+pub(crate) const CHUNK: usize = 32;
 
-pub(super) fn trace_vertices(
+/// Traces the rays of `vertices` (a vertex's results do not depend on which others are traced
+/// with it, so shards of the range concatenate to the whole).
+pub(crate) fn trace_vertices(
     geometry: &SceneMesh,
     bvh: &SceneBvh,
     settings: &BakeSettings,
+    vertices: std::ops::Range<usize>,
     progress: &dyn Progress,
 ) -> TracedVertices {
-    let mesh = &geometry.mesh;
     let order = settings.order;
     let n = num_coeffs(order);
-    let tracer = VertexTracer {
-        geometry,
-        bvh,
-        basis: ShBasis::<f32>::new(order).expect("validated settings"),
-        samples: base_samples(settings.samples),
-        inv_samples: 1.0 / settings.samples as f32,
-        offset: RAY_OFFSET_FRACTION * geometry.diagonal(),
-        record_hits: settings.bounces > 0,
-        front_normals: (0..mesh.triangle_count())
-            .map(|t| mesh.front_normal(t))
-            .collect(),
-        seed: settings.seed,
-    };
-    let vertex_count = mesh.vertex_count();
+    let tracer = VertexTracer::new(geometry, bvh, settings);
+    let first = vertices.start;
+    let vertex_count = vertices.len();
 
     let chunks: Vec<Chunk> = (0..vertex_count.div_ceil(CHUNK))
         .into_par_iter()
@@ -115,7 +109,8 @@ pub(super) fn trace_vertices(
                 hits: Vec::with_capacity(3 * tracer.samples.len()),
             },
             |scratch, chunk_index| {
-                let vertices = chunk_index * CHUNK..((chunk_index + 1) * CHUNK).min(vertex_count);
+                let vertices = first + chunk_index * CHUNK
+                    ..first + ((chunk_index + 1) * CHUNK).min(vertex_count);
                 let mut chunk = Chunk {
                     visibility: vec![0.0; vertices.len() * n],
                     operator: OperatorBlock::new(),
@@ -152,6 +147,25 @@ pub(super) fn trace_vertices(
     }
 }
 
+/// Each vertex's estimated tracing cost: the BVH nodes visited by `probe_rays` rays from one
+/// vertex in `stride` (cosine-distributed, rotated per vertex like the bake's), which the
+/// vertices after it share. Depends only on the scene and the settings.
+pub(crate) fn vertex_costs(
+    geometry: &SceneMesh,
+    bvh: &SceneBvh,
+    settings: &BakeSettings,
+    probe_rays: u32,
+    stride: usize,
+) -> Vec<f64> {
+    let tracer = VertexTracer::new(geometry, bvh, settings);
+    let vertex_count = geometry.mesh.vertex_count();
+    let probes: Vec<f64> = (0..vertex_count.div_ceil(stride))
+        .into_par_iter()
+        .map(|k| tracer.probe_work(k * stride, probe_rays) as f64)
+        .collect();
+    (0..vertex_count).map(|v| probes[v / stride]).collect()
+}
+
 /// What tracing one vertex's rays needs, shared by every vertex.
 struct VertexTracer<'a> {
     geometry: &'a SceneMesh,
@@ -166,7 +180,24 @@ struct VertexTracer<'a> {
     seed: u64,
 }
 
-impl VertexTracer<'_> {
+impl<'a> VertexTracer<'a> {
+    fn new(geometry: &'a SceneMesh, bvh: &'a SceneBvh, settings: &BakeSettings) -> Self {
+        let mesh = &geometry.mesh;
+        Self {
+            geometry,
+            bvh,
+            basis: ShBasis::<f32>::new(settings.order).expect("validated settings"),
+            samples: base_samples(settings.samples),
+            inv_samples: 1.0 / settings.samples as f32,
+            offset: RAY_OFFSET_FRACTION * geometry.diagonal(),
+            record_hits: settings.bounces > 0,
+            front_normals: (0..mesh.triangle_count())
+                .map(|t| mesh.front_normal(t))
+                .collect(),
+            seed: settings.seed,
+        }
+    }
+
     /// Traces vertex `v`'s rays: adds `(1/N) Σ Y_k(ω)` over the escaping ones to `visibility`,
     /// leaves the hits' interpolation weights in `scratch.hits`, and says whether the vertex
     /// is inside a solid.
@@ -206,6 +237,24 @@ impl VertexTracer<'_> {
             *y *= self.inv_samples;
         }
         back_faces as f32 > INSIDE_BACKFACE_FRACTION * self.samples.len() as f32
+    }
+
+    /// BVH nodes visited by `rays` probe rays from vertex `v`, plus one per ray for the work
+    /// outside the traversal.
+    fn probe_work(&self, v: usize, rays: u32) -> u64 {
+        let mesh = &self.geometry.mesh;
+        let normal = mesh.normals[v];
+        let frame = Frame::from_normal(normal);
+        let origin = mesh.positions[v] + normal * self.offset;
+        let rotation = hash_to_unit2(mix64(self.seed ^ mix64(v as u64)));
+        (0..rays)
+            .map(|i| {
+                let u = cranley_patterson(hammersley(i, rays), rotation);
+                let direction = frame.to_world(cosine_hemisphere(u));
+                let skip = Skip::VertexTriangles(v as u32);
+                1 + u64::from(self.bvh.closest_hit_work(origin, direction, skip))
+            })
+            .sum()
     }
 }
 

@@ -2,6 +2,7 @@
 //! its two renders.
 
 use super::*;
+use crate::render;
 use foundation::envmap::EnvMap;
 use foundation::infra::progress::NoProgress;
 use foundation::mesh::box_mesh;

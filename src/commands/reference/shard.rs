@@ -1,0 +1,366 @@
+//! `hprt reference --shard I/N` and `hprt reference merge`: the reference rendered as
+//! interleaved rows (shard I takes rows I, I+N, I+2N, …, so every shard gets its share of
+//! sky and of geometry), each row exactly as one run renders it, joined into the same files.
+//!
+//! A band file (`.hprtband`, little-endian): magic `HPRTBAND`, u32 version, u32 length of a
+//! JSON header (the job, its fingerprint, the shard, the image size), the header padded to 4
+//! bytes, then per image (the scene; for a composite also the proxies alone) radiance and
+//! specular (f32 RGB), coverage and visibility (f32), primary triangle (u32), each over the
+//! band's pixels, and a CRC-32 of everything before it.
+
+use super::job::{JobSpec, OutputFiles, ReferenceJob};
+use crate::outputs::{check_outputs, scene_inputs};
+use crate::support::create_folder;
+use anyhow::Context;
+use clap::Args;
+use foundation::color::Rgb;
+use foundation::image_io::RgbImageF32;
+use foundation::infra::atomic_file::AtomicOutput;
+use foundation::infra::limits::read_regular_file;
+use foundation::infra::shard::{ShardSpec, check_indices};
+use reference::{ReferenceImage, RenderStats};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+const MAGIC: &[u8; 8] = b"HPRTBAND";
+const VERSION: u32 = 1;
+const EXTENSION: &str = "hprtband";
+/// Largest band file read (a 4K reference band of a composite is a few hundred MB).
+const MAX_BAND_BYTES: u64 = 16 << 30;
+
+#[derive(Args)]
+pub struct MergeArgs {
+    /// The folder of the bands (`*.hprtband`).
+    pub bands: PathBuf,
+    #[command(flatten)]
+    pub files: OutputFiles,
+}
+
+/// The band header.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct BandHeader {
+    hprt: String,
+    job: JobSpec,
+    /// Hash of the job and of every input file's content ([`fingerprint`]).
+    fingerprint: String,
+    index: u32,
+    count: u32,
+    width: usize,
+    height: usize,
+    /// 1, or 2 for a composite (the scene, then the proxies alone).
+    images: usize,
+}
+
+/// Hash of the job and of the contents it reads: bands of one job agree on it, and a merge
+/// after an input changed does not.
+fn fingerprint(spec: &JobSpec, job: &ReferenceJob) -> anyhow::Result<String> {
+    let mut hasher = blake3::Hasher::new();
+    hasher.update(env!("CARGO_PKG_VERSION").as_bytes());
+    hasher.update(&serde_json::to_vec(spec)?);
+    hasher.update(&job.scene.geometry.content_hash());
+    let mut files = vec![job.scene.path.clone(), job.env.path.clone()];
+    if let Some(foundation::scene::Backplate::Image(path)) = &job.scene.backplate {
+        files.push(path.clone());
+    }
+    for file in files.iter().filter(|f| f.is_file()) {
+        let bytes =
+            std::fs::read(file).with_context(|| format!("cannot read {}", file.display()))?;
+        hasher.update(blake3::hash(&bytes).as_bytes());
+    }
+    Ok(hasher.finalize().to_hex().to_string())
+}
+
+/// Shard `spec`'s rows of an image `height` rows high.
+fn band_rows(spec: ShardSpec, height: usize) -> Vec<usize> {
+    (spec.index as usize..height)
+        .step_by(spec.count as usize)
+        .collect()
+}
+
+fn band_name(spec: ShardSpec) -> String {
+    format!("reference-{}.{EXTENSION}", spec.tag())
+}
+
+/// `hprt reference SCENE --shard I/N -o DIR`.
+pub fn run_band(
+    spec: &JobSpec,
+    job: &ReferenceJob,
+    shard: ShardSpec,
+    dir: &Path,
+    threads: Option<usize>,
+) -> anyhow::Result<()> {
+    let path = dir.join(band_name(shard));
+    let inputs = scene_inputs(&job.scene, &[Some(&job.env.path)]);
+    check_outputs(&inputs, &[("-o", Some(&path))])?;
+    create_folder(dir)?;
+    let file =
+        AtomicOutput::create(&path).with_context(|| format!("cannot write {}", path.display()))?;
+    job.announce();
+    let rows = band_rows(shard, job.camera.height as usize);
+    println!(
+        "shard {shard}: {} of {} rows",
+        rows.len(),
+        job.camera.height
+    );
+    let (with, without) = job.render_rows(&rows, threads)?;
+    let header = BandHeader {
+        hprt: env!("CARGO_PKG_VERSION").to_owned(),
+        job: spec.clone(),
+        fingerprint: fingerprint(spec, job)?,
+        index: shard.index,
+        count: shard.count,
+        width: job.camera.width as usize,
+        height: job.camera.height as usize,
+        images: 1 + usize::from(without.is_some()),
+    };
+    let images: Vec<&ReferenceImage> = std::iter::once(&with).chain(without.as_ref()).collect();
+    let bytes = encode(&header, &images)?;
+    file.commit(&bytes)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    println!(
+        "rendered in {:.2} s; wrote {} ({:.1} MB)",
+        with.stats.seconds + without.as_ref().map_or(0.0, |w| w.stats.seconds),
+        path.display(),
+        bytes.len() as f64 / 1e6
+    );
+    Ok(())
+}
+
+fn encode(header: &BandHeader, images: &[&ReferenceImage]) -> anyhow::Result<Vec<u8>> {
+    let json = serde_json::to_vec(header)?;
+    let mut out = Vec::new();
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(&json);
+    out.resize(out.len().div_ceil(4) * 4, 0);
+    let rgb = |out: &mut Vec<u8>, image: &RgbImageF32| {
+        out.extend(
+            image
+                .pixels
+                .iter()
+                .flat_map(|p| p.to_array())
+                .flat_map(f32::to_le_bytes),
+        );
+    };
+    for image in images {
+        rgb(&mut out, &image.radiance);
+        rgb(&mut out, &image.specular);
+        out.extend(image.coverage.iter().flat_map(|x| x.to_le_bytes()));
+        out.extend(image.visibility.iter().flat_map(|x| x.to_le_bytes()));
+        out.extend(image.primary.iter().flat_map(|x| x.to_le_bytes()));
+        out.extend_from_slice(&image.stats.rays.to_le_bytes());
+        out.extend_from_slice(&image.stats.seconds.to_le_bytes());
+    }
+    let crc = crc32fast::hash(&out);
+    out.extend_from_slice(&crc.to_le_bytes());
+    Ok(out)
+}
+
+/// A band read back: its header, its rows, and its images.
+struct Band {
+    header: BandHeader,
+    rows: Vec<usize>,
+    images: Vec<ReferenceImage>,
+}
+
+/// Reads little-endian values in order, failing on a short file instead of panicking.
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> anyhow::Result<&'a [u8]> {
+        let end = self
+            .at
+            .checked_add(n)
+            .filter(|&e| e <= self.bytes.len())
+            .context("truncated")?;
+        let out = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(out)
+    }
+
+    fn words(&mut self, n: usize) -> anyhow::Result<Vec<[u8; 4]>> {
+        let bytes = self.take(n.checked_mul(4).context("impossible size")?)?;
+        Ok(bytes
+            .chunks_exact(4)
+            .map(|b| [b[0], b[1], b[2], b[3]])
+            .collect())
+    }
+
+    fn floats(&mut self, n: usize) -> anyhow::Result<Vec<f32>> {
+        Ok(self.words(n)?.into_iter().map(f32::from_le_bytes).collect())
+    }
+
+    fn rgb(&mut self, width: usize, height: usize) -> anyhow::Result<RgbImageF32> {
+        let floats = self.floats(width * height * 3)?;
+        let pixels = floats
+            .chunks_exact(3)
+            .map(|c| Rgb::new(c[0], c[1], c[2]))
+            .collect();
+        Ok(RgbImageF32::new(width, height, pixels))
+    }
+
+    fn eight(&mut self) -> anyhow::Result<[u8; 8]> {
+        Ok(self.take(8)?.try_into().expect("8 bytes"))
+    }
+}
+
+fn decode(bytes: &[u8]) -> anyhow::Result<Band> {
+    anyhow::ensure!(
+        bytes.len() >= 20 && &bytes[..8] == MAGIC,
+        "not an hprt reference band"
+    );
+    let (body, crc) = bytes.split_at(bytes.len() - 4);
+    anyhow::ensure!(
+        crc32fast::hash(body).to_le_bytes() == crc,
+        "checksum mismatch (truncated or damaged)"
+    );
+    let mut r = Reader { bytes: body, at: 8 };
+    let version = u32::from_le_bytes(r.words(1)?[0]);
+    anyhow::ensure!(
+        version == VERSION,
+        "band format version {version}, this hprt reads {VERSION}"
+    );
+    let json_len = u32::from_le_bytes(r.words(1)?[0]) as usize;
+    let header: BandHeader =
+        serde_json::from_slice(r.take(json_len)?).context("unreadable header")?;
+    anyhow::ensure!(
+        header.hprt == env!("CARGO_PKG_VERSION"),
+        "made by hprt {}, this is hprt {}; render the bands again with this version",
+        header.hprt,
+        env!("CARGO_PKG_VERSION")
+    );
+    r.take(r.at.div_ceil(4) * 4 - r.at)?;
+    let shard = ShardSpec::new(header.index, header.count).map_err(anyhow::Error::msg)?;
+    anyhow::ensure!(
+        (1..=2).contains(&header.images) && header.width > 0,
+        "{} images of width {}",
+        header.images,
+        header.width
+    );
+    let rows = band_rows(shard, header.height);
+    let (w, h) = (header.width, rows.len());
+    let mut images = Vec::new();
+    for _ in 0..header.images {
+        images.push(ReferenceImage {
+            radiance: r.rgb(w, h)?,
+            specular: r.rgb(w, h)?,
+            coverage: r.floats(w * h)?,
+            visibility: r.floats(w * h)?,
+            primary: r
+                .words(w * h)?
+                .into_iter()
+                .map(u32::from_le_bytes)
+                .collect(),
+            stats: RenderStats {
+                rays: u64::from_le_bytes(r.eight()?),
+                seconds: f64::from_le_bytes(r.eight()?),
+            },
+        });
+    }
+    anyhow::ensure!(
+        r.at == body.len(),
+        "{} bytes after the data",
+        body.len() - r.at
+    );
+    Ok(Band {
+        header,
+        rows,
+        images,
+    })
+}
+
+/// The band files in `dir`, read, in index order.
+fn read_bands(dir: &Path) -> anyhow::Result<Vec<Band>> {
+    let entries = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot read the folder {}", dir.display()))?;
+    let mut files = Vec::new();
+    for entry in entries {
+        let path = entry
+            .with_context(|| format!("cannot read the folder {}", dir.display()))?
+            .path();
+        if path.extension().is_some_and(|e| e == EXTENSION) {
+            files.push(path);
+        }
+    }
+    files.sort();
+    anyhow::ensure!(
+        !files.is_empty(),
+        "{} holds no reference bands (*.{EXTENSION}); make them with `hprt reference SCENE \
+         --shard I/N -o {}`",
+        dir.display(),
+        dir.display()
+    );
+    let mut bands = Vec::new();
+    for file in &files {
+        let bytes = read_regular_file(file, MAX_BAND_BYTES)
+            .map_err(|e| anyhow::anyhow!("{e}"))
+            .and_then(|b| decode(&b))
+            .with_context(|| format!("{}: not a usable reference band", file.display()))?;
+        bands.push(bytes);
+    }
+    bands.sort_by_key(|b| b.header.index);
+    Ok(bands)
+}
+
+/// Checks that `bands` are every shard of one job.
+fn check_bands(dir: &Path, bands: &[Band]) -> anyhow::Result<()> {
+    let first = &bands[0].header;
+    for b in bands {
+        let h = &b.header;
+        anyhow::ensure!(
+            h.fingerprint == first.fingerprint && h.count == first.count,
+            "{}: the bands are of different jobs (shard {}/{} and shard {}/{}: other inputs, \
+             settings or shard counts); render them again into an empty folder",
+            dir.display(),
+            first.index,
+            first.count,
+            h.index,
+            h.count
+        );
+    }
+    let specs: Vec<ShardSpec> = bands
+        .iter()
+        .map(|b| ShardSpec::new(b.header.index, b.header.count))
+        .collect::<Result<_, _>>()
+        .map_err(anyhow::Error::msg)?;
+    check_indices(&specs).with_context(|| format!("cannot merge the bands in {}", dir.display()))
+}
+
+/// `hprt reference merge DIR -o FILE`.
+pub fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
+    let Some(output) = &args.files.output else {
+        anyhow::bail!("hprt reference merge needs -o");
+    };
+    let bands = read_bands(&args.bands)?;
+    check_bands(&args.bands, &bands)?;
+    let spec = bands[0].header.job.clone();
+    let job = ReferenceJob::prepare(&spec)?;
+    anyhow::ensure!(
+        fingerprint(&spec, &job)? == bands[0].header.fingerprint,
+        "{}: the scene, its map or its backplate changed since the bands were rendered; \
+         render them again",
+        args.bands.display()
+    );
+    let files = job.open_outputs(&args.files, output)?;
+    let (width, height) = (bands[0].header.width, bands[0].header.height);
+    let mut parts: [Vec<(Vec<usize>, ReferenceImage)>; 2] = Default::default();
+    for band in bands {
+        for (k, image) in band.images.into_iter().enumerate() {
+            parts[k].push((band.rows.clone(), image));
+        }
+    }
+    let assemble = |parts: &[(Vec<usize>, ReferenceImage)]| {
+        ReferenceImage::assemble(width, height, parts).context("the bands do not tile the image")
+    };
+    let with = assemble(&parts[0])?;
+    let without = (!parts[1].is_empty())
+        .then(|| assemble(&parts[1]))
+        .transpose()?;
+    println!("merged {} bands of {width}x{height}", parts[0].len());
+    let (image, composite) = job.finish(with, without);
+    job.write(&args.files, output, files, &image, composite.as_ref())
+}
