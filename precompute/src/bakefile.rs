@@ -99,38 +99,58 @@ pub fn encode(transfer: &Transfer, mesh_hash: &[u8; 32]) -> Vec<u8> {
     out
 }
 
-fn u32_at(bytes: &[u8], offset: usize) -> u32 {
+/// The little-endian u32 at `offset` (checked in bounds by the caller).
+pub(crate) fn u32_at(bytes: &[u8], offset: usize) -> u32 {
     u32::from_le_bytes(bytes[offset..offset + 4].try_into().expect("4 bytes"))
 }
 
-fn u64_at(bytes: &[u8], offset: usize) -> u64 {
+/// The little-endian u64 at `offset` (checked in bounds by the caller).
+pub(crate) fn u64_at(bytes: &[u8], offset: usize) -> u64 {
     u64::from_le_bytes(bytes[offset..offset + 8].try_into().expect("8 bytes"))
+}
+
+/// What is wrong with a file's envelope: its magic, its length, its format version (at 8).
+pub(crate) enum Envelope {
+    Magic,
+    Short(usize),
+    Version(u32),
+}
+
+/// Checks the envelope the bake and shard files share: `magic`, at least `header_size`
+/// bytes and a checksum, and format `version`.
+pub(crate) fn check_envelope(
+    bytes: &[u8],
+    magic: &[u8; 8],
+    header_size: usize,
+    version: u32,
+) -> Result<(), Envelope> {
+    if bytes.len() < 8 || &bytes[..8] != magic {
+        return Err(Envelope::Magic);
+    }
+    if bytes.len() < header_size + 4 {
+        return Err(Envelope::Short(bytes.len()));
+    }
+    match u32_at(bytes, 8) {
+        v if v == version => Ok(()),
+        found => Err(Envelope::Version(found)),
+    }
 }
 
 /// Parses bytes written by [`encode`]; `path` only names the file in errors.
 pub fn decode(path: &Path, bytes: &[u8]) -> Result<(BakeHeader, Transfer), BakeFileError> {
+    let path = path.to_owned();
     let corrupt = |message: String| BakeFileError::Corrupt {
-        path: path.to_owned(),
+        path: path.clone(),
         message,
     };
-    if bytes.len() < 8 || &bytes[..8] != MAGIC {
-        return Err(BakeFileError::NotABake {
-            path: path.to_owned(),
-        });
-    }
-    if bytes.len() < HEADER_SIZE + 4 {
-        return Err(corrupt(format!(
-            "only {} bytes, truncated header",
-            bytes.len()
-        )));
-    }
-    let version = u32_at(bytes, 8);
-    if version != VERSION {
-        return Err(BakeFileError::Version {
-            path: path.to_owned(),
-            found: version,
-        });
-    }
+    check_envelope(bytes, MAGIC, HEADER_SIZE, VERSION).map_err(|e| match e {
+        Envelope::Magic => BakeFileError::NotABake { path: path.clone() },
+        Envelope::Short(n) => corrupt(format!("only {n} bytes, truncated header")),
+        Envelope::Version(found) => BakeFileError::Version {
+            path: path.clone(),
+            found,
+        },
+    })?;
     let header_size = u32_at(bytes, 12) as usize;
     let order = u32_at(bytes, 16) as usize;
     let channels = u32_at(bytes, 28);

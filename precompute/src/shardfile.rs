@@ -34,6 +34,7 @@
 
 use crate::bake::shard::BakeShard;
 use crate::bake::{BakeSettings, RAY_OFFSET_FRACTION};
+use crate::bakefile::{Envelope, check_envelope, u32_at, u64_at};
 use foundation::infra::limits::{MAX_BAKE_BYTES, ReadError, read_regular_file};
 use foundation::infra::shard::ShardSpec;
 use foundation::sh::{self, num_coeffs};
@@ -181,35 +182,22 @@ impl<'a> Reader<'a> {
     }
 }
 
-fn u32_at(bytes: &[u8], offset: usize) -> u32 {
-    u32::from_le_bytes(bytes[offset..offset + 4].try_into().expect("4 bytes"))
-}
-
-fn u64_at(bytes: &[u8], offset: usize) -> u64 {
-    u64::from_le_bytes(bytes[offset..offset + 8].try_into().expect("8 bytes"))
-}
-
 /// Parses bytes written by [`encode`]; `path` only names the file in errors.
 pub fn decode(path: &Path, bytes: &[u8]) -> Result<BakeShard, ShardFileError> {
     let corrupt = |message: String| ShardFileError::Corrupt {
         path: path.to_owned(),
         message,
     };
-    if bytes.len() < 8 || &bytes[..8] != MAGIC {
-        return Err(ShardFileError::NotAShard {
+    check_envelope(bytes, MAGIC, HEADER_SIZE, VERSION).map_err(|e| match e {
+        Envelope::Magic => ShardFileError::NotAShard {
             path: path.to_owned(),
-        });
-    }
-    if bytes.len() < HEADER_SIZE + 4 {
-        return Err(corrupt(format!("only {} bytes", bytes.len())));
-    }
-    let version = u32_at(bytes, 8);
-    if version != VERSION {
-        return Err(ShardFileError::Version {
+        },
+        Envelope::Short(n) => corrupt(format!("only {n} bytes")),
+        Envelope::Version(found) => ShardFileError::Version {
             path: path.to_owned(),
-            found: version,
-        });
-    }
+            found,
+        },
+    })?;
     let stored_crc = u32_at(bytes, bytes.len() - 4);
     let body = &bytes[..bytes.len() - 4];
     if crc32fast::hash(body) != stored_crc {

@@ -3,7 +3,9 @@
 
 use crate::bake_cache::print_bake_stats;
 use crate::outputs::{check_outputs, scene_inputs};
-use crate::support::{TerminalProgress, create_folder, load_scene, with_threads};
+use crate::support::{
+    TerminalProgress, create_folder, files_with_extension, load_scene, with_threads,
+};
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use foundation::bvh::SceneBvh;
@@ -198,33 +200,11 @@ fn run_shard(
     Ok(())
 }
 
-/// The shard files in `dir`, in name order.
-fn shard_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
-    let entries = std::fs::read_dir(dir)
-        .with_context(|| format!("cannot read the folder {}", dir.display()))?;
-    let mut files = Vec::new();
-    for entry in entries {
-        let path = entry
-            .with_context(|| format!("cannot read the folder {}", dir.display()))?
-            .path();
-        if path.extension().is_some_and(|e| e == shardfile::EXTENSION) {
-            files.push(path);
-        }
-    }
-    files.sort();
-    anyhow::ensure!(
-        !files.is_empty(),
-        "{} holds no bake shards (*.{}); make them with `hprt bake SCENE --shard I/N -o {}`",
-        dir.display(),
-        shardfile::EXTENSION,
-        dir.display()
-    );
-    Ok(files)
-}
-
 /// `hprt bake merge DIR -o FILE`.
 fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
-    let files = shard_files(&args.shards)?;
+    let dir = &args.shards;
+    let how = format!("hprt bake SCENE --shard I/N -o {}", dir.display());
+    let files = files_with_extension(dir, shardfile::EXTENSION, "bake shards", &how)?;
     let shards = files
         .iter()
         .map(|f| shardfile::read(f))

@@ -93,12 +93,7 @@ fn key(
 ) -> anyhow::Result<String> {
     let mut hasher = blake3::Hasher::new();
     hasher.update(b"hprt composite truth v1");
-    hasher.update(&scene.geometry.content_hash());
-    hasher.update(serde_json::to_string(camera)?.as_bytes());
-    hasher.update(&(map.width() as u64).to_le_bytes());
-    hasher.update(&(map.height() as u64).to_le_bytes());
-    hasher.update(bytemuck::cast_slice(map.texels()));
-    hasher.update(&rotation_deg.to_le_bytes());
+    super::truth::hash_view(&mut hasher, scene, camera, map, rotation_deg)?;
     hasher.update(&settings.bounces.to_le_bytes());
     hasher.update(&settings.seed.to_le_bytes());
     hasher.update(&((settings.spp / 2).max(1)).to_le_bytes());

@@ -116,16 +116,29 @@ fn reference_key(
 ) -> anyhow::Result<String> {
     let mut hasher = blake3::Hasher::new();
     hasher.update(b"hprt reference v4 (halves, files by sample count)");
+    hash_view(&mut hasher, scene, camera, map, rotation_deg)?;
+    hasher.update(&request.bounces.to_le_bytes());
+    hasher.update(&request.seed.to_le_bytes());
+    hasher.update(request.sampler.name().as_bytes());
+    Ok(hasher.finalize().to_hex()[..24].to_owned())
+}
+
+/// Hashes what a path trace sees: the scene's mesh (and materials), the camera, the map's
+/// texels and its rotation.
+pub(super) fn hash_view(
+    hasher: &mut blake3::Hasher,
+    scene: &Scene,
+    camera: &Camera,
+    map: &EnvMap,
+    rotation_deg: f32,
+) -> anyhow::Result<()> {
     hasher.update(&scene.geometry.content_hash());
     hasher.update(serde_json::to_string(camera)?.as_bytes());
     hasher.update(&(map.width() as u64).to_le_bytes());
     hasher.update(&(map.height() as u64).to_le_bytes());
     hasher.update(bytemuck::cast_slice(map.texels()));
     hasher.update(&rotation_deg.to_le_bytes());
-    hasher.update(&request.bounces.to_le_bytes());
-    hasher.update(&request.seed.to_le_bytes());
-    hasher.update(request.sampler.name().as_bytes());
-    Ok(hasher.finalize().to_hex()[..24].to_owned())
+    Ok(())
 }
 
 #[derive(serde::Serialize, serde::Deserialize)]

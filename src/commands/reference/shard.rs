@@ -10,7 +10,7 @@
 
 use super::job::{JobSpec, OutputFiles, ReferenceJob};
 use crate::outputs::{check_outputs, scene_inputs};
-use crate::support::create_folder;
+use crate::support::{create_folder, files_with_extension};
 use anyhow::Context;
 use clap::Args;
 use foundation::color::Rgb;
@@ -275,25 +275,8 @@ fn decode(bytes: &[u8]) -> anyhow::Result<Band> {
 
 /// The band files in `dir`, read, in index order.
 fn read_bands(dir: &Path) -> anyhow::Result<Vec<Band>> {
-    let entries = std::fs::read_dir(dir)
-        .with_context(|| format!("cannot read the folder {}", dir.display()))?;
-    let mut files = Vec::new();
-    for entry in entries {
-        let path = entry
-            .with_context(|| format!("cannot read the folder {}", dir.display()))?
-            .path();
-        if path.extension().is_some_and(|e| e == EXTENSION) {
-            files.push(path);
-        }
-    }
-    files.sort();
-    anyhow::ensure!(
-        !files.is_empty(),
-        "{} holds no reference bands (*.{EXTENSION}); make them with `hprt reference SCENE \
-         --shard I/N -o {}`",
-        dir.display(),
-        dir.display()
-    );
+    let how = format!("hprt reference SCENE --shard I/N -o {}", dir.display());
+    let files = files_with_extension(dir, EXTENSION, "reference bands", &how)?;
     let mut bands = Vec::new();
     for file in &files {
         let bytes = read_regular_file(file, MAX_BAND_BYTES)
