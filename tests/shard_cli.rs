@@ -57,6 +57,12 @@ fn bake_shards_from_the_scheduler_environment_merge_to_the_whole_bake() {
         &[],
     );
     same_bytes(d, "merged.bake", "whole.bake");
+    // A merge never writes over a shard it reads.
+    let shard0 = "shards/bake-0000-of-0003.hprtshard";
+    let before = std::fs::read(d.join(shard0)).unwrap();
+    let out = hprt(d, &["bake", "merge", "shards", "-o", shard0]);
+    assert_clean_failure(&out, &["destroy the input"]);
+    assert!(std::fs::read(d.join(shard0)).unwrap() == before);
 
     // One shard gone: refused, naming it, and nothing written.
     std::fs::remove_file(d.join("shards/bake-0001-of-0003.hprtshard")).unwrap();

@@ -215,7 +215,9 @@ fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
         None => PathBuf::from(&shards[0].scene_path),
     };
     let scene = load_scene(&scene_path)?;
-    check_outputs(&scene_inputs(&scene, &[]), &[("-o", Some(&args.output))])?;
+    let mut inputs = scene_inputs(&scene, &[]);
+    inputs.extend(files.iter().map(PathBuf::as_path));
+    check_outputs(&inputs, &[("-o", Some(&args.output))])?;
     let file = AtomicOutput::create(&args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     let settings = shards[0].settings;

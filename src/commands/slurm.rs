@@ -171,7 +171,10 @@ fn check_parses(name: &str, args: &[String]) -> anyhow::Result<()> {
         .into_iter()
         .map(str::to_owned)
         .chain(args.iter().cloned());
-    Check::try_parse_from(argv).map_err(|e| anyhow::anyhow!("hprt {name}: {}", e.render()))?;
+    Check::try_parse_from(argv).map_err(|e| {
+        let message = e.render().to_string();
+        anyhow::anyhow!("hprt {name}: {}", message.trim_start_matches("error: "))
+    })?;
     Ok(())
 }
 

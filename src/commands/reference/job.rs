@@ -143,8 +143,10 @@ impl ReferenceJob {
         &self,
         files: &OutputFiles,
         output: &std::path::Path,
+        more_inputs: &[&std::path::Path],
     ) -> anyhow::Result<Vec<AtomicOutput>> {
-        let inputs = scene_inputs(&self.scene, &[Some(&self.env.path)]);
+        let mut inputs = scene_inputs(&self.scene, &[Some(&self.env.path)]);
+        inputs.extend_from_slice(more_inputs);
         let aux = files
             .aux
             .as_deref()

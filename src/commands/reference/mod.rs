@@ -75,7 +75,7 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
         );
         return shard::run_band(&spec, &job, band, output, args.threads);
     }
-    let files = job.open_outputs(&args.files, output)?;
+    let files = job.open_outputs(&args.files, output, &[])?;
     job.announce();
     let (image, composite) = job.render_whole(args.threads)?;
     job.write(&args.files, output, files, &image, composite.as_ref())

@@ -235,11 +235,19 @@ fn decode(bytes: &[u8]) -> anyhow::Result<Band> {
     );
     r.take(r.at.div_ceil(4) * 4 - r.at)?;
     let shard = ShardSpec::new(header.index, header.count).map_err(anyhow::Error::msg)?;
+    // Within any camera's limits (checked again when the merge loads the job) before
+    // anything is allocated for them.
+    let pixels = header.width as u64 * header.height as u64;
     anyhow::ensure!(
-        (1..=2).contains(&header.images) && header.width > 0,
-        "{} images of width {}",
+        (1..=2).contains(&header.images)
+            && header.width > 0
+            && header.height > 0
+            && pixels <= (body.len() as u64).saturating_mul(u64::from(header.count)),
+        "{} images of {}x{} pixels in {} bytes",
         header.images,
-        header.width
+        header.width,
+        header.height,
+        body.len()
     );
     let rows = band_rows(shard, header.height);
     let (w, h) = (header.width, rows.len());
@@ -274,7 +282,7 @@ fn decode(bytes: &[u8]) -> anyhow::Result<Band> {
 }
 
 /// The band files in `dir`, read, in index order.
-fn read_bands(dir: &Path) -> anyhow::Result<Vec<Band>> {
+fn read_bands(dir: &Path) -> anyhow::Result<(Vec<PathBuf>, Vec<Band>)> {
     let how = format!("hprt reference SCENE --shard I/N -o {}", dir.display());
     let files = files_with_extension(dir, EXTENSION, "reference bands", &how)?;
     let mut bands = Vec::new();
@@ -286,7 +294,7 @@ fn read_bands(dir: &Path) -> anyhow::Result<Vec<Band>> {
         bands.push(bytes);
     }
     bands.sort_by_key(|b| b.header.index);
-    Ok(bands)
+    Ok((files, bands))
 }
 
 /// Checks that `bands` are every shard of one job.
@@ -318,7 +326,7 @@ pub fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
     let Some(output) = &args.files.output else {
         anyhow::bail!("hprt reference merge needs -o");
     };
-    let bands = read_bands(&args.bands)?;
+    let (band_files, bands) = read_bands(&args.bands)?;
     check_bands(&args.bands, &bands)?;
     let spec = bands[0].header.job.clone();
     let job = ReferenceJob::prepare(&spec)?;
@@ -328,7 +336,8 @@ pub fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
          render them again",
         args.bands.display()
     );
-    let files = job.open_outputs(&args.files, output)?;
+    let band_files: Vec<&Path> = band_files.iter().map(PathBuf::as_path).collect();
+    let files = job.open_outputs(&args.files, output, &band_files)?;
     let (width, height) = (bands[0].header.width, bands[0].header.height);
     let mut parts: [Vec<(Vec<usize>, ReferenceImage)>; 2] = Default::default();
     for band in bands {
