@@ -277,3 +277,104 @@ fn slurm_dry_run_prints_the_jobs_and_writes_nothing() {
     );
     assert_clean_failure(&out, &["--sample"]);
 }
+
+/// A scene with a glossy teapot and a textured crate on a floor (absolute paths into
+/// `scenes/`).
+fn glossy_and_textured_scene(dir: &Path) -> std::path::PathBuf {
+    let scenes = repo().join("scenes");
+    let text = format!(
+        r#"name = "glossy-and-textured"
+[camera]
+position = [6.5, 7.5, 11.0]
+target = [0.3, 0.9, 0.0]
+fov_y_deg = 38.0
+width = 64
+height = 48
+[environment]
+map = "{env}"
+[bake]
+order = 3
+samples = 16
+bounces = 1
+[[object]]
+name = "teapot"
+mesh = "{teapot}"
+patch_segments = 4
+albedo = [0.45, 0.45, 0.45]
+specular = [0.4, 0.4, 0.4]
+shininess = 60.0
+transform = {{ rotate_deg = [-90.0, 0.0, 0.0] }}
+[[object]]
+name = "crate"
+mesh = "{crate}"
+transform = {{ translate = [2.5, 0.0, 0.0] }}
+[[object]]
+name = "floor"
+box = {{ min = [-5.0, -0.3, -4.0], max = [5.0, 0.0, 4.0], segments = [16, 1, 12] }}
+albedo = [0.6, 0.5, 0.4]
+"#,
+        env = scenes.join("env/city.exr").display(),
+        teapot = scenes.join("meshes/teapot.bpt").display(),
+        crate = scenes.join("models/crate.glb").display(),
+    );
+    let path = dir.join("mixed.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn merges_equal_one_run_for_every_shard_count_on_plain_glossy_and_textured_scenes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let teapot = scene("teapot.toml");
+    let mixed = glossy_and_textured_scene(d);
+    for (name, path) in [("teapot", &teapot), ("mixed", &mixed)] {
+        let scene = path.to_str().unwrap();
+        let bake = ["bake", scene, "--samples", "16", "--bounces", "1"];
+        let reference = [
+            "reference",
+            scene,
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--spp",
+            "2",
+        ];
+        run_ok(
+            d,
+            &[&bake[..], &["-o", &format!("{name}.bake")]].concat(),
+            &[],
+        );
+        run_ok(
+            d,
+            &[&reference[..], &["-o", &format!("{name}.exr")]].concat(),
+            &[],
+        );
+        for count in [1, 2, 3, 8] {
+            let (bakes, bands) = (
+                format!("{name}-{count}-bake"),
+                format!("{name}-{count}-bands"),
+            );
+            for i in 0..count {
+                let shard = format!("{i}/{count}");
+                run_ok(
+                    d,
+                    &[&bake[..], &["--shard", &shard, "-o", &bakes]].concat(),
+                    &[],
+                );
+                run_ok(
+                    d,
+                    &[&reference[..], &["--shard", &shard, "-o", &bands]].concat(),
+                    &[],
+                );
+            }
+            let merged = format!("{name}-{count}.bake");
+            run_ok(d, &["bake", "merge", &bakes, "-o", &merged], &[]);
+            same_bytes(d, &merged, &format!("{name}.bake"));
+            let merged = format!("{name}-{count}.exr");
+            run_ok(d, &["reference", "merge", &bands, "-o", &merged], &[]);
+            same_bytes(d, &merged, &format!("{name}.exr"));
+        }
+    }
+}

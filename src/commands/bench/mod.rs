@@ -5,6 +5,7 @@ mod composite;
 mod reference;
 mod reflections;
 mod render;
+mod shards;
 mod turn;
 
 use bake::{BenchBakeArgs, bench_bake};
@@ -13,6 +14,7 @@ use composite::{BenchCompositeArgs, bench_composite};
 use reference::{BenchReferenceArgs, bench_reference};
 use reflections::{BenchReflectionsArgs, bench_reflections};
 use render::{BenchRenderArgs, bench_render};
+use shards::{BenchShardsArgs, bench_shards};
 use turn::{BenchTurnArgs, bench_turn};
 
 #[derive(Subcommand)]
@@ -31,6 +33,9 @@ pub enum BenchCommand {
     /// The live composite: frame times composited and of the same scene drawn whole, static
     /// and with the map turning.
     Composite(BenchCompositeArgs),
+    /// Sharded bakes: each shard's and the merge's wall time and peak memory, for several
+    /// shard counts, against the one-machine bake.
+    Shards(BenchShardsArgs),
     /// Glossy reflections: the GPU time of prefiltering the map's remainder per lighting
     /// change, at each face size.
     Reflections(BenchReflectionsArgs),
@@ -44,5 +49,6 @@ pub fn run(command: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Turn(args) => bench_turn(args),
         BenchCommand::Reflections(args) => bench_reflections(args),
         BenchCommand::Composite(args) => bench_composite(args),
+        BenchCommand::Shards(args) => bench_shards(args),
     }
 }
