@@ -12,6 +12,15 @@ fn image_rgb(path: &std::path::Path) -> (u32, u32, Vec<u8>) {
     (decoded.width(), decoded.height(), decoded.into_raw())
 }
 
+/// The largest difference between two 8-bit images' samples.
+fn worst_difference(a: &[u8], b: &[u8]) -> u8 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| x.abs_diff(*y))
+        .max()
+        .expect("non-empty images")
+}
+
 #[test]
 fn without_a_display_it_says_to_use_render() {
     let out = Command::new(env!("CARGO_BIN_EXE_hprt"))
@@ -129,12 +138,7 @@ fn smoke_test_under_xvfb() {
         let (_, _, shown) = image_rgb(&d.join(screenshot));
         let (rw, rh, again) = image_rgb(&d.join(&output));
         assert_eq!((rw, rh), (w, h));
-        let worst = shown
-            .iter()
-            .zip(&again)
-            .map(|(a, b)| a.abs_diff(*b))
-            .max()
-            .unwrap();
+        let worst = worst_difference(&shown, &again);
         assert!(
             worst <= 1,
             "{script} reproduces the viewer's image (worst difference {worst})"
@@ -422,12 +426,7 @@ fn composites_a_model_into_its_environment_under_xvfb() {
         let (w, h, viewed) = image_rgb(&d.join(screenshot));
         let (rw, rh, again) = image_rgb(&d.join(&output));
         assert_eq!((rw, rh), (w, h));
-        let worst = viewed
-            .iter()
-            .zip(&again)
-            .map(|(a, b)| a.abs_diff(*b))
-            .max()
-            .unwrap();
+        let worst = worst_difference(&viewed, &again);
         assert!(
             worst <= 1,
             "{script} reproduces {screenshot} (worst {worst})"

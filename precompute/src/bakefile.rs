@@ -24,7 +24,7 @@
 
 use crate::bake::{BakeSettings, RAY_OFFSET_FRACTION, Transfer, TransferVectors};
 use foundation::infra::atomic_file::AtomicOutput;
-use foundation::infra::limits::{MAX_BAKE_BYTES, ReadError, read_regular_file};
+use foundation::infra::limits::{MAX_BAKE_BYTES, read_regular_file};
 use foundation::sh::{self, num_coeffs};
 use std::path::{Path, PathBuf};
 
@@ -219,10 +219,7 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<(BakeHeader, Transfer), BakeF
 pub fn read(path: &Path) -> Result<(BakeHeader, Transfer), BakeFileError> {
     let bytes = read_regular_file(path, MAX_BAKE_BYTES).map_err(|e| BakeFileError::Io {
         path: path.to_owned(),
-        cause: match e {
-            ReadError::Io(cause) => cause,
-            other => std::io::Error::other(other.to_string()),
-        },
+        cause: e.into(),
     })?;
     decode(path, &bytes)
 }

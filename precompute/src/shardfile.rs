@@ -35,7 +35,7 @@
 use crate::bake::shard::BakeShard;
 use crate::bake::{BakeSettings, RAY_OFFSET_FRACTION};
 use crate::bakefile::{Envelope, check_envelope, u32_at, u64_at};
-use foundation::infra::limits::{MAX_BAKE_BYTES, ReadError, read_regular_file};
+use foundation::infra::limits::{MAX_BAKE_BYTES, read_regular_file};
 use foundation::infra::shard::ShardSpec;
 use foundation::sh::{self, num_coeffs};
 use std::path::{Path, PathBuf};
@@ -301,10 +301,7 @@ fn check_operator(
 pub fn read(path: &Path) -> Result<BakeShard, ShardFileError> {
     let bytes = read_regular_file(path, MAX_BAKE_BYTES).map_err(|e| ShardFileError::Io {
         path: path.to_owned(),
-        cause: match e {
-            ReadError::Io(cause) => cause,
-            other => std::io::Error::other(other.to_string()),
-        },
+        cause: e.into(),
     })?;
     decode(path, &bytes)
 }

@@ -55,6 +55,16 @@ pub enum ReadError {
     TooLarge { size: u64, max: u64 },
 }
 
+impl From<ReadError> for std::io::Error {
+    /// The I/O error itself, or the refusal as one (for errors that hold an `io::Error`).
+    fn from(error: ReadError) -> Self {
+        match error {
+            ReadError::Io(cause) => cause,
+            other => std::io::Error::other(other.to_string()),
+        }
+    }
+}
+
 /// The bytes of the regular file at `path`, refused before reading when it is not a regular
 /// file (`/dev/zero`, a folder, a FIFO) or larger than `max` bytes.
 pub fn read_regular_file(path: &Path, max: u64) -> Result<Vec<u8>, ReadError> {
