@@ -32,12 +32,15 @@
 //!    end    4  u32 CRC-32 (IEEE) of every preceding byte
 //! ```
 
+use crate::bake::bounce::{InterreflectionOperator, OperatorBlock};
 use crate::bake::shard::BakeShard;
+use crate::bake::visibility::{CHUNK, TracedVertices};
 use crate::bake::{BakeSettings, RAY_OFFSET_FRACTION};
 use crate::bakefile::{Envelope, check_envelope, u32_at, u64_at};
-use foundation::infra::limits::{MAX_BAKE_BYTES, read_regular_file};
+use foundation::infra::limits::{MAX_BAKE_BYTES, ReadError};
 use foundation::infra::shard::ShardSpec;
 use foundation::sh::{self, num_coeffs};
+use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8; 8] = b"HPRTSHRD";
@@ -72,25 +75,46 @@ pub fn file_name(spec: ShardSpec) -> String {
     format!("bake-{}.{EXTENSION}", spec.tag())
 }
 
-fn put_u32(out: &mut Vec<u8>, v: u32) {
-    out.extend_from_slice(&v.to_le_bytes());
+/// A writer that keeps the CRC-32 of what passes through it.
+struct Checksummed<W> {
+    inner: W,
+    crc: crc32fast::Hasher,
+    written: u64,
 }
 
-fn put_u64(out: &mut Vec<u8>, v: u64) {
-    out.extend_from_slice(&v.to_le_bytes());
+impl<W: Write> Write for Checksummed<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.crc.update(&buf[..n]);
+        self.written += n as u64;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
 }
 
-fn pad4(out: &mut Vec<u8>) {
-    out.resize(out.len().div_ceil(4) * 4, 0);
+/// Writes 32-bit words little-endian, a buffer at a time (never the whole array as bytes).
+fn write_words(out: &mut impl Write, words: impl Iterator<Item = [u8; 4]>) -> std::io::Result<()> {
+    let mut buffer = Vec::with_capacity(IO_CHUNK);
+    for word in words {
+        buffer.extend_from_slice(&word);
+        if buffer.len() >= IO_CHUNK {
+            out.write_all(&buffer)?;
+            buffer.clear();
+        }
+    }
+    out.write_all(&buffer)
 }
 
-/// Serialises a shard (header, data, checksum).
-pub fn encode(shard: &BakeShard) -> Vec<u8> {
+/// Bytes moved per read or write of the data arrays.
+const IO_CHUNK: usize = 1 << 16;
+
+/// The fixed header and the scene path (zero-padded), as written.
+fn header_bytes(shard: &BakeShard, entries: usize) -> Vec<u8> {
     let s = &shard.settings;
-    let traced = &shard.traced;
-    let blocks = traced.operator.blocks();
-    let entries: usize = blocks.iter().map(|b| b.columns.len()).sum();
-    let mut out = Vec::with_capacity(HEADER_SIZE + 4 * traced.visibility.len() + 8 * entries);
+    let mut out = Vec::with_capacity(HEADER_SIZE + shard.scene_path.len() + 4);
     out.extend_from_slice(MAGIC);
     for v in [
         VERSION,
@@ -101,7 +125,7 @@ pub fn encode(shard: &BakeShard) -> Vec<u8> {
         shard.spec.index,
         shard.spec.count,
     ] {
-        put_u32(&mut out, v);
+        out.extend_from_slice(&v.to_le_bytes());
     }
     out.extend_from_slice(&RAY_OFFSET_FRACTION.to_le_bytes());
     for v in [
@@ -110,7 +134,7 @@ pub fn encode(shard: &BakeShard) -> Vec<u8> {
         shard.vertices.start as u64,
         shard.vertices.end as u64,
     ] {
-        put_u64(&mut out, v);
+        out.extend_from_slice(&v.to_le_bytes());
     }
     out.extend_from_slice(&shard.seconds.to_le_bytes());
     out.extend_from_slice(&shard.mesh_hash);
@@ -119,91 +143,216 @@ pub fn encode(shard: &BakeShard) -> Vec<u8> {
     let v = env!("CARGO_PKG_VERSION").as_bytes();
     version[..v.len().min(16)].copy_from_slice(&v[..v.len().min(16)]);
     out.extend_from_slice(&version);
-    put_u32(&mut out, shard.scene_path.len() as u32);
-    put_u64(&mut out, entries as u64);
+    out.extend_from_slice(&(shard.scene_path.len() as u32).to_le_bytes());
+    out.extend_from_slice(&(entries as u64).to_le_bytes());
     out.resize(HEADER_SIZE, 0);
     out.extend_from_slice(shard.scene_path.as_bytes());
-    pad4(&mut out);
-    out.extend(traced.visibility.iter().flat_map(|x| x.to_le_bytes()));
-    let mut offset = 0u32;
-    put_u32(&mut out, 0);
-    for block in blocks {
-        for start in &block.row_starts[1..] {
-            put_u32(&mut out, offset + start);
-        }
-        offset += block.columns.len() as u32;
-    }
-    for block in blocks {
-        out.extend(block.columns.iter().flat_map(|x| x.to_le_bytes()));
-    }
-    for block in blocks {
-        out.extend(block.weights.iter().flat_map(|x| x.to_le_bytes()));
-    }
-    out.extend(traced.inside.iter().map(|&i| u8::from(i)));
-    pad4(&mut out);
-    let crc = crc32fast::hash(&out);
-    put_u32(&mut out, crc);
+    out.resize(out.len().div_ceil(4) * 4, 0);
     out
 }
 
-/// Reads little-endian fields in order, failing on a short file instead of panicking.
-struct Reader<'a> {
-    bytes: &'a [u8],
-    at: usize,
+/// Writes a shard (header, data, checksum) to `out`, streaming: beside the shard itself only
+/// a buffer is held, so a shard of most of a large scene does not need twice its memory.
+/// Returns the bytes written.
+pub fn write(shard: &BakeShard, out: impl Write) -> std::io::Result<u64> {
+    let traced = &shard.traced;
+    let blocks = traced.operator.blocks();
+    let entries: usize = blocks.iter().map(|b| b.columns.len()).sum();
+    let mut out = Checksummed {
+        inner: out,
+        crc: crc32fast::Hasher::new(),
+        written: 0,
+    };
+    out.write_all(&header_bytes(shard, entries))?;
+    write_words(&mut out, traced.visibility.iter().map(|x| x.to_le_bytes()))?;
+    let mut offset = 0u32;
+    let mut starts = vec![0u32];
+    for block in blocks {
+        starts.extend(block.row_starts[1..].iter().map(|s| offset + s));
+        offset += block.columns.len() as u32;
+    }
+    write_words(&mut out, starts.iter().map(|x| x.to_le_bytes()))?;
+    let columns = blocks.iter().flat_map(|b| &b.columns);
+    write_words(&mut out, columns.map(|x| x.to_le_bytes()))?;
+    let weights = blocks.iter().flat_map(|b| &b.weights);
+    write_words(&mut out, weights.map(|x| x.to_le_bytes()))?;
+    let mut inside: Vec<u8> = traced.inside.iter().map(|&i| u8::from(i)).collect();
+    inside.resize(inside.len().div_ceil(4) * 4, 0);
+    out.write_all(&inside)?;
+    let crc = out.crc.clone().finalize();
+    let written = out.written + 4;
+    out.inner.write_all(&crc.to_le_bytes())?;
+    out.inner.flush()?;
+    Ok(written)
 }
 
-impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
-        let end = self
-            .at
-            .checked_add(n)
-            .filter(|&e| e <= self.bytes.len())
-            .ok_or_else(|| format!("truncated: {n} bytes wanted at offset {}", self.at))?;
-        let out = &self.bytes[self.at..end];
-        self.at = end;
-        Ok(out)
-    }
+/// Serialises a shard in memory ([`write`]).
+pub fn encode(shard: &BakeShard) -> Vec<u8> {
+    let mut out = Vec::new();
+    write(shard, &mut out).expect("writing to memory cannot fail");
+    out
+}
 
-    fn u32s(&mut self, n: usize) -> Result<Vec<u32>, String> {
-        let bytes = self.take(n.checked_mul(4).ok_or("impossible size")?)?;
-        Ok(bytes
-            .chunks_exact(4)
-            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .collect())
-    }
+/// Where a shard file's sections start, from its header and checked against its length.
+struct Layout {
+    rows: usize,
+    entries: usize,
+    path: u64,
+    path_len: usize,
+    visibility: u64,
+    row_starts: u64,
+    columns: u64,
+    weights: u64,
+    inside: u64,
+}
 
-    fn f32s(&mut self, n: usize) -> Result<Vec<f32>, String> {
-        Ok(self.u32s(n)?.into_iter().map(f32::from_bits).collect())
+impl Layout {
+    /// The sections of a file of `len` bytes whose header is `header` (its first
+    /// [`HEADER_SIZE`] bytes); an error when the header's sizes do not add up to `len`.
+    fn of(header: &[u8], len: u64) -> Result<Self, String> {
+        let order = u32_at(header, 16) as usize;
+        sh::check_order(order).map_err(|e| e.to_string())?;
+        let (vertex_count, first, end) =
+            (u64_at(header, 48), u64_at(header, 56), u64_at(header, 64));
+        if first > end || end > vertex_count || vertex_count > u64::from(u32::MAX) {
+            return Err(format!("vertex range {first}..{end} of {vertex_count}"));
+        }
+        let rows = end - first;
+        let entries = u64_at(header, 164);
+        let path_len = u64::from(u32_at(header, 160));
+        let coeffs = num_coeffs(order) as u64;
+        let sizes = [
+            path_len.div_ceil(4) * 4,
+            rows.checked_mul(4 * coeffs).ok_or("size")?,
+            4 * (rows + 1),
+            entries.checked_mul(4).ok_or("size")?,
+            entries.checked_mul(4).ok_or("size")?,
+            rows.div_ceil(4) * 4,
+        ];
+        let mut starts = [0u64; 6];
+        let mut at = HEADER_SIZE as u64;
+        for (start, size) in starts.iter_mut().zip(sizes) {
+            *start = at;
+            at = at.checked_add(size).ok_or("size")?;
+        }
+        if at + 4 != len {
+            return Err(format!(
+                "{len} bytes where its header describes {} (truncated or damaged)",
+                at + 4
+            ));
+        }
+        Ok(Self {
+            rows: rows as usize,
+            entries: entries as usize,
+            path: starts[0],
+            path_len: path_len as usize,
+            visibility: starts[1],
+            row_starts: starts[2],
+            columns: starts[3],
+            weights: starts[4],
+            inside: starts[5],
+        })
     }
+}
 
-    fn skip_to_multiple_of_4(&mut self) -> Result<(), String> {
-        let pad = self.at.div_ceil(4) * 4 - self.at;
-        self.take(pad).map(|_| ())
+/// Reads `count` little-endian 32-bit words at `offset`.
+fn read_words<R: Read + Seek>(
+    source: &mut R,
+    offset: u64,
+    count: usize,
+) -> std::io::Result<Vec<u32>> {
+    source.seek(SeekFrom::Start(offset))?;
+    let mut out = Vec::with_capacity(count);
+    let mut buffer = vec![0u8; IO_CHUNK];
+    let mut left = count * 4;
+    while left > 0 {
+        let chunk = &mut buffer[..left.min(IO_CHUNK)];
+        source.read_exact(chunk)?;
+        out.extend(
+            chunk
+                .chunks_exact(4)
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        );
+        left -= chunk.len();
     }
+    Ok(out)
+}
+
+/// The CRC-32 of the first `len` bytes of `source`, read a buffer at a time.
+fn checksum<R: Read + Seek>(source: &mut R, len: u64) -> std::io::Result<u32> {
+    source.seek(SeekFrom::Start(0))?;
+    let mut crc = crc32fast::Hasher::new();
+    let mut buffer = vec![0u8; IO_CHUNK];
+    let mut left = len;
+    while left > 0 {
+        let chunk = &mut buffer[..left.min(IO_CHUNK as u64) as usize];
+        source.read_exact(chunk)?;
+        crc.update(chunk);
+        left -= chunk.len() as u64;
+    }
+    Ok(crc.finalize())
 }
 
 /// Parses bytes written by [`encode`]; `path` only names the file in errors.
 pub fn decode(path: &Path, bytes: &[u8]) -> Result<BakeShard, ShardFileError> {
+    decode_from(path, &mut std::io::Cursor::new(bytes), bytes.len() as u64)
+}
+
+/// Reads and verifies a shard file: checksum first (one pass over the file), then the data
+/// straight into the shard's arrays, so reading holds no copy of the file.
+pub fn read(path: &Path) -> Result<BakeShard, ShardFileError> {
+    let io = |cause: std::io::Error| ShardFileError::Io {
+        path: path.to_owned(),
+        cause,
+    };
+    let metadata = std::fs::metadata(path).map_err(io)?;
+    if !metadata.is_file() {
+        return Err(io(ReadError::NotAFile.into()));
+    }
+    if metadata.len() > MAX_BAKE_BYTES {
+        return Err(io(ReadError::TooLarge {
+            size: metadata.len(),
+            max: MAX_BAKE_BYTES,
+        }
+        .into()));
+    }
+    let file = std::fs::File::open(path).map_err(io)?;
+    decode_from(path, &mut std::io::BufReader::new(file), metadata.len())
+}
+
+/// [`decode`] from a source of `len` bytes.
+fn decode_from<R: Read + Seek>(
+    path: &Path,
+    source: &mut R,
+    len: u64,
+) -> Result<BakeShard, ShardFileError> {
     let corrupt = |message: String| ShardFileError::Corrupt {
         path: path.to_owned(),
         message,
     };
-    check_envelope(bytes, MAGIC, HEADER_SIZE, VERSION).map_err(|e| match e {
+    let io = |cause: std::io::Error| ShardFileError::Io {
+        path: path.to_owned(),
+        cause,
+    };
+    let mut header = vec![0u8; len.min(HEADER_SIZE as u64 + 4) as usize];
+    source.read_exact(&mut header).map_err(io)?;
+    check_envelope(&header, MAGIC, HEADER_SIZE, VERSION).map_err(|e| match e {
         Envelope::Magic => ShardFileError::NotAShard {
             path: path.to_owned(),
         },
-        Envelope::Short(n) => corrupt(format!("only {n} bytes")),
+        Envelope::Short(_) => corrupt(format!("only {len} bytes")),
         Envelope::Version(found) => ShardFileError::Version {
             path: path.to_owned(),
             found,
         },
     })?;
-    let stored_crc = u32_at(bytes, bytes.len() - 4);
-    let body = &bytes[..bytes.len() - 4];
-    if crc32fast::hash(body) != stored_crc {
+    let mut stored = [0u8; 4];
+    source.seek(SeekFrom::Start(len - 4)).map_err(io)?;
+    source.read_exact(&mut stored).map_err(io)?;
+    if checksum(source, len - 4).map_err(io)? != u32::from_le_bytes(stored) {
         return Err(corrupt("checksum mismatch (truncated or damaged)".into()));
     }
-    let hprt = String::from_utf8_lossy(&bytes[144..160])
+    let hprt = String::from_utf8_lossy(&header[144..160])
         .trim_end_matches('\0')
         .to_owned();
     if hprt != env!("CARGO_PKG_VERSION") {
@@ -212,96 +361,218 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<BakeShard, ShardFileError> {
             found: hprt,
         });
     }
-    decode_checked(body).map_err(corrupt)
+    let layout = Layout::of(&header, len).map_err(corrupt)?;
+    decode_checked(&header, &layout, source).map_err(|e| match e {
+        Decode::Io(cause) => io(cause),
+        Decode::Corrupt(message) => corrupt(message),
+    })
 }
 
-/// The fields of a shard whose header, version and checksum passed.
-fn decode_checked(body: &[u8]) -> Result<BakeShard, String> {
-    let order = u32_at(body, 16) as usize;
-    sh::check_order(order).map_err(|e| e.to_string())?;
+/// Why the data of a shard whose header passed cannot be read.
+enum Decode {
+    Io(std::io::Error),
+    Corrupt(String),
+}
+
+impl From<std::io::Error> for Decode {
+    fn from(e: std::io::Error) -> Self {
+        Self::Io(e)
+    }
+}
+
+impl From<String> for Decode {
+    fn from(e: String) -> Self {
+        Self::Corrupt(e)
+    }
+}
+
+/// The fields of a shard whose header, version, length and checksum passed; the operator is
+/// read block by block into its final arrays.
+fn decode_checked<R: Read + Seek>(
+    header: &[u8],
+    layout: &Layout,
+    source: &mut R,
+) -> Result<BakeShard, Decode> {
+    let order = u32_at(header, 16) as usize;
     let settings = BakeSettings {
         order,
-        bounces: u32_at(body, 20),
-        samples: u32_at(body, 24),
-        seed: u64_at(body, 40),
+        bounces: u32_at(header, 20),
+        samples: u32_at(header, 24),
+        seed: u64_at(header, 40),
     };
     settings.validate().map_err(|e| e.to_string())?;
-    let spec = ShardSpec::new(u32_at(body, 28), u32_at(body, 32))?;
-    let ray_offset = f32::from_le_bytes(body[36..40].try_into().expect("4 bytes"));
+    let spec = ShardSpec::new(u32_at(header, 28), u32_at(header, 32))?;
+    let ray_offset = f32::from_le_bytes(header[36..40].try_into().expect("4 bytes"));
     if ray_offset != RAY_OFFSET_FRACTION {
-        return Err(format!(
-            "ray offset {ray_offset}, this hprt uses {RAY_OFFSET_FRACTION}"
-        ));
+        return Err(
+            format!("ray offset {ray_offset}, this hprt uses {RAY_OFFSET_FRACTION}").into(),
+        );
     }
-    let vertex_count = u64_at(body, 48);
-    let (first, end) = (u64_at(body, 56), u64_at(body, 64));
-    if first > end || end > vertex_count || vertex_count > u64::from(u32::MAX) {
-        return Err(format!("vertex range {first}..{end} of {vertex_count}"));
+    let vertex_count = u64_at(header, 48);
+    let first = u64_at(header, 56) as usize;
+    let mut path_bytes = vec![0u8; layout.path_len];
+    source.seek(SeekFrom::Start(layout.path))?;
+    source.read_exact(&mut path_bytes)?;
+    let visibility: Vec<f32> =
+        read_words(source, layout.visibility, layout.rows * num_coeffs(order))?
+            .into_iter()
+            .map(f32::from_bits)
+            .collect();
+    let row_starts = read_words(source, layout.row_starts, layout.rows + 1)?;
+    check_rows(&row_starts, layout.entries)?;
+    let mut blocks = Vec::with_capacity(layout.rows.div_ceil(CHUNK));
+    for first_row in (0..layout.rows).step_by(CHUNK) {
+        let end = (first_row + CHUNK).min(layout.rows);
+        let (base, stop) = (row_starts[first_row], row_starts[end]);
+        let count = (stop - base) as usize;
+        let columns = read_words(source, layout.columns + 4 * u64::from(base), count)?;
+        if columns.iter().any(|&c| u64::from(c) >= vertex_count) {
+            return Err("operator column beyond the scene's vertices"
+                .to_string()
+                .into());
+        }
+        let weights: Vec<f32> = read_words(source, layout.weights + 4 * u64::from(base), count)?
+            .into_iter()
+            .map(f32::from_bits)
+            .collect();
+        check_finite(&weights)?;
+        blocks.push(OperatorBlock {
+            row_starts: row_starts[first_row..=end]
+                .iter()
+                .map(|s| s - base)
+                .collect(),
+            columns,
+            weights,
+        });
     }
-    let rows = (end - first) as usize;
-    let entries = usize::try_from(u64_at(body, 164)).map_err(|_| "entry count".to_string())?;
-    let mut reader = Reader {
-        bytes: body,
-        at: HEADER_SIZE,
-    };
-    let path_len = u32_at(body, 160) as usize;
-    let scene_path = String::from_utf8_lossy(reader.take(path_len)?).into_owned();
-    reader.skip_to_multiple_of_4()?;
-    let visibility = reader.f32s(rows.checked_mul(num_coeffs(order)).ok_or("size")?)?;
-    let row_starts = reader.u32s(rows + 1)?;
-    let columns = reader.u32s(entries)?;
-    let weights = reader.f32s(entries)?;
-    let inside: Vec<bool> = reader.take(rows)?.iter().map(|&b| b != 0).collect();
-    reader.skip_to_multiple_of_4()?;
-    if reader.at != body.len() {
-        return Err(format!("{} bytes after the data", body.len() - reader.at));
-    }
-    check_operator(&row_starts, &columns, vertex_count, entries)?;
-    if let Some(x) = visibility.iter().chain(&weights).find(|x| !x.is_finite()) {
-        return Err(format!("a stored value is {x} (finite numbers only)"));
-    }
+    check_finite(&visibility)?;
+    let mut inside = vec![0u8; layout.rows];
+    source.seek(SeekFrom::Start(layout.inside))?;
+    source.read_exact(&mut inside)?;
     Ok(BakeShard {
         spec,
         settings,
         vertex_count,
-        vertices: first as usize..end as usize,
-        mesh_hash: body[80..112].try_into().expect("32 bytes"),
-        partition_hash: body[112..144].try_into().expect("32 bytes"),
-        scene_path,
-        seconds: f64::from_le_bytes(body[72..80].try_into().expect("8 bytes")),
-        traced: crate::bake::shard::traced_from_rows(
+        vertices: first..first + layout.rows,
+        mesh_hash: header[80..112].try_into().expect("32 bytes"),
+        partition_hash: header[112..144].try_into().expect("32 bytes"),
+        scene_path: String::from_utf8_lossy(&path_bytes).into_owned(),
+        seconds: f64::from_le_bytes(header[72..80].try_into().expect("8 bytes")),
+        traced: TracedVertices {
             order,
             visibility,
-            &row_starts,
-            columns,
-            weights,
-            inside,
-        ),
+            operator: InterreflectionOperator::from_blocks(blocks),
+            inside: inside.into_iter().map(|b| b != 0).collect(),
+        },
     })
 }
 
-/// Row starts that rise from 0 to the entry count, columns that name scene vertices.
-fn check_operator(
-    row_starts: &[u32],
-    columns: &[u32],
-    vertex_count: u64,
-    entries: usize,
-) -> Result<(), String> {
-    let rising = row_starts.windows(2).all(|w| w[0] <= w[1]);
-    if row_starts.first() != Some(&0) || !rising || row_starts.last() != Some(&(entries as u32)) {
-        return Err("operator rows out of order".into());
+fn check_finite(values: &[f32]) -> Result<(), String> {
+    match values.iter().find(|x| !x.is_finite()) {
+        Some(x) => Err(format!("a stored value is {x} (finite numbers only)")),
+        None => Ok(()),
     }
-    if columns.iter().any(|&c| u64::from(c) >= vertex_count) {
-        return Err("operator column beyond the scene's vertices".into());
+}
+
+/// Row starts that rise from 0 to the entry count.
+fn check_rows(row_starts: &[u32], entries: usize) -> Result<(), String> {
+    let rising = row_starts.windows(2).all(|w| w[0] <= w[1]);
+    if row_starts.first() != Some(&0)
+        || !rising
+        || row_starts.last().map(|&e| e as usize) != Some(entries)
+    {
+        return Err("operator rows out of order".into());
     }
     Ok(())
 }
 
-/// Reads and verifies a shard file.
-pub fn read(path: &Path) -> Result<BakeShard, ShardFileError> {
-    let bytes = read_regular_file(path, MAX_BAKE_BYTES).map_err(|e| ShardFileError::Io {
-        path: path.to_owned(),
-        cause: e.into(),
-    })?;
-    decode(path, &bytes)
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bake::shard::trace_shard;
+    use foundation::bvh::SceneBvh;
+    use foundation::color::Rgb;
+    use foundation::infra::progress::NoProgress;
+    use foundation::mesh::{box_mesh, sphere_mesh};
+    use foundation::scene::SceneMesh;
+    use glam::Vec3;
+
+    fn shard() -> BakeShard {
+        let mut scene = SceneMesh::default();
+        // A ball over a floor: rays between them fill the operator.
+        let floor = box_mesh(
+            Vec3::new(-2.0, -0.7, -2.0),
+            Vec3::new(2.0, -0.5, 2.0),
+            [8, 1, 8],
+            [false; 6],
+        );
+        scene.push_object("floor".into(), &floor, Rgb::splat(0.6));
+        let ball = sphere_mesh(Vec3::ZERO, 0.5, 3);
+        scene.push_object("ball".into(), &ball, Rgb::splat(0.7));
+        let bvh = SceneBvh::build(&scene.mesh);
+        let settings = BakeSettings {
+            order: 3,
+            samples: 40,
+            bounces: 1,
+            seed: 3,
+        };
+        let spec = ShardSpec::new(1, 2).unwrap();
+        trace_shard(&scene, &bvh, &settings, spec, "ball.toml", &NoProgress).unwrap()
+    }
+
+    /// `bytes` with its checksum made right again (a damage the checksum cannot see).
+    fn resealed(mut bytes: Vec<u8>) -> Vec<u8> {
+        let n = bytes.len() - 4;
+        let crc = crc32fast::hash(&bytes[..n]);
+        bytes[n..].copy_from_slice(&crc.to_le_bytes());
+        bytes
+    }
+
+    fn message(bytes: &[u8]) -> String {
+        match decode(Path::new("s.hprtshard"), bytes) {
+            Ok(_) => panic!("a damaged shard was read"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn a_file_read_back_in_pieces_equals_the_shard() {
+        let shard = shard();
+        let blocks = shard.traced.operator.blocks();
+        assert!(blocks.len() > 2 && blocks.iter().any(|b| !b.columns.is_empty()));
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.hprtshard");
+        let written = write(&shard, std::fs::File::create(&path).unwrap()).unwrap();
+        assert_eq!(written, std::fs::metadata(&path).unwrap().len());
+        assert!(std::fs::read(&path).unwrap() == encode(&shard));
+        assert_eq!(read(&path).unwrap(), shard);
+    }
+
+    #[test]
+    fn damaged_truncated_or_foreign_shards_are_refused_with_the_reason() {
+        let bytes = encode(&shard());
+        assert!(message(&bytes[..bytes.len() - 40]).contains("checksum"));
+        assert!(message(&bytes[..100]).contains("only 100 bytes"));
+        let mut flipped = bytes.clone();
+        flipped[HEADER_SIZE + 20] ^= 1;
+        assert!(message(&flipped).contains("checksum"));
+        // Another hprt version, checksum intact.
+        let mut other = bytes.clone();
+        other[144..160].copy_from_slice(b"0.0.1\0\0\0\0\0\0\0\0\0\0\0");
+        let text = message(&resealed(other));
+        assert!(text.contains("made by hprt 0.0.1"), "{text}");
+        // A header that promises more operator entries than the file holds.
+        let mut more = bytes.clone();
+        let entries = u64_at(&more, 164) + 1;
+        more[164..172].copy_from_slice(&entries.to_le_bytes());
+        let text = message(&resealed(more));
+        assert!(text.contains("where its header describes"), "{text}");
+        // An operator column that names a vertex the scene does not have.
+        let layout = Layout::of(&bytes[..HEADER_SIZE], bytes.len() as u64).unwrap();
+        let mut column = bytes.clone();
+        let at = layout.columns as usize;
+        column[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+        let text = message(&resealed(column));
+        assert!(text.contains("beyond the scene's vertices"), "{text}");
+    }
 }

@@ -282,11 +282,48 @@ pub struct CubeResampler {
     size: usize,
     map_width: usize,
     map_height: usize,
-    /// Source texel `k` deposits into `targets[starts[k]..starts[k + 1]]` with the matching
-    /// `gains` (energy share divided by the target's solid angle: a radiance gain).
+    /// Cube texel `t` gathers source texels `sources[starts[t]..starts[t + 1]]` (in increasing
+    /// order) with the matching `gains` (energy share divided by the target's solid angle: a
+    /// radiance gain). A gather keeps each sum in registers, where scattering from the source
+    /// texels would read and write the cube texel once per share.
     starts: Vec<u32>,
-    targets: Vec<u32>,
+    sources: Vec<u32>,
     gains: Vec<f32>,
+}
+
+/// The shares of source texels (`targets[starts[k]..starts[k + 1]]` for source `k`, with
+/// `gains`) regrouped by target, each target's sources in increasing order: the same terms
+/// summed in the same order as scattering them source after source.
+fn by_target(
+    starts: &[u32],
+    targets: &[u32],
+    gains: &[f32],
+    target_count: usize,
+) -> (Vec<u32>, Vec<u32>, Vec<f32>) {
+    let mut counts = vec![0u32; target_count + 1];
+    for &t in targets {
+        counts[t as usize + 1] += 1;
+    }
+    for t in 0..target_count {
+        counts[t + 1] += counts[t];
+    }
+    let mut next = counts.clone();
+    let mut sources = vec![0u32; targets.len()];
+    let mut by_target_gains = vec![0f32; targets.len()];
+    for k in 0..starts.len() - 1 {
+        for e in starts[k] as usize..starts[k + 1] as usize {
+            let slot = &mut next[targets[e] as usize];
+            sources[*slot as usize] = k as u32;
+            by_target_gains[*slot as usize] = gains[e];
+            *slot += 1;
+        }
+    }
+    (counts, sources, by_target_gains)
+}
+
+thread_local! {
+    /// The source map shifted by a rotation, reused from frame to frame.
+    static SHIFTED_SOURCE: std::cell::RefCell<Vec<Rgb>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 impl CubeResampler {
@@ -350,17 +387,18 @@ impl CubeResampler {
             &reference,
             geometry.solid_angles(),
         );
-        let gains = targets
+        let gains: Vec<f32> = targets
             .iter()
             .zip(&overlaps)
             .map(|(t, a)| (*a / geometry.solid_angles()[*t as usize] as f64) as f32)
             .collect();
+        let (starts, sources, gains) = by_target(&starts, &targets, &gains, geometry.texel_count());
         Self {
             size,
             map_width,
             map_height,
             starts,
-            targets,
+            sources,
             gains,
         }
     }
@@ -381,28 +419,28 @@ impl CubeResampler {
         assert_eq!(out.size, self.size);
         let w = self.map_width;
         let shift = (rotation / std::f32::consts::TAU).rem_euclid(1.0) * w as f32;
-        let (whole, t) = (shift.floor() as usize, shift.fract());
-        out.texels.iter_mut().for_each(|c| *c = Rgb::ZERO);
+        let (whole, t) = (shift.floor() as usize % w, shift.fract());
         let texels = map.texels();
-        // One source row, rotated, with its first texel repeated at the end for the lerp.
-        let mut shifted = Vec::with_capacity(w + 1);
-        for j in 0..self.map_height {
-            let row = &texels[j * w..(j + 1) * w];
-            shifted.clear();
-            shifted.extend_from_slice(&row[whole..]);
-            shifted.extend_from_slice(&row[..whole]);
-            shifted.push(shifted[0]);
-            let first = self.starts[j * w] as usize;
-            let mut entry = first;
-            for i in 0..w {
-                let value = shifted[i] * (1.0 - t) + shifted[i + 1] * t;
-                let end = self.starts[j * w + i + 1] as usize;
-                while entry < end {
-                    out.texels[self.targets[entry] as usize] += value * self.gains[entry];
-                    entry += 1;
-                }
+        SHIFTED_SOURCE.with_borrow_mut(|lerped| {
+            lerped.clear();
+            // Each source row, rotated, with its first texel repeated at the end for the lerp.
+            let mut shifted = Vec::with_capacity(w + 1);
+            for row in texels.chunks_exact(w) {
+                shifted.clear();
+                shifted.extend_from_slice(&row[whole..]);
+                shifted.extend_from_slice(&row[..whole]);
+                shifted.push(shifted[0]);
+                lerped.extend(shifted.windows(2).map(|p| p[0] * (1.0 - t) + p[1] * t));
             }
-        }
+            for (texel, range) in out.texels.iter_mut().zip(self.starts.windows(2)) {
+                let range = range[0] as usize..range[1] as usize;
+                let mut sum = Rgb::ZERO;
+                for (s, g) in self.sources[range.clone()].iter().zip(&self.gains[range]) {
+                    sum += lerped[*s as usize] * *g;
+                }
+                *texel = sum;
+            }
+        });
     }
 
     pub fn resample(&self, map: &EnvMap, rotation: f32) -> CubeMap {

@@ -21,8 +21,8 @@ pub use decompose::{
 };
 pub use light::DirectionalLight;
 pub use lighting::{
-    EnvironmentLighting, FrameLighting, LitFrame, RenderMode, ShTransfer, lights_indirect_default,
-    map_rotation,
+    EnvironmentLighting, FrameCost, FrameLighting, LitFrame, RenderMode, ShTransfer,
+    lights_indirect_default, map_rotation,
 };
 pub use peers::median_cut::{MedianCutError, analysis_map, median_cut};
 pub use reflection::{ReflectedEnvironment, SharedCube, convolve_exact};

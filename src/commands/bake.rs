@@ -185,8 +185,8 @@ fn run_shard(
         let name = scene_path.to_string_lossy();
         bake::shard::trace_shard(&scene.geometry, &bvh, settings, spec, &name, &progress)
     })??;
-    let bytes = shardfile::encode(&shard);
-    file.commit(&bytes)
+    let bytes = file
+        .commit_streamed(|out| shardfile::write(&shard, out))
         .with_context(|| format!("cannot write {}", path.display()))?;
     println!(
         "traced vertices {}..{} of {} in {:.2} s; wrote {} ({:.1} MB)",
@@ -195,7 +195,7 @@ fn run_shard(
         shard.vertex_count,
         shard.seconds,
         path.display(),
-        bytes.len() as f64 / 1e6
+        bytes as f64 / 1e6
     );
     Ok(())
 }

@@ -137,6 +137,33 @@ impl AtomicOutput {
     pub fn commit(self, bytes: &[u8]) -> Result<(), std::io::Error> {
         commit_all(vec![(self, bytes)])
     }
+
+    /// Lets `write` stream the contents (through a buffer), then moves the file into place:
+    /// for outputs too large to assemble in memory first. Returns what `write` returned.
+    pub fn commit_streamed<T>(
+        mut self,
+        write: impl FnOnce(&mut dyn Write) -> Result<T, std::io::Error>,
+    ) -> Result<T, std::io::Error> {
+        match self.target.take() {
+            None => Err(std::io::Error::other("output already committed")),
+            Some(Target::Direct(file)) => write(&mut std::io::BufWriter::new(file)),
+            Some(Target::Temporary(mut temp)) => {
+                let written = (|| -> Result<T, std::io::Error> {
+                    let mut out = std::io::BufWriter::new(temp.as_file_mut());
+                    let value = write(&mut out)?;
+                    out.flush()?;
+                    drop(out);
+                    temp.as_file().sync_all()?;
+                    Ok(value)
+                })();
+                // Either way the temporary file is now this function's to keep or drop.
+                forget_partial(temp.path());
+                let value = written?;
+                temp.persist(&self.path).map_err(|e| e.error)?;
+                Ok(value)
+            }
+        }
+    }
 }
 
 /// Writes several outputs all or none: every temporary file is written and synced first, and

@@ -7,11 +7,11 @@
 //! interreflection operator `W` (vertex × vertex), so each Neumann-series bounce
 //! `T_b = diag(ρ) W T_{b-1}` reuses every hit without tracing again.
 
-mod bounce;
+pub(crate) mod bounce;
 mod inside;
 pub mod shard;
 mod transfer;
-mod visibility;
+pub(crate) mod visibility;
 
 pub use bounce::InterreflectionOperator;
 pub use inside::VertexNeighbours;

@@ -8,7 +8,7 @@
 //! The cost is estimated by tracing a few probe rays from a subset of vertices and counting
 //! the nodes they visit, which depends only on the scene, so every shard finds the same split.
 
-use super::bounce::{InterreflectionOperator, OperatorBlock};
+use super::bounce::InterreflectionOperator;
 use super::visibility::{self, TracedVertices};
 use super::{BakeSettings, BakeStats, TracedScene, Transfer};
 use foundation::bvh::SceneBvh;
@@ -167,9 +167,16 @@ pub fn merge(
     let settings = first.settings;
     let seconds = shards.iter().map(|s| s.seconds).sum();
     let order = settings.order;
-    let mut visibility = Vec::new();
-    let mut inside = Vec::new();
-    let mut blocks = Vec::new();
+    // Sized once: growing would hold the old and the new array at the same time.
+    let rows: usize = shards.iter().map(|s| s.vertices.len()).sum();
+    let mut visibility = Vec::with_capacity(shards.iter().map(|s| s.traced.visibility.len()).sum());
+    let mut inside = Vec::with_capacity(rows);
+    let mut blocks = Vec::with_capacity(
+        shards
+            .iter()
+            .map(|s| s.traced.operator.blocks().len())
+            .sum(),
+    );
     for shard in shards {
         visibility.extend(shard.traced.visibility);
         inside.extend(shard.traced.inside);
@@ -183,38 +190,6 @@ pub fn merge(
     };
     let traced = TracedScene::new(geometry, &settings, traced, seconds);
     Ok(super::sum_bounces(geometry, &settings, traced, progress))
-}
-
-/// A shard's tracing results from its stored rows (the operator cut into the blocks the
-/// bounces work on in parallel).
-pub(crate) fn traced_from_rows(
-    order: usize,
-    visibility: Vec<f32>,
-    row_starts: &[u32],
-    columns: Vec<u32>,
-    weights: Vec<f32>,
-    inside: Vec<bool>,
-) -> TracedVertices {
-    let rows = row_starts.len() - 1;
-    let blocks = (0..rows)
-        .step_by(visibility::CHUNK)
-        .map(|first| {
-            let end = (first + visibility::CHUNK).min(rows);
-            let base = row_starts[first];
-            let range = base as usize..row_starts[end] as usize;
-            OperatorBlock {
-                row_starts: row_starts[first..=end].iter().map(|s| s - base).collect(),
-                columns: columns[range.clone()].to_vec(),
-                weights: weights[range].to_vec(),
-            }
-        })
-        .collect();
-    TracedVertices {
-        order,
-        visibility,
-        operator: InterreflectionOperator::from_blocks(blocks),
-        inside,
-    }
 }
 
 #[cfg(test)]
@@ -340,6 +315,18 @@ mod tests {
                 ..
             }))
         ));
+        let twice = merge(
+            &scene,
+            vec![shard(0, 2, &s), shard(1, 2, &s), shard(1, 2, &s)],
+            &NoProgress,
+        );
+        assert_eq!(
+            twice.err(),
+            Some(MergeError::Incomplete(IncompleteShards::Duplicate {
+                index: 1,
+                count: 2
+            }))
+        );
         let other_seed = BakeSettings { seed: 8, ..s };
         let mixed = merge(
             &scene,

@@ -71,7 +71,10 @@ pub struct Decomposer {
     detection_window: Vec<f32>,
     sh_window: Vec<f32>,
     // Per-frame scratch buffers.
-    smoothed: Vec<Rgb>,
+    /// The analysis map's luminance.
+    luminances: Vec<f32>,
+    /// Its smoothed luminance at the icosahedron's vertices.
+    smoothed: Vec<f32>,
     ring: Vec<u32>,
     cap: Vec<u32>,
     owner: Vec<(u16, f32)>,
@@ -122,6 +125,7 @@ impl Decomposer {
             smoothing,
             projector,
             ico_basis,
+            luminances: Vec::new(),
             smoothed: Vec::new(),
             ring: Vec::new(),
             cap: Vec::new(),
@@ -263,14 +267,19 @@ impl Decomposer {
         } else {
             &self.analysis_map
         };
-        self.smoothing.apply(analysis, &mut self.smoothed);
+        // Smoothing is linear: the luminance of the smoothed map is the smoothed luminance.
+        self.luminances.clear();
+        self.luminances
+            .extend(analysis.texels().iter().map(|c| luminance(*c)));
+        self.smoothing
+            .apply_scalar(&self.luminances, &mut self.smoothed);
         let mut expansion = Vec::new();
         self.ico_basis.eval_all(detection, &mut expansion);
         let residual: Vec<f32> = self
             .smoothed
             .iter()
             .zip(&expansion)
-            .map(|(s, p)| luminance(*s - *p))
+            .map(|(s, p)| *s - luminance(*p))
             .collect();
         let floor = self.settings.min_contrast * mean_luminance;
         let mut maxima: Vec<u32> = self

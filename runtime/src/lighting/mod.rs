@@ -10,4 +10,4 @@ mod tests;
 pub use frame::{
     FrameLighting, LitFrame, RenderMode, ShTransfer, lights_indirect_default, map_rotation,
 };
-pub use service::EnvironmentLighting;
+pub use service::{EnvironmentLighting, FrameCost};

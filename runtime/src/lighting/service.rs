@@ -91,6 +91,17 @@ struct MapDerived {
 /// turning map keeps exactly the same lights, rotated, and costs no new decomposition per
 /// frame. A map that changes ([`Self::set_map`]) can have its lights tracked from frame to
 /// frame ([`Self::enable_tracking`], [`LightTracker`]).
+/// What one resampled decomposition cost, by stage, in milliseconds of one thread.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FrameCost {
+    /// The map turned and resampled to the cube.
+    pub resample_ms: f64,
+    /// The decomposition proper ([`Decomposer::decompose`]).
+    pub decompose_ms: f64,
+    /// The sizes of the lights' sources, measured on the full map.
+    pub sources_ms: f64,
+}
+
 pub struct EnvironmentLighting {
     /// The map as given (the background is drawn from it).
     map: EnvMap,
@@ -256,8 +267,16 @@ impl EnvironmentLighting {
     /// `rotation_deg` about +Y and decompose it again. Its lights jump and flicker as the
     /// sources move against the cube's texels; [`Self::decompose`] does not.
     pub fn decompose_resampled(&mut self, rotation_deg: f32) -> Decomposition {
+        self.decompose_resampled_timed(rotation_deg).0
+    }
+
+    /// [`Self::decompose_resampled`], with what each stage of it cost.
+    pub fn decompose_resampled_timed(&mut self, rotation_deg: f32) -> (Decomposition, FrameCost) {
+        let start = Instant::now();
         let cube = self.source.cube(rotation_deg.to_radians());
+        let resampled = Instant::now();
         let mut decomposition = self.decomposer.decompose(&cube);
+        let decomposed = Instant::now();
         let to_map = Quat::from_rotation_y(-rotation_deg.to_radians());
         for light in &mut decomposition.lights {
             light.direction = to_map * light.direction;
@@ -266,7 +285,13 @@ impl EnvironmentLighting {
         for light in &mut decomposition.lights {
             light.direction = (to_map.inverse() * light.direction).normalize();
         }
-        decomposition
+        let ms = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e3;
+        let cost = FrameCost {
+            resample_ms: ms(start, resampled),
+            decompose_ms: ms(resampled, decomposed),
+            sources_ms: ms(decomposed, Instant::now()),
+        };
+        (decomposition, cost)
     }
 
     /// The SH part plus lights of the map at the current orientation; when tracking, the

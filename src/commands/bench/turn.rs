@@ -40,6 +40,8 @@ struct TurnStats {
     direction_error_deg: f64,
     /// Median per-frame CPU cost, milliseconds.
     frame_ms: f64,
+    /// Medians of the stages of a resampled frame (zero when rotated).
+    stages: runtime::FrameCost,
 }
 
 fn turn_stats(
@@ -53,6 +55,7 @@ fn turn_stats(
         ..Default::default()
     };
     let (mut powers, mut times) = (Vec::new(), Vec::new());
+    let mut stages = Vec::new();
     let mut previous_count = None;
     let mut first_direction = None;
     for k in 0..steps {
@@ -60,7 +63,9 @@ fn turn_stats(
         lighting.set_rotation(angle);
         let start = std::time::Instant::now();
         let d = if resampled {
-            lighting.decompose_resampled(angle)
+            let (d, cost) = lighting.decompose_resampled_timed(angle);
+            stages.push(cost);
+            d
         } else {
             lighting.decompose()
         };
@@ -92,6 +97,14 @@ fn turn_stats(
         .fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     stats.power_variation = if mean > 0.0 { (hi - lo) / mean } else { 0.0 };
     stats.frame_ms = median(times);
+    if !stages.is_empty() {
+        let stage = |f: fn(&runtime::FrameCost) -> f64| median(stages.iter().map(f).collect());
+        stats.stages = runtime::FrameCost {
+            resample_ms: stage(|c| c.resample_ms),
+            decompose_ms: stage(|c| c.decompose_ms),
+            sources_ms: stage(|c| c.sources_ms),
+        };
+    }
     stats
 }
 
@@ -109,8 +122,15 @@ pub(super) fn bench_turn(args: BenchTurnArgs) -> anyhow::Result<()> {
         args.order
     );
     println!(
-        "{:<10} {:<12} {:>8} {:>7} {:>9} {:>10} {:>12}",
-        "map", "method", "changes", "lights", "power", "dir err °", "ms/frame"
+        "{:<10} {:<12} {:>8} {:>7} {:>9} {:>10} {:>12} {:>26}",
+        "map",
+        "method",
+        "changes",
+        "lights",
+        "power",
+        "dir err °",
+        "ms/frame",
+        "resample/decompose/sources"
     );
     for path in &args.maps {
         let map = load_map(path, None)?.map;
@@ -122,21 +142,33 @@ pub(super) fn bench_turn(args: BenchTurnArgs) -> anyhow::Result<()> {
             .unwrap_or_default();
         for (method, resampled) in [("redecompose", true), ("rotate", false)] {
             let s = turn_stats(&mut lighting, args.step, resampled);
+            let stages = if resampled {
+                let c = s.stages;
+                format!(
+                    "{:.3}/{:.3}/{:.3}",
+                    c.resample_ms, c.decompose_ms, c.sources_ms
+                )
+            } else {
+                String::new()
+            };
             println!(
-                "{:<10} {:<12} {:>8} {:>7} {:>8.2}% {:>10.3} {:>12.4}",
+                "{:<10} {:<12} {:>8} {:>7} {:>8.2}% {:>10.3} {:>12.4} {:>26}",
                 name,
                 method,
                 s.count_changes,
                 format!("{}-{}", s.min_lights, s.max_lights),
                 100.0 * s.power_variation,
                 s.direction_error_deg,
-                s.frame_ms
+                s.frame_ms,
+                stages
             );
         }
     }
     println!(
         "redecompose: the turned map resampled and decomposed every frame (the thesis' way); \
-         rotate: decomposed once in the map's frame, SH part and lights rotated per frame."
+         rotate: decomposed once in the map's frame, SH part and lights rotated per frame. \
+         ms/frame and its stages are medians of one thread's time; the decomposition proper \
+         (the middle stage) is what `cargo bench -p runtime --bench decompose` times."
     );
     Ok(())
 }

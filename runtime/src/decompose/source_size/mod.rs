@@ -18,13 +18,14 @@
 //! distance from the light, `E[θ] = 2ρ/3` for a uniform disc); the shadow filter spreads its
 //! samples over both discs in proportion (CONVENTIONS.md, "Shadows and background on the GPU").
 
+mod background;
 mod median;
 mod texel_set;
 mod texels;
 
+use background::{MedianScratch, cap_median};
 use foundation::envmap::EnvMap;
 use glam::Vec3;
-use median::{TopBits, median_of_keys};
 use std::f32::consts::PI;
 use texel_set::TexelSet;
 use texels::{EquirectTexels, TexelTable};
@@ -109,8 +110,8 @@ impl SourceMeter {
 /// Buffers reused from light to light.
 #[derive(Default)]
 struct Scratch {
-    /// Luminances of the background cap, as [`order_key`]s.
-    values: Vec<u32>,
+    /// For the median of the background cap.
+    median: MedianScratch,
     cell: Vec<(usize, usize)>,
     /// One bit per texel: in the half-maximum region of the light being measured.
     core: TexelSet,
@@ -125,10 +126,7 @@ fn source_shape(
     scratch: &mut Scratch,
 ) -> Option<SourceShape> {
     let d = directions[k];
-    scratch.values.clear();
-    let mut top = TopBits::new();
-    table.luminances_within(d, BACKGROUND_RADIUS, &mut scratch.values, &mut top);
-    let background = median_of_keys(&mut scratch.values, &top);
+    let background = cap_median(table, d, BACKGROUND_RADIUS, &mut scratch.median);
     scratch.cell.clear();
     let cell_rivals = Rivals::of(directions, k, cap_radius);
     table.for_each_within(d, cap_radius, |t| {

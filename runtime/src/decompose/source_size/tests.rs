@@ -1,7 +1,7 @@
 //! The source measurement against brute force and closed forms.
 
-use super::median::{median_of, order_key};
-use super::texels::texels_within;
+use super::median::{TopBits, median_of, order_key};
+use super::texels::{AllKeys, texels_within};
 use super::*;
 use foundation::Rgb;
 use foundation::luminance;
@@ -373,11 +373,14 @@ fn texels_within_a_cap_across_the_seam_and_the_pole() {
                     map: &indexed,
                     texels: &texels,
                 }
-                .luminances_within(
+                .keys_within(
                     centre,
                     radius,
-                    &mut values,
-                    &mut TopBits::new(),
+                    1,
+                    &mut AllKeys {
+                        keys: &mut values,
+                        top: &mut TopBits::new(),
+                    },
                 );
                 values.sort_unstable();
                 let mut expected: Vec<u32> = brute

@@ -2,7 +2,7 @@
 
 use super::median::{TopBits, order_key};
 use foundation::envmap::EnvMap;
-use foundation::luminance;
+use foundation::{Rgb, luminance};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -134,19 +134,20 @@ impl TexelTable<'_> {
         (theta, first..last)
     }
 
-    /// Appends the luminance ([`order_key`]) of every texel within `radius` of `centre` to
-    /// `out` (the same texels as [`Self::for_each_within`], in no particular order). In each
-    /// row, the columns certainly inside (by more than the test's rounding) are read in bulk,
-    /// and only those near the cap's rim are tested.
-    pub(super) fn luminances_within(
+    /// Hands `sink` the texels within `radius` of `centre` (the same texels as
+    /// [`Self::for_each_within`], in no particular order), of every `row_step`-th row. In each
+    /// row, the columns certainly inside (by more than the test's rounding) go in runs, and
+    /// only those near the cap's rim are tested, each handed over as its luminance key.
+    pub(super) fn keys_within(
         &self,
         centre: Vec3,
         radius: f32,
-        out: &mut Vec<u32>,
-        top: &mut TopBits,
+        row_step: usize,
+        sink: &mut impl KeySink,
     ) {
         let w = self.width();
         let (theta, rows) = self.cap_rows(centre, radius);
+        let rows = rows.step_by(row_step.max(1));
         let cos_radius = radius.cos();
         let centre_u = f64::from(foundation::envmap::uv_of_direction(centre).0) * w as f64;
         let column_angle = std::f64::consts::TAU / w as f64;
@@ -176,18 +177,43 @@ impl TexelTable<'_> {
                 column_range(centre_u, outer, w),
             );
             for (a, b) in inside.segments(w) {
-                top.extend(out, row[a..b].iter().map(|c| order_key(luminance(*c))));
+                sink.run(&row[a..b]);
             }
             for band in near.minus(inside, w) {
                 for (a, b) in band.segments(w) {
                     for (i, texel) in row.iter().enumerate().take(b).skip(a) {
                         if self.direction((i, j)).dot(centre) >= cos_radius {
-                            out.push(top.count(order_key(luminance(*texel))));
+                            sink.one(order_key(luminance(*texel)));
                         }
                     }
                 }
             }
         }
+    }
+}
+
+/// Receives the texels of a cap ([`TexelTable::keys_within`]).
+pub(super) trait KeySink {
+    /// Texels certainly inside the cap: a run of one row.
+    fn run(&mut self, texels: &[Rgb]);
+    /// The [`order_key`] of the luminance of one texel near the rim, found inside.
+    fn one(&mut self, key: u32);
+}
+
+/// Every key, counted by its top bits for [`super::median::median_of_keys`].
+pub(super) struct AllKeys<'a> {
+    pub(super) keys: &'a mut Vec<u32>,
+    pub(super) top: &'a mut TopBits,
+}
+
+impl KeySink for AllKeys<'_> {
+    fn run(&mut self, texels: &[Rgb]) {
+        self.top
+            .extend(self.keys, texels.iter().map(|c| order_key(luminance(*c))));
+    }
+
+    fn one(&mut self, key: u32) {
+        self.keys.push(self.top.count(key));
     }
 }
 
