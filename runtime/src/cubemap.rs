@@ -64,12 +64,10 @@ impl CubeGeometry {
         let (s, c) = (angle.sin(), angle.cos());
         let (t1, t2) = axis.any_orthonormal_pair();
         // Boundary of the cone plus its axis, projected on each face.
-        const RIM: usize = 24;
         let mut points = [Vec3::ZERO; RIM + 1];
         points[0] = axis;
-        for (k, p) in points.iter_mut().skip(1).enumerate() {
-            let (sa, ca) = (std::f32::consts::TAU * k as f32 / RIM as f32).sin_cos();
-            *p = axis * c + (t1 * ca + t2 * sa) * s;
+        for (p, (sa, ca)) in points.iter_mut().skip(1).zip(rim_angles()) {
+            *p = axis * c + (t1 * *ca + t2 * *sa) * s;
         }
         let n = self.size as f32;
         for face in ALL_FACES {
@@ -197,6 +195,18 @@ impl CubeMap {
             .map(|(c, w)| *c * *w)
             .sum()
     }
+}
+
+/// Points on the rim of a cone that [`CubeGeometry::texels_within`] projects.
+const RIM: usize = 24;
+
+/// `(sin, cos)` of the rim points' angles around the cone's axis, computed once: a frame asks
+/// for dozens of cones.
+fn rim_angles() -> &'static [(f32, f32); RIM] {
+    static ANGLES: std::sync::OnceLock<[(f32, f32); RIM]> = std::sync::OnceLock::new();
+    ANGLES.get_or_init(|| {
+        std::array::from_fn(|k| (std::f32::consts::TAU * k as f32 / RIM as f32).sin_cos())
+    })
 }
 
 /// A map ready to be turned into cube maps of one face size at any rotation (every frame, for

@@ -1,161 +1,21 @@
-//! The local background of a light: the median luminance of a wide cap around it, found
-//! exactly but without sorting or histogramming every texel of the cap.
-//!
-//! A cap of 30° on a 1024-wide map holds some 30 000 texels, and the median is taken for every
-//! light every frame. So a sparse sample of the cap (every [`SAMPLE_STEP`]-th row and column)
-//! brackets the median first; one pass over the cap then counts the keys below the bracket
-//! and keeps only those inside it, and the median is selected among those few (the same
-//! element as among all keys: the answer is exact). Should the bracket miss (the sample
-//! unlucky, or too small in a small cap), every key is gathered and the median selected by
-//! [`median_of_keys`] as before.
+//! The local background of a light: the median luminance of a wide cap around it.
 
-use super::median::{TopBits, median_of_keys, order_key};
-use super::texels::{AllKeys, KeySink, TexelTable};
-use foundation::{Rgb, luminance};
+use super::median::{TopBits, median_of_keys};
+use super::texels::TexelTable;
 use glam::Vec3;
 
-/// Rows and columns between the sampled texels.
-const SAMPLE_STEP: usize = 8;
-/// Below this many sampled texels the bracket is not tried.
-const MIN_SAMPLE: usize = 64;
-/// Half-width of the bracket in standard deviations of the sample median's rank.
-const BRACKET_SIGMAS: f64 = 3.0;
-
-/// Buffers reused from light to light.
-#[derive(Default)]
-pub(super) struct MedianScratch {
-    keys: Vec<u32>,
-    sample: Vec<u32>,
-}
-
 /// The median luminance (the element at index `len / 2` in `total_cmp` order) of the texels
-/// within `radius` of `centre`; 0 for an empty cap.
+/// within `radius` of `centre`, 0 for an empty cap; `keys` is scratch.
 pub(super) fn cap_median(
     table: &TexelTable,
     centre: Vec3,
     radius: f32,
-    scratch: &mut MedianScratch,
+    keys: &mut Vec<u32>,
 ) -> f32 {
-    if let Some(median) = bracketed_median(table, centre, radius, scratch) {
-        return median;
-    }
-    scratch.keys.clear();
+    keys.clear();
     let mut top = TopBits::new();
-    let mut all = AllKeys {
-        keys: &mut scratch.keys,
-        top: &mut top,
-    };
-    table.keys_within(centre, radius, 1, &mut all);
-    median_of_keys(&mut scratch.keys, &top)
-}
-
-/// The median through a bracket from a sample; `None` when the sample is too small or the
-/// median falls outside the bracket.
-fn bracketed_median(
-    table: &TexelTable,
-    centre: Vec3,
-    radius: f32,
-    scratch: &mut MedianScratch,
-) -> Option<f32> {
-    scratch.sample.clear();
-    let mut sample = Sample {
-        keys: &mut scratch.sample,
-    };
-    table.keys_within(centre, radius, SAMPLE_STEP, &mut sample);
-    let (lo, hi) = bracket(&mut scratch.sample)?;
-    scratch.keys.clear();
-    let mut bracket = Bracket {
-        lo,
-        span: hi - lo,
-        below: 0,
-        total: 0,
-        inside: &mut scratch.keys,
-    };
-    table.keys_within(centre, radius, 1, &mut bracket);
-    let rank = (bracket.total / 2).checked_sub(bracket.below)?;
-    let inside = &mut scratch.keys;
-    if rank >= inside.len() {
-        return None;
-    }
-    let (_, key, _) = inside.select_nth_unstable(rank);
-    Some(from_order_key(*key))
-}
-
-/// Keys around the sample's median that the whole cap's median lies between, very likely:
-/// [`BRACKET_SIGMAS`] standard deviations of a sample median's rank either side.
-fn bracket(sample: &mut [u32]) -> Option<(u32, u32)> {
-    let m = sample.len();
-    if m < MIN_SAMPLE {
-        return None;
-    }
-    sample.sort_unstable();
-    let spread = (BRACKET_SIGMAS * (0.25 * m as f64).sqrt()).ceil() as usize + 1;
-    Some((
-        sample[(m / 2).saturating_sub(spread)],
-        sample[(m / 2 + spread).min(m - 1)],
-    ))
-}
-
-/// Inverse of [`order_key`].
-fn from_order_key(key: u32) -> f32 {
-    f32::from_bits(if key >> 31 == 1 { key ^ 1 << 31 } else { !key })
-}
-
-/// Every [`SAMPLE_STEP`]-th texel of the runs (rows are stepped by the caller); the rim is left
-/// out, which only shifts the bracket a little.
-struct Sample<'a> {
-    keys: &'a mut Vec<u32>,
-}
-
-impl KeySink for Sample<'_> {
-    fn run(&mut self, texels: &[Rgb]) {
-        self.keys.extend(
-            texels
-                .iter()
-                .step_by(SAMPLE_STEP)
-                .map(|c| order_key(luminance(*c))),
-        );
-    }
-
-    fn one(&mut self, _key: u32) {}
-}
-
-/// Counts the keys below `lo` and keeps those in `lo..=lo + span`.
-struct Bracket<'a> {
-    lo: u32,
-    span: u32,
-    below: usize,
-    total: usize,
-    inside: &'a mut Vec<u32>,
-}
-
-impl KeySink for Bracket<'_> {
-    fn run(&mut self, texels: &[Rgb]) {
-        // Without a branch per key: each key is written after those kept, and kept only when
-        // it is inside.
-        let start = self.inside.len();
-        self.inside.resize(start + texels.len(), 0);
-        let mut kept = start;
-        let mut below = 0;
-        for c in texels {
-            let key = order_key(luminance(*c));
-            self.inside[kept] = key;
-            kept += usize::from(key.wrapping_sub(self.lo) <= self.span);
-            below += usize::from(key < self.lo);
-        }
-        self.inside.truncate(kept);
-        self.below += below;
-        self.total += texels.len();
-    }
-
-    fn one(&mut self, key: u32) {
-        self.total += 1;
-        if key < self.lo {
-            self.below += 1;
-        } else if key - self.lo <= self.span {
-            self.inside.push(key);
-        }
-    }
+    table.luminances_within(centre, radius, keys, &mut top);
+    median_of_keys(keys, &top)
 }
 
 #[cfg(test)]
@@ -163,6 +23,7 @@ mod tests {
     use super::*;
     use crate::decompose::source_size::texels::EquirectTexels;
     use foundation::envmap::EnvMap;
+    use foundation::{Rgb, luminance};
 
     /// The median by sorting every texel of the cap.
     fn sorted_median(map: &EnvMap, centre: Vec3, radius: f32) -> f32 {
@@ -175,8 +36,8 @@ mod tests {
         values[values.len() / 2]
     }
 
-    /// Noisy, smooth, flat and bimodal maps, caps large and small, at the pole and across the
-    /// seam: the same median as sorting, through the bracket or the fallback.
+    /// Noisy, smooth, flat and two-level maps, caps large and small, at the pole and across
+    /// the seam: the same median as sorting.
     #[test]
     fn the_cap_median_is_the_sorted_median() {
         let (w, h) = (512, 256);
@@ -194,8 +55,7 @@ mod tests {
             Vec3::X,
         ];
         let texels = EquirectTexels::new(w, h);
-        let mut scratch = MedianScratch::default();
-        let mut bracketed = 0;
+        let mut keys = Vec::new();
         for map in &maps {
             let table = TexelTable {
                 map,
@@ -205,15 +65,10 @@ mod tests {
                 for degrees in [3.0f32, 30.0] {
                     let radius = degrees.to_radians();
                     let expected = sorted_median(map, centre, radius);
-                    let found = cap_median(&table, centre, radius, &mut scratch);
+                    let found = cap_median(&table, centre, radius, &mut keys);
                     assert_eq!(found.to_bits(), expected.to_bits(), "{centre} {degrees}°");
-                    bracketed += usize::from(
-                        bracketed_median(&table, centre, radius, &mut scratch).is_some(),
-                    );
                 }
             }
         }
-        // The 30° caps (most of them) go through the bracket.
-        assert!(bracketed >= 12, "{bracketed} bracketed");
     }
 }

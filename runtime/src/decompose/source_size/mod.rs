@@ -23,7 +23,7 @@ mod median;
 mod texel_set;
 mod texels;
 
-use background::{MedianScratch, cap_median};
+use background::cap_median;
 use foundation::envmap::EnvMap;
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -110,8 +110,8 @@ impl SourceMeter {
 /// Buffers reused from light to light.
 #[derive(Default)]
 struct Scratch {
-    /// For the median of the background cap.
-    median: MedianScratch,
+    /// Luminances of the background cap, as order keys.
+    values: Vec<u32>,
     cell: Vec<(usize, usize)>,
     /// One bit per texel: in the half-maximum region of the light being measured.
     core: TexelSet,
@@ -126,11 +126,11 @@ fn source_shape(
     scratch: &mut Scratch,
 ) -> Option<SourceShape> {
     let d = directions[k];
-    let background = cap_median(table, d, BACKGROUND_RADIUS, &mut scratch.median);
+    let background = cap_median(table, d, BACKGROUND_RADIUS, &mut scratch.values);
     scratch.cell.clear();
     let cell_rivals = Rivals::of(directions, k, cap_radius);
-    table.for_each_within(d, cap_radius, |t| {
-        if cell_rivals.owns(table.direction(t)) {
+    table.for_each_within(d, cap_radius, |t, direction| {
+        if cell_rivals.owns(direction) {
             scratch.cell.push(t);
         }
     });
@@ -144,8 +144,8 @@ fn source_shape(
     }
     let half = 0.5 * (background + peak);
     let region_rivals = Rivals::of(directions, k, MAX_SOURCE_RADIUS);
-    let core = half_maximum_region(table, peak_texel, d, half, &mut scratch.core, |t| {
-        region_rivals.owns(table.direction(t))
+    let core = half_maximum_region(table, peak_texel, d, half, &mut scratch.core, |w| {
+        region_rivals.owns(w)
     });
     let omega: f32 = core.iter().map(|t| table.solid_angle(*t)).sum();
     let radius = disc_radius(omega);
@@ -215,18 +215,19 @@ impl Rivals {
     }
 }
 
-/// The texels `owned` connected to `seed` (4-neighbours, wrapping in azimuth) brighter than
-/// `level`, within [`MAX_SOURCE_RADIUS`] of `centre`, in the order found; `seen` (empty on
-/// entry) holds them on return. A convex source cut by the convex cells of the lights nearest
-/// to its parts stays connected within each cell.
+/// The texels `owned` (asked by direction) connected to `seed` (4-neighbours, wrapping in
+/// azimuth) brighter than `level`, within [`MAX_SOURCE_RADIUS`] of `centre`, in the order
+/// found; `seen` (empty on entry) holds them on return. A convex source cut by the convex
+/// cells of the lights nearest to its parts stays connected within each cell.
 fn half_maximum_region(
     table: &TexelTable,
     seed: (usize, usize),
     centre: Vec3,
     level: f32,
     seen: &mut TexelSet,
-    owned: impl Fn((usize, usize)) -> bool,
+    owned: impl Fn(Vec3) -> bool,
 ) -> Vec<(usize, usize)> {
+    use std::cmp::Ordering::Greater;
     let (w, h) = (table.width(), table.height());
     let cos_max = MAX_SOURCE_RADIUS.cos();
     let mut region = vec![seed];
@@ -247,11 +248,11 @@ fn half_maximum_region(
             neighbours[3] = Some((i, j + 1));
         }
         for n in neighbours.into_iter().flatten() {
-            if !seen.contains(n)
-                && table.luminance(n) > level
-                && table.direction(n).dot(centre) >= cos_max
-                && owned(n)
-            {
+            if seen.contains(n) || table.luminance(n).partial_cmp(&level) != Some(Greater) {
+                continue;
+            }
+            let direction = table.direction(n);
+            if direction.dot(centre) >= cos_max && owned(direction) {
                 seen.insert(n);
                 region.push(n);
             }

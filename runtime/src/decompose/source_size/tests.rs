@@ -1,7 +1,7 @@
 //! The source measurement against brute force and closed forms.
 
 use super::median::{TopBits, median_of, order_key};
-use super::texels::{AllKeys, texels_within};
+use super::texels::texels_within;
 use super::*;
 use foundation::Rgb;
 use foundation::luminance;
@@ -373,14 +373,11 @@ fn texels_within_a_cap_across_the_seam_and_the_pole() {
                     map: &indexed,
                     texels: &texels,
                 }
-                .keys_within(
+                .luminances_within(
                     centre,
                     radius,
-                    1,
-                    &mut AllKeys {
-                        keys: &mut values,
-                        top: &mut TopBits::new(),
-                    },
+                    &mut values,
+                    &mut TopBits::new(),
                 );
                 values.sort_unstable();
                 let mut expected: Vec<u32> = brute

@@ -2,7 +2,7 @@
 
 use super::median::{TopBits, order_key};
 use foundation::envmap::EnvMap;
-use foundation::{Rgb, luminance};
+use foundation::luminance;
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -67,7 +67,8 @@ impl TexelTable<'_> {
         self.texels.solid_angles[j]
     }
 
-    /// Calls `visit` for each texel `(i, j)` within `radius` of `centre`: rows by polar angle,
+    /// Calls `visit` for each texel `(i, j)` within `radius` of `centre`, with its direction:
+    /// rows by polar angle,
     /// then in each row the columns of an azimuth window around the centre's, in increasing
     /// azimuth from the window's start (wrapping). Only the part of the window that can be
     /// that close (with two texels' margin) is tested.
@@ -75,7 +76,7 @@ impl TexelTable<'_> {
         &self,
         centre: Vec3,
         radius: f32,
-        mut visit: impl FnMut((usize, usize)),
+        mut visit: impl FnMut((usize, usize), Vec3),
     ) {
         let w = self.width();
         let (theta, rows) = self.cap_rows(centre, radius);
@@ -114,8 +115,9 @@ impl TexelTable<'_> {
             let k_last = ((centre_k + reach).ceil().max(0.0) as usize).min(span.max(1));
             let mut i = (start + k_first as isize).rem_euclid(w as isize) as usize;
             for _ in k_first..k_last {
-                if self.direction((i, j)).dot(centre) >= cos_radius {
-                    visit((i, j));
+                let direction = self.direction((i, j));
+                if direction.dot(centre) >= cos_radius {
+                    visit((i, j), direction);
                 }
                 i = if i + 1 == w { 0 } else { i + 1 };
             }
@@ -134,20 +136,19 @@ impl TexelTable<'_> {
         (theta, first..last)
     }
 
-    /// Hands `sink` the texels within `radius` of `centre` (the same texels as
-    /// [`Self::for_each_within`], in no particular order), of every `row_step`-th row. In each
-    /// row, the columns certainly inside (by more than the test's rounding) go in runs, and
-    /// only those near the cap's rim are tested, each handed over as its luminance key.
-    pub(super) fn keys_within(
+    /// Appends the luminance ([`order_key`]) of every texel within `radius` of `centre` to
+    /// `out` (the same texels as [`Self::for_each_within`], in no particular order). In each
+    /// row, the columns certainly inside (by more than the test's rounding) are read in bulk,
+    /// and only those near the cap's rim are tested.
+    pub(super) fn luminances_within(
         &self,
         centre: Vec3,
         radius: f32,
-        row_step: usize,
-        sink: &mut impl KeySink,
+        out: &mut Vec<u32>,
+        top: &mut TopBits,
     ) {
         let w = self.width();
         let (theta, rows) = self.cap_rows(centre, radius);
-        let rows = rows.step_by(row_step.max(1));
         let cos_radius = radius.cos();
         let centre_u = f64::from(foundation::envmap::uv_of_direction(centre).0) * w as f64;
         let column_angle = std::f64::consts::TAU / w as f64;
@@ -177,43 +178,18 @@ impl TexelTable<'_> {
                 column_range(centre_u, outer, w),
             );
             for (a, b) in inside.segments(w) {
-                sink.run(&row[a..b]);
+                top.extend(out, row[a..b].iter().map(|c| order_key(luminance(*c))));
             }
             for band in near.minus(inside, w) {
                 for (a, b) in band.segments(w) {
                     for (i, texel) in row.iter().enumerate().take(b).skip(a) {
                         if self.direction((i, j)).dot(centre) >= cos_radius {
-                            sink.one(order_key(luminance(*texel)));
+                            out.push(top.count(order_key(luminance(*texel))));
                         }
                     }
                 }
             }
         }
-    }
-}
-
-/// Receives the texels of a cap ([`TexelTable::keys_within`]).
-pub(super) trait KeySink {
-    /// Texels certainly inside the cap: a run of one row.
-    fn run(&mut self, texels: &[Rgb]);
-    /// The [`order_key`] of the luminance of one texel near the rim, found inside.
-    fn one(&mut self, key: u32);
-}
-
-/// Every key, counted by its top bits for [`super::median::median_of_keys`].
-pub(super) struct AllKeys<'a> {
-    pub(super) keys: &'a mut Vec<u32>,
-    pub(super) top: &'a mut TopBits,
-}
-
-impl KeySink for AllKeys<'_> {
-    fn run(&mut self, texels: &[Rgb]) {
-        self.top
-            .extend(self.keys, texels.iter().map(|c| order_key(luminance(*c))));
-    }
-
-    fn one(&mut self, key: u32) {
-        self.keys.push(self.top.count(key));
     }
 }
 
@@ -295,6 +271,6 @@ pub(super) fn texels_within(map: &EnvMap, centre: Vec3, radius: f32) -> Vec<(usi
         map,
         texels: &texels,
     }
-    .for_each_within(centre, radius, |t| out.push(t));
+    .for_each_within(centre, radius, |t, _| out.push(t));
     out
 }
