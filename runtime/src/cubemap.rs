@@ -189,11 +189,13 @@ impl CubeMap {
 
     /// `∫ L dω` over the sphere.
     pub fn total_power(&self, geometry: &CubeGeometry) -> Rgb {
-        self.texels
-            .iter()
-            .zip(&geometry.solid_angles)
-            .map(|(c, w)| *c * *w)
-            .sum()
+        // Four partial sums (texel i into sum i mod 4), so that the additions do not wait on
+        // one another: this runs every frame.
+        let mut sums = [glam::Vec3A::ZERO; 4];
+        for (i, (c, w)) in self.texels.iter().zip(&geometry.solid_angles).enumerate() {
+            sums[i % 4] += glam::Vec3A::from(*c) * *w;
+        }
+        Rgb::from((sums[0] + sums[1]) + (sums[2] + sums[3]))
     }
 }
 
@@ -298,6 +300,8 @@ pub struct CubeResampler {
     /// texels would read and write the cube texel once per share.
     starts: Vec<u32>,
     sources: Vec<u32>,
+    /// The column of each of `sources` in its row (to wrap a rotated row's end).
+    columns: Vec<u32>,
     gains: Vec<f32>,
 }
 
@@ -403,12 +407,14 @@ impl CubeResampler {
             .map(|(t, a)| (*a / geometry.solid_angles()[*t as usize] as f64) as f32)
             .collect();
         let (starts, sources, gains) = by_target(&starts, &targets, &gains, geometry.texel_count());
+        let columns = sources.iter().map(|s| s % map_width as u32).collect();
         Self {
             size,
             map_width,
             map_height,
             starts,
             sources,
+            columns,
             gains,
         }
     }
@@ -431,6 +437,19 @@ impl CubeResampler {
         let shift = (rotation / std::f32::consts::TAU).rem_euclid(1.0) * w as f32;
         let (whole, t) = (shift.floor() as usize % w, shift.fract());
         let texels = map.texels();
+        if t == 0.0 {
+            // A whole number of texels (no turn at all, for a map that changes in its own
+            // frame): source texel (i, j) is texel i + whole of row j, wrapping, read where it
+            // is gathered (the interpolation below would give the same floats).
+            return self.gather(out, |s, column| {
+                let c = column as usize + whole;
+                texels[if c >= w {
+                    s as usize + whole - w
+                } else {
+                    s as usize + whole
+                }]
+            });
+        }
         SHIFTED_SOURCE.with_borrow_mut(|lerped| {
             lerped.clear();
             // Each source row, rotated, with its first texel repeated at the end for the lerp.
@@ -442,15 +461,25 @@ impl CubeResampler {
                 shifted.push(shifted[0]);
                 lerped.extend(shifted.windows(2).map(|p| p[0] * (1.0 - t) + p[1] * t));
             }
-            for (texel, range) in out.texels.iter_mut().zip(self.starts.windows(2)) {
-                let range = range[0] as usize..range[1] as usize;
-                let mut sum = Rgb::ZERO;
-                for (s, g) in self.sources[range.clone()].iter().zip(&self.gains[range]) {
-                    sum += lerped[*s as usize] * *g;
-                }
-                *texel = sum;
-            }
+            self.gather(out, |s, _| lerped[s as usize]);
         });
+    }
+
+    /// Fills each cube texel with its sources' shares, source `s` (in column `c` of its row)
+    /// read as `source(s, c)`.
+    fn gather(&self, out: &mut CubeMap, source: impl Fn(u32, u32) -> Rgb) {
+        for (texel, range) in out.texels.iter_mut().zip(self.starts.windows(2)) {
+            let range = range[0] as usize..range[1] as usize;
+            let mut sum = Rgb::ZERO;
+            for ((s, c), g) in self.sources[range.clone()]
+                .iter()
+                .zip(&self.columns[range.clone()])
+                .zip(&self.gains[range])
+            {
+                sum += source(*s, *c) * *g;
+            }
+            *texel = sum;
+        }
     }
 
     pub fn resample(&self, map: &EnvMap, rotation: f32) -> CubeMap {

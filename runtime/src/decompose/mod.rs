@@ -13,6 +13,7 @@
 
 mod decomposition;
 mod icosphere;
+mod octant;
 mod peaks;
 mod projection;
 mod settings;
@@ -76,7 +77,8 @@ pub struct Decomposer {
     /// Its smoothed luminance at the icosahedron's vertices.
     smoothed: Vec<f32>,
     ring: Vec<u32>,
-    cap: Vec<u32>,
+    /// The texels of the caps asked for in this frame, by centre and radius.
+    caps: Vec<(Vec3, f32, Vec<u32>)>,
     owner: Vec<(u16, f32)>,
     member_basis: MemberBasis,
 }
@@ -128,7 +130,7 @@ impl Decomposer {
             luminances: Vec::new(),
             smoothed: Vec::new(),
             ring: Vec::new(),
-            cap: Vec::new(),
+            caps: Vec::new(),
             owner: vec![(u16::MAX, 0.0); texels],
         })
     }
@@ -188,22 +190,24 @@ impl Decomposer {
             "cube map of the wrong size"
         );
         let total_power = map.total_power(&self.geometry);
+        self.caps.clear();
         self.prepare_analysis(map);
         let full = self.projector.project(self.analysis_map(map));
         let mut detection = full.clone();
         detection.scale_bands(&self.detection_window);
-        let peaks = self.find_peaks(map, &detection, luminance(total_power) / (4.0 * PI));
-        let candidates = peaks.len();
+        let directions = self.find_peaks(map, &detection, luminance(total_power) / (4.0 * PI));
+        let candidates = directions.len();
         let (sh, mut lights) = match self.settings.mode {
             DecomposeMode::Thesis => {
                 // The thesis' SH part: the whole map, windowed by the chosen window (the
                 // peaks are always found on the Hanning-windowed detection expansion).
                 let mut sh = full.clone();
                 sh.scale_bands(&self.sh_window);
+                let peaks = self.measure_peaks(map, &detection, &directions);
                 let lights = self.thesis_lights(&peaks, &detection, &sh);
                 (sh, lights)
             }
-            DecomposeMode::Consistent => self.consistent_lights(map, &full, &peaks),
+            DecomposeMode::Consistent => self.consistent_lights(map, &full, &directions),
         };
         let total_luminance = luminance(total_power).max(f32::MIN_POSITIVE);
         for light in &mut lights {
@@ -228,6 +232,7 @@ impl Decomposer {
         );
         self.prepare_analysis(map);
         let full = self.projector.project(self.analysis_map(map));
+        self.caps.clear();
         self.cap_powers(map, &full, centres, CONSISTENT_ITERATIONS)
     }
 
@@ -255,13 +260,14 @@ impl Decomposer {
     }
 
     /// Steps 1, 2 and 4: smoothed map minus SH part on the icosahedron, its significant local
-    /// maxima, refined; brightest first.
+    /// maxima, refined: their directions, in decreasing order of the residual at the vertex
+    /// each was climbed to (the analysis map of `map` prepared).
     fn find_peaks(
         &mut self,
         map: &CubeMap,
         detection: &ShCoeffs<Rgb>,
         mean_luminance: f32,
-    ) -> Vec<Peak> {
+    ) -> Vec<Vec3> {
         let analysis = if self.downsample.is_empty() {
             map
         } else {
@@ -290,18 +296,31 @@ impl Decomposer {
             .collect();
         maxima.sort_by(|a, b| residual[*b as usize].total_cmp(&residual[*a as usize]));
         maxima.truncate(MAX_CANDIDATES);
-        let sigma = self.settings.smoothing_deg.to_radians();
-        let mut peaks: Vec<Peak> = maxima
+        maxima
             .into_iter()
-            .map(|v| {
-                let (direction, _) = peaks::refine_peak(&self.ico, &residual, v, &mut self.ring);
-                // λ − P(Ξ) at the refined direction itself: the map smoothed there (one more
-                // kernel) minus the SH part. The fitted quadric's apex would overshoot a
-                // flat-topped peak (a source wider than the kernel) by tens of percent.
-                let mut smoothed = Vec::with_capacity(1);
-                GaussianSmoothing::new(&self.analysis, &[direction], sigma)
-                    .apply(analysis, &mut smoothed);
-                let rgb = smoothed[0] - detection.eval(direction);
+            .map(|v| peaks::refine_peak(&self.ico, &residual, v, &mut self.ring).0)
+            .collect()
+    }
+
+    /// The thesis' residual `λ − P(Ξ)` at each peak direction itself: the map smoothed there
+    /// (one more kernel) minus the SH part `detection`; brightest first. The fitted quadric's
+    /// apex would overshoot a flat-topped peak (a source wider than the kernel) by tens of
+    /// percent.
+    fn measure_peaks(
+        &self,
+        map: &CubeMap,
+        detection: &ShCoeffs<Rgb>,
+        directions: &[Vec3],
+    ) -> Vec<Peak> {
+        let sigma = self.settings.smoothing_deg.to_radians();
+        let mut smoothed = Vec::with_capacity(directions.len());
+        GaussianSmoothing::new(&self.analysis, directions, sigma)
+            .apply(self.analysis_map(map), &mut smoothed);
+        let mut peaks: Vec<Peak> = directions
+            .iter()
+            .zip(smoothed)
+            .map(|(&direction, smoothed)| {
+                let rgb = smoothed - detection.eval(direction);
                 Peak {
                     direction,
                     value: luminance(rgb),
@@ -357,12 +376,11 @@ impl Decomposer {
         &mut self,
         map: &CubeMap,
         full: &ShCoeffs<Rgb>,
-        peaks: &[Peak],
+        centres: &[Vec3],
     ) -> (ShCoeffs<Rgb>, Vec<DirectionalLight>) {
-        let centres: Vec<Vec3> = peaks.iter().map(|p| p.direction).collect();
         // One refit step is enough to rank the candidates.
         let trial: Vec<f32> = self
-            .cap_powers(map, full, &centres, 1)
+            .cap_powers(map, full, centres, 1)
             .iter()
             .map(|p| luminance(*p))
             .collect();
@@ -385,8 +403,21 @@ impl Decomposer {
     fn cap_members(&mut self, centres: &[Vec3], radius: f32) -> Vec<u32> {
         let mut members: Vec<u32> = Vec::new();
         for (i, c) in centres.iter().enumerate() {
-            self.geometry.texels_within(*c, radius, &mut self.cap);
-            for &t in &self.cap {
+            // The ranking and the extraction ask for the same caps: each is found once.
+            let cap = match self
+                .caps
+                .iter()
+                .position(|(d, r, _)| d == c && *r == radius)
+            {
+                Some(k) => &self.caps[k].2,
+                None => {
+                    let mut cap = Vec::new();
+                    self.geometry.texels_within(*c, radius, &mut cap);
+                    self.caps.push((*c, radius, cap));
+                    &self.caps[self.caps.len() - 1].2
+                }
+            };
+            for &t in cap {
                 let cos = self.geometry.directions()[t as usize].dot(*c);
                 let slot = &mut self.owner[t as usize];
                 if slot.0 == u16::MAX {
@@ -411,39 +442,26 @@ impl Decomposer {
         keep_sh: bool,
     ) -> (ShCoeffs<Rgb>, Vec<Rgb>) {
         let texels = map.texels();
-        // At the analysis resolution the projector has the basis at every texel already.
-        let table = self
-            .downsample
-            .is_empty()
-            .then(|| self.projector.texel_basis());
-        if iterations == 1 && !keep_sh {
-            // One step from the full expansion and no refit: `full` at each member is all
-            // that is needed (the same floats as through the member basis).
-            let mut row = vec![0.0; self.basis.num_coeffs()];
-            let excess = members
-                .iter()
-                .map(|&t| {
-                    let y = match table {
-                        Some(table) => table.padded_row(t as usize),
-                        None => {
-                            self.basis
-                                .eval(self.geometry.directions()[t as usize], &mut row);
-                            &row
-                        }
-                    };
-                    (texels[t as usize] - full.dot_basis(y)).max(Rgb::ZERO)
-                })
-                .collect();
-            return (full.clone(), excess);
+        // At the analysis resolution the projector has the basis at every texel already (folded
+        // into one octant); otherwise it is evaluated at the members.
+        let octant = if self.downsample.is_empty() {
+            self.projector.octant()
+        } else {
+            None
+        };
+        if octant.is_none() {
+            self.member_basis
+                .set(members, &self.basis, self.geometry.directions());
         }
-        self.member_basis
-            .set(members, table, &self.basis, self.geometry.directions());
         let mut sh = full.clone();
         let mut excess: Vec<Rgb> = vec![Rgb::ZERO; members.len()];
         let (mut expansion, mut projected) = (Vec::new(), Vec::new());
         for step in 0..iterations {
             // P = SH(map) − SH(excess), P refitted to the map less the excess.
-            self.member_basis.eval_all(&sh, &mut expansion);
+            match octant {
+                Some(octant) => octant.eval_at(&sh, members, &mut expansion),
+                None => self.member_basis.eval_all(&sh, &mut expansion),
+            }
             for ((e, &t), p) in excess.iter_mut().zip(members).zip(&expansion) {
                 *e = (texels[t as usize] - *p).max(Rgb::ZERO);
             }
@@ -457,7 +475,10 @@ impl Decomposer {
                     .zip(members)
                     .map(|(e, &t)| *e * self.geometry.solid_angles()[t as usize]),
             );
-            sh = self.member_basis.subtract(full, &projected);
+            sh = match octant {
+                Some(octant) => octant.subtract(full, members, &projected),
+                None => self.member_basis.subtract(full, &projected),
+            };
         }
         (sh, excess)
     }

@@ -1,6 +1,8 @@
 //! SH projection of a cube map by solid-angle weighted texel quadrature (thesis Figure 4.4),
 //! and evaluation of expansions at fixed directions, with every basis value tabulated once.
+//! A cube of even face size is projected folded into one octant ([`super::octant`]).
 
+use super::octant::OctantBasis;
 use crate::cubemap::{CubeGeometry, CubeMap};
 use foundation::Rgb;
 use foundation::sh::{ShBasis, ShCoeffs, num_coeffs};
@@ -32,12 +34,6 @@ impl BasisTable {
             stride,
             values,
         }
-    }
-
-    /// Row `i` with its zero padding ([`padded_stride`] values).
-    #[inline]
-    pub(crate) fn padded_row(&self, i: usize) -> &[f32] {
-        &self.values[i * self.stride..][..self.stride]
     }
 }
 
@@ -129,173 +125,59 @@ impl BasisColumns {
 /// Projects cube maps onto SH of one order.
 #[derive(Debug, Clone)]
 pub(crate) struct ShProjector {
-    table: BasisTable,
     solid_angles: Vec<f32>,
-    /// The projection folded across x = 0, where the geometry allows it.
-    mirror: Option<MirrorProjection>,
+    /// The basis on one octant, where the geometry allows folding the projection.
+    octant: Option<OctantBasis>,
+    /// Else the basis at every texel.
+    table: Option<BasisTable>,
 }
 
 impl ShProjector {
     pub(crate) fn new(geometry: &CubeGeometry, order: usize) -> Self {
-        let table = BasisTable::new(order, geometry.directions());
+        let octant = OctantBasis::new(geometry, order);
         Self {
-            mirror: MirrorProjection::new(geometry, &table),
-            table,
             solid_angles: geometry.solid_angles().to_vec(),
+            table: octant
+                .is_none()
+                .then(|| BasisTable::new(order, geometry.directions())),
+            octant,
         }
     }
 
-    /// Basis values at the texel centres.
-    pub(crate) fn texel_basis(&self) -> &BasisTable {
-        &self.table
+    /// The basis folded into one octant, when the geometry is symmetric.
+    pub(crate) fn octant(&self) -> Option<&OctantBasis> {
+        self.octant.as_ref()
     }
 
     /// `SH(L)_k = Σ_t L_t Y_k(ω_t) Δω_t`.
     pub(crate) fn project(&self, map: &CubeMap) -> ShCoeffs<Rgb> {
-        match &self.mirror {
-            Some(mirror) => mirror.project(map, &self.solid_angles, self.table.order),
-            None => self.project_every_texel(map),
+        match (&self.octant, &self.table) {
+            (Some(octant), _) => octant.project(map),
+            (None, Some(table)) => project_every_texel(table, &self.solid_angles, map),
+            (None, None) => unreachable!("a projector has a table where it has no octant"),
         }
-    }
-
-    /// [`Self::project`] with each coefficient's sum taken texel after texel.
-    fn project_every_texel(&self, map: &CubeMap) -> ShCoeffs<Rgb> {
-        let table = &self.table;
-        let stride = table.stride;
-        let mut sums = RowSums::zeros(stride);
-        let mut weighted = [Rgb::ZERO; ROW_TILE];
-        for ((texels, d_omegas), rows) in map
-            .texels()
-            .chunks(ROW_TILE)
-            .zip(self.solid_angles.chunks(ROW_TILE))
-            .zip(table.values.chunks(ROW_TILE * stride))
-        {
-            let weighted = &mut weighted[..texels.len()];
-            for ((l, c), d_omega) in weighted.iter_mut().zip(texels).zip(d_omegas) {
-                *l = *c * *d_omega;
-            }
-            sums.add_rows(weighted, |i| &rows[i * stride..][..stride]);
-        }
-        sums.into_coeffs(table.order)
     }
 }
 
-/// The projection folded across the plane x = 0. The cube's texels are symmetric under
-/// x → −x and every real SH basis function is even or odd under it, so each coefficient is a
-/// sum over the texels with x > 0 of the basis there times the texel's radiance plus (even) or
-/// minus (odd) its mirror's: half the basis values to read and half the multiply-adds. Both
-/// symmetries are checked when it is set up (else the projection runs over every texel).
-#[derive(Debug, Clone)]
-struct MirrorProjection {
-    /// Each texel with x > 0 and its mirror image.
-    pairs: Vec<(u32, u32)>,
-    /// The coefficients even under the mirror, then their basis rows at the pairs' first texels.
-    even: Vec<usize>,
-    even_rows: Vec<f32>,
-    odd: Vec<usize>,
-    odd_rows: Vec<f32>,
-}
-
-impl MirrorProjection {
-    fn new(geometry: &CubeGeometry, table: &BasisTable) -> Option<Self> {
-        let pairs = mirror_pairs(geometry)?;
-        let n = num_coeffs(table.order);
-        let parity: Vec<bool> = (0..n)
-            .map(|k| coefficient_parity(table, &pairs, k))
-            .collect::<Option<_>>()?;
-        let (even, odd): (Vec<usize>, Vec<usize>) = (0..n).partition(|&k| parity[k]);
-        let rows_of = |columns: &[usize]| {
-            let stride = padded_stride(columns.len());
-            let mut rows = vec![0.0; pairs.len() * stride];
-            for (row, &(t, _)) in rows.chunks_exact_mut(stride).zip(&pairs) {
-                let full = table.padded_row(t as usize);
-                for (y, &k) in row.iter_mut().zip(columns) {
-                    *y = full[k];
-                }
-            }
-            rows
-        };
-        Some(Self {
-            even_rows: rows_of(&even),
-            odd_rows: rows_of(&odd),
-            pairs,
-            even,
-            odd,
-        })
-    }
-
-    fn project(&self, map: &CubeMap, solid_angles: &[f32], order: usize) -> ShCoeffs<Rgb> {
-        let texels = map.texels();
-        let (even_stride, odd_stride) = (
-            padded_stride(self.even.len()),
-            padded_stride(self.odd.len()),
-        );
-        let (mut even, mut odd) = (RowSums::zeros(even_stride), RowSums::zeros(odd_stride));
-        let (mut plus, mut minus) = ([Rgb::ZERO; ROW_TILE], [Rgb::ZERO; ROW_TILE]);
-        for (tile, pairs) in self.pairs.chunks(ROW_TILE).enumerate() {
-            for ((p, m), &(a, b)) in plus.iter_mut().zip(&mut minus).zip(pairs) {
-                let (a, b) = (a as usize, b as usize);
-                let (la, lb) = (texels[a] * solid_angles[a], texels[b] * solid_angles[b]);
-                (*p, *m) = (la + lb, la - lb);
-            }
-            let first = tile * ROW_TILE;
-            even.add_rows(&plus[..pairs.len()], |i| {
-                &self.even_rows[(first + i) * even_stride..][..even_stride]
-            });
-            odd.add_rows(&minus[..pairs.len()], |i| {
-                &self.odd_rows[(first + i) * odd_stride..][..odd_stride]
-            });
+/// [`ShProjector::project`] with each coefficient's sum taken texel after texel, the basis
+/// at the texels in `table`.
+fn project_every_texel(table: &BasisTable, solid_angles: &[f32], map: &CubeMap) -> ShCoeffs<Rgb> {
+    let stride = table.stride;
+    let mut sums = RowSums::zeros(stride);
+    let mut weighted = [Rgb::ZERO; ROW_TILE];
+    for ((texels, d_omegas), rows) in map
+        .texels()
+        .chunks(ROW_TILE)
+        .zip(solid_angles.chunks(ROW_TILE))
+        .zip(table.values.chunks(ROW_TILE * stride))
+    {
+        let weighted = &mut weighted[..texels.len()];
+        for ((l, c), d_omega) in weighted.iter_mut().zip(texels).zip(d_omegas) {
+            *l = *c * *d_omega;
         }
-        let mut coeffs = vec![Rgb::ZERO; num_coeffs(order)];
-        for (sums, columns) in [(&even, &self.even), (&odd, &self.odd)] {
-            for (value, &k) in sums.values().zip(columns.iter()) {
-                coeffs[k] = value;
-            }
-        }
-        ShCoeffs::from_vec(coeffs).expect("n² coefficients")
+        sums.add_rows(weighted, |i| &rows[i * stride..][..stride]);
     }
-}
-
-/// Each texel with x > 0 and the texel at its mirror image (x → −x), when every texel has
-/// one and none lies on the plane. (Each keeps its own solid angle in the sums.)
-fn mirror_pairs(geometry: &CubeGeometry) -> Option<Vec<(u32, u32)>> {
-    let directions = geometry.directions();
-    let mut pairs = Vec::with_capacity(directions.len() / 2);
-    for (t, d) in directions.iter().enumerate() {
-        if d.x.abs() < 1e-6 {
-            return None;
-        }
-        if d.x < 0.0 {
-            continue;
-        }
-        let image = Vec3::new(-d.x, d.y, d.z);
-        let m = geometry.texel_of(image);
-        if directions[m].distance(image) > 1e-5 {
-            return None;
-        }
-        pairs.push((t as u32, m as u32));
-    }
-    (2 * pairs.len() == directions.len()).then_some(pairs)
-}
-
-/// Whether coefficient `k` is even (`Some(true)`) or odd under x → −x, read off the basis at
-/// the pairs' texels; `None` if it is neither.
-fn coefficient_parity(table: &BasisTable, pairs: &[(u32, u32)], k: usize) -> Option<bool> {
-    let (mut even, mut odd) = (true, true);
-    for &(a, b) in pairs {
-        let (ya, yb) = (
-            table.padded_row(a as usize)[k],
-            table.padded_row(b as usize)[k],
-        );
-        let tolerance = 1e-4 * ya.abs().max(1e-3);
-        even &= (ya - yb).abs() <= tolerance;
-        odd &= (ya + yb).abs() <= tolerance;
-    }
-    match (even, odd) {
-        (true, false) => Some(true),
-        (false, true) => Some(false),
-        _ => None,
-    }
+    sums.into_coeffs(table.order)
 }
 
 /// Rows of basis values taken at a time by [`RowSums::add_rows`]: a tile stays in the first
@@ -307,14 +189,12 @@ const ROW_TILE: usize = 64;
 /// registers, so they do not go through memory at every row. Each coefficient's sum is still
 /// taken row after row (the same additions in the same order: the same floats as a plain loop).
 pub(crate) struct RowSums {
-    stride: usize,
     blocks: Vec<[[f32; LANES]; 3]>,
 }
 
 impl RowSums {
     fn zeros(stride: usize) -> Self {
         Self {
-            stride,
             blocks: vec![[[0.0; LANES]; 3]; stride / LANES],
         }
     }
@@ -378,13 +258,6 @@ impl RowSums {
         sums.copy_from_slice(&acc);
     }
 
-    /// The sums, coefficient after coefficient (padding included).
-    fn values(&self) -> impl Iterator<Item = Rgb> + '_ {
-        self.blocks
-            .iter()
-            .flat_map(|[r, g, b]| (0..LANES).map(|k| Rgb::new(r[k], g[k], b[k])))
-    }
-
     fn into_coeffs(self, order: usize) -> ShCoeffs<Rgb> {
         let coeffs = self
             .blocks
@@ -414,24 +287,14 @@ impl MemberBasis {
         }
     }
 
-    /// Makes the set the texels `members`: their rows are copied from `table` when given (the
-    /// basis at every texel), else evaluated at `directions[t]`.
-    pub(crate) fn set(
-        &mut self,
-        members: &[u32],
-        table: Option<&BasisTable>,
-        basis: &ShBasis<f32>,
-        directions: &[Vec3],
-    ) {
+    /// Makes the set the texels `members`, the basis evaluated at `directions[t]`.
+    pub(crate) fn set(&mut self, members: &[u32], basis: &ShBasis<f32>, directions: &[Vec3]) {
         let n = num_coeffs(self.order);
         let stride = padded_stride(n);
         self.rows.clear();
         self.rows.resize(members.len() * stride, 0.0);
         for (row, &t) in self.rows.chunks_exact_mut(stride).zip(members) {
-            match table {
-                Some(table) => row.copy_from_slice(table.padded_row(t as usize)),
-                None => basis.eval(directions[t as usize], &mut row[..n]),
-            }
+            basis.eval(directions[t as usize], &mut row[..n]);
         }
         self.columns.set_rows(&self.rows, stride);
     }
@@ -439,9 +302,9 @@ impl MemberBasis {
     /// `coeffs` less `Σ_i excess_i Y(d_i)` over the members, in member order (adding
     /// `−excess_i Y` subtracts exactly).
     pub(crate) fn subtract(&self, coeffs: &ShCoeffs<Rgb>, excess: &[Rgb]) -> ShCoeffs<Rgb> {
+        let stride = padded_stride(num_coeffs(self.order));
         let mut sums = RowSums::starting_at(coeffs);
         let negated: Vec<Rgb> = excess.iter().map(|e| -*e).collect();
-        let stride = sums.stride;
         sums.add_rows(&negated, |i| &self.rows[i * stride..][..stride]);
         sums.into_coeffs(self.order)
     }
@@ -489,18 +352,17 @@ mod tests {
         }
     }
 
-    /// Folded across x = 0, the projection gives every coefficient of the plain texel-by-texel
-    /// sum (to rounding), odd coefficients included, for a map with no symmetry at all.
+    /// Folded into one octant, the projection gives every coefficient of the plain
+    /// texel-by-texel sum (to rounding), odd ones included, for a map with no symmetry at all.
     #[test]
     fn the_folded_projection_equals_the_sum_over_every_texel() {
-        // An odd face size puts texels on the plane: no folding there.
-        assert!(ShProjector::new(&CubeGeometry::new(9), 3).mirror.is_none());
+        // An odd face size puts texels on the planes: no folding there.
+        assert!(ShProjector::new(&CubeGeometry::new(9), 3).octant.is_none());
         for (size, order) in [(8, 3), (64, 5), (32, 8)] {
             let geometry = CubeGeometry::new(size);
             let projector = ShProjector::new(&geometry, order);
-            let mirror = projector.mirror.as_ref();
-            let mirror = mirror.unwrap_or_else(|| panic!("size {size} is mirror-symmetric"));
-            assert!(!mirror.even.is_empty() && !mirror.odd.is_empty());
+            assert!(projector.octant.is_some(), "size {size} is symmetric");
+            let table = BasisTable::new(order, geometry.directions());
             let map = CubeMap::from_fn(&geometry, |w| {
                 let bump = (5.0 * w.x + 2.0 * w.y).sin() * (3.0 * w.z - w.x).cos();
                 Rgb::new(
@@ -509,7 +371,10 @@ mod tests {
                     (8.0 * w.x * w.y).exp(),
                 )
             });
-            let (folded, plain) = (projector.project(&map), projector.project_every_texel(&map));
+            let (folded, plain) = (
+                projector.project(&map),
+                project_every_texel(&table, geometry.solid_angles(), &map),
+            );
             let scale = plain.as_slice()[0].abs().max_element();
             for (k, (a, b)) in folded.as_slice().iter().zip(plain.as_slice()).enumerate() {
                 assert!(

@@ -236,8 +236,8 @@ fn half_maximum_region(
     while let Some(&(i, j)) = region.get(next) {
         next += 1;
         let mut neighbours = [
-            Some(((i + 1) % w, j)),
-            Some(((i + w - 1) % w, j)),
+            Some((if i + 1 == w { 0 } else { i + 1 }, j)),
+            Some((if i == 0 { w - 1 } else { i - 1 }, j)),
             None,
             None,
         ];

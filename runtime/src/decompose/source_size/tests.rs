@@ -1,6 +1,6 @@
 //! The source measurement against brute force and closed forms.
 
-use super::median::{TopBits, median_of, order_key};
+use super::median::{median_of_keys, order_key};
 use super::texels::texels_within;
 use super::*;
 use foundation::Rgb;
@@ -159,14 +159,13 @@ fn the_median_is_the_middle_element_in_total_order() {
         sorted.sort_by(f32::total_cmp);
         let keys: Vec<u32> = values.iter().map(|v| order_key(*v)).collect();
         assert_eq!(
-            median_of(&mut keys.clone()).to_bits(),
+            median_of_keys(&mut keys.clone()).to_bits(),
             sorted[len / 2].to_bits(),
             "{len} values"
         );
     }
-    assert_eq!(median_of(&mut Vec::new()), 0.0);
-    // Flat maps: all keys equal, or equal but for a few in the same top bin on either side
-    // (the selection stops early on equal keys, and keeps them all when a bin holds all).
+    assert_eq!(median_of_keys(&mut []), 0.0);
+    // Flat maps: all keys equal, or equal but for a few on either side.
     for (len, odd) in [(1001usize, 0usize), (1001, 3), (4000, 499)] {
         let mut values = vec![1.5f32; len];
         for k in 0..odd {
@@ -176,7 +175,10 @@ fn the_median_is_the_middle_element_in_total_order() {
         let mut sorted = values.clone();
         sorted.sort_by(f32::total_cmp);
         let mut keys: Vec<u32> = values.iter().map(|v| order_key(*v)).collect();
-        assert_eq!(median_of(&mut keys).to_bits(), sorted[len / 2].to_bits());
+        assert_eq!(
+            median_of_keys(&mut keys).to_bits(),
+            sorted[len / 2].to_bits()
+        );
     }
 }
 
@@ -203,8 +205,13 @@ fn brute_force_shapes(map: &EnvMap, directions: &[Vec3], cap: f32) -> Vec<Option
     (0..directions.len())
         .map(|k| {
             let d = directions[k];
-            let mut background: Vec<f32> =
-                within(d, BACKGROUND_RADIUS).into_iter().map(lum).collect();
+            let step = super::background::lattice_step(w, h, BACKGROUND_RADIUS);
+            let on_lattice = |n: usize| n % step == step / 2;
+            let mut background: Vec<f32> = within(d, BACKGROUND_RADIUS)
+                .into_iter()
+                .filter(|&(i, j)| on_lattice(i) && on_lattice(j))
+                .map(lum)
+                .collect();
             background.sort_by(f32::total_cmp);
             let background = background[background.len() / 2];
             let cell: Vec<(usize, usize)> = within(d, cap)
@@ -365,30 +372,30 @@ fn texels_within_a_cap_across_the_seam_and_the_pole() {
                     .collect();
                 brute.sort_unstable();
                 assert_eq!(found, brute, "{centre} {radius_deg}° on {width}x{height}");
-                // The bulk reading finds the same texels (each map texel's luminance is
-                // its index here, so the values name the texels).
-                let mut values = Vec::new();
-                let texels = EquirectTexels::new(width, height);
-                TexelTable {
-                    map: &indexed,
-                    texels: &texels,
+                // The bulk reading finds the same texels, or those of them on a lattice
+                // (each map texel's luminance is its index here, so the values name the
+                // texels).
+                for step in [1, 2, 3] {
+                    let mut values = Vec::new();
+                    let texels = EquirectTexels::new(width, height);
+                    TexelTable {
+                        map: &indexed,
+                        texels: &texels,
+                    }
+                    .luminances_within(centre, radius, step, &mut values);
+                    values.sort_unstable();
+                    let on_lattice = |n: usize| n % step == step / 2;
+                    let mut expected: Vec<u32> = brute
+                        .iter()
+                        .filter(|&&(i, j)| on_lattice(i) && on_lattice(j))
+                        .map(|&(i, j)| order_key(luminance(indexed.texel(i, j))))
+                        .collect();
+                    expected.sort_unstable();
+                    assert_eq!(
+                        values, expected,
+                        "{centre} {radius_deg}° on {width}x{height}, step {step}"
+                    );
                 }
-                .luminances_within(
-                    centre,
-                    radius,
-                    &mut values,
-                    &mut TopBits::new(),
-                );
-                values.sort_unstable();
-                let mut expected: Vec<u32> = brute
-                    .iter()
-                    .map(|&(i, j)| order_key(luminance(indexed.texel(i, j))))
-                    .collect();
-                expected.sort_unstable();
-                assert_eq!(
-                    values, expected,
-                    "{centre} {radius_deg}° on {width}x{height}"
-                );
             }
         }
     }

@@ -1,6 +1,6 @@
 //! A map's texels tabulated by row and column, and the texels of a cap, visited in order.
 
-use super::median::{TopBits, order_key};
+use super::median::order_key;
 use foundation::envmap::EnvMap;
 use foundation::luminance;
 use glam::Vec3;
@@ -136,17 +136,20 @@ impl TexelTable<'_> {
         (theta, first..last)
     }
 
-    /// Appends the luminance ([`order_key`]) of every texel within `radius` of `centre` to
-    /// `out` (the same texels as [`Self::for_each_within`], in no particular order). In each
-    /// row, the columns certainly inside (by more than the test's rounding) are read in bulk,
-    /// and only those near the cap's rim are tested.
+    /// Appends the luminance ([`order_key`]) of every texel of the lattice of step `step`
+    /// (rows and columns `n` with `n mod step = step / 2`; every texel for 1) within `radius`
+    /// of `centre` to `out` (of [`Self::for_each_within`]'s texels, in no particular order).
+    /// In each row, the columns certainly inside (by more than the test's rounding) are read
+    /// in bulk, and only those near the cap's rim are tested.
     pub(super) fn luminances_within(
         &self,
         centre: Vec3,
         radius: f32,
+        step: usize,
         out: &mut Vec<u32>,
-        top: &mut TopBits,
     ) {
+        // The first lattice column at or after `a`.
+        let on_lattice_from = |a: usize| a + (step / 2 + step - a % step) % step;
         let w = self.width();
         let (theta, rows) = self.cap_rows(centre, radius);
         let cos_radius = radius.cos();
@@ -154,7 +157,7 @@ impl TexelTable<'_> {
         let column_angle = std::f64::consts::TAU / w as f64;
         let (sin_c, cos_c) = (f64::from(theta).sin(), f64::from(theta).cos());
         let texels = self.map.texels();
-        for j in rows {
+        for j in rows.filter(|j| j % step == step / 2) {
             let (sin_theta, cos_theta) = self.texels.rows[j];
             let across = f64::from(sin_theta) * sin_c;
             let level = f64::from(cos_radius) - f64::from(cos_theta) * cos_c;
@@ -178,13 +181,15 @@ impl TexelTable<'_> {
                 column_range(centre_u, outer, w),
             );
             for (a, b) in inside.segments(w) {
-                top.extend(out, row[a..b].iter().map(|c| order_key(luminance(*c))));
+                let a = on_lattice_from(a).min(b);
+                let lattice = row[a..b].iter().step_by(step);
+                out.extend(lattice.map(|c| order_key(luminance(*c))));
             }
             for band in near.minus(inside, w) {
                 for (a, b) in band.segments(w) {
-                    for (i, texel) in row.iter().enumerate().take(b).skip(a) {
+                    for i in (on_lattice_from(a)..b).step_by(step) {
                         if self.direction((i, j)).dot(centre) >= cos_radius {
-                            out.push(top.count(order_key(luminance(*texel))));
+                            out.push(order_key(luminance(row[i])));
                         }
                     }
                 }
