@@ -112,22 +112,20 @@ impl OctantBasis {
     pub(crate) fn project(&self, map: &CubeMap) -> ShCoeffs<Rgb> {
         let texels = map.texels();
         let count = self.octets.len();
-        // Each octet's transform, by parity class (radiance in a vector of four).
-        let mut combos: [Vec<Vec3A>; 8] = std::array::from_fn(|_| Vec::with_capacity(count));
-        for octet in &self.octets {
-            let mut v: [Vec3A; 8] = std::array::from_fn(|s| {
-                let t = octet[s] as usize;
-                Vec3A::from(texels[t])
-            });
+        // combos[class · count + o]: octet o's transform (radiance in a vector of four).
+        let mut combos = vec![Vec3A::ZERO; 8 * count];
+        for (o, octet) in self.octets.iter().enumerate() {
+            let mut v: [Vec3A; 8] = std::array::from_fn(|s| Vec3A::from(texels[octet[s] as usize]));
             walsh_hadamard(&mut v);
-            for (class, value) in combos.iter_mut().zip(v) {
-                class.push(value);
+            for (class, value) in v.into_iter().enumerate() {
+                combos[class * count + o] = value;
             }
         }
         let coeffs = (0..num_coeffs(self.order))
             .map(|k| {
                 let column = &self.columns[k * count..][..count];
-                Rgb::from(weighted_sum(&combos[self.parity[k] as usize], column))
+                let class = self.parity[k] as usize;
+                Rgb::from(weighted_sum(&combos[class * count..][..count], column))
             })
             .collect();
         ShCoeffs::from_vec(coeffs).expect("n² coefficients")
