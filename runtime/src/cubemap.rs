@@ -441,8 +441,8 @@ impl CubeResampler {
             // A whole number of texels (no turn at all, for a map that changes in its own
             // frame): source texel (i, j) is texel i + whole of row j, wrapping, read where it
             // is gathered (the interpolation below would give the same floats).
-            return self.gather(out, |s, column| {
-                let c = column as usize + whole;
+            return self.gather(out, |e| {
+                let (s, c) = (self.sources[e], self.columns[e] as usize + whole);
                 texels[if c >= w {
                     s as usize + whole - w
                 } else {
@@ -461,22 +461,18 @@ impl CubeResampler {
                 shifted.push(shifted[0]);
                 lerped.extend(shifted.windows(2).map(|p| p[0] * (1.0 - t) + p[1] * t));
             }
-            self.gather(out, |s, _| lerped[s as usize]);
+            self.gather(out, |e| lerped[self.sources[e] as usize]);
         });
     }
 
-    /// Fills each cube texel with its sources' shares, source `s` (in column `c` of its row)
-    /// read as `source(s, c)`.
-    fn gather(&self, out: &mut CubeMap, source: impl Fn(u32, u32) -> Rgb) {
+    /// Fills each cube texel with its sources' shares, the `e`-th share's source read as
+    /// `source(e)` (from `sources[e]`, and `columns[e]` where needed).
+    fn gather(&self, out: &mut CubeMap, source: impl Fn(usize) -> Rgb) {
         for (texel, range) in out.texels.iter_mut().zip(self.starts.windows(2)) {
             let range = range[0] as usize..range[1] as usize;
             let mut sum = Rgb::ZERO;
-            for ((s, c), g) in self.sources[range.clone()]
-                .iter()
-                .zip(&self.columns[range.clone()])
-                .zip(&self.gains[range])
-            {
-                sum += source(*s, *c) * *g;
+            for (e, g) in range.clone().zip(&self.gains[range]) {
+                sum += source(e) * *g;
             }
             *texel = sum;
         }
