@@ -1,7 +1,9 @@
 //! Per-frame decomposition cost (one thread): `cargo bench -p runtime --bench decompose`.
-//! Targets: 6×64×64 under 2 ms, 6×256×256 under 15 ms; turning a decomposed map (SH rotation
-//! of the SH part and the lights) well under 0.05 ms at order 5; median cut (a peer) at 32
-//! lights under 1 ms on a 256 × 128 map.
+//! Targets: 6×64×64 under 0.5 ms (a changing map's whole frame, resampling and the sources'
+//! sizes included, under 2 ms: `hprt bench turn`), 6×256×256 under 15 ms; turning a decomposed
+//! map (SH rotation of the SH part and the lights) well under 0.05 ms at order 5; median cut (a
+//! peer) at 32 lights under 1 ms on a 256 × 128 map. This machine's speed drifts by a third
+//! within minutes: compare two builds with interleaved runs.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use runtime::{CubeSource, DecomposeMode, DecomposeSettings, Decomposer, EnvironmentLighting};
