@@ -300,8 +300,6 @@ pub struct CubeResampler {
     /// texels would read and write the cube texel once per share.
     starts: Vec<u32>,
     sources: Vec<u32>,
-    /// The column of each of `sources` in its row (to wrap a rotated row's end).
-    columns: Vec<u32>,
     gains: Vec<f32>,
 }
 
@@ -407,14 +405,12 @@ impl CubeResampler {
             .map(|(t, a)| (*a / geometry.solid_angles()[*t as usize] as f64) as f32)
             .collect();
         let (starts, sources, gains) = by_target(&starts, &targets, &gains, geometry.texel_count());
-        let columns = sources.iter().map(|s| s % map_width as u32).collect();
         Self {
             size,
             map_width,
             map_height,
             starts,
             sources,
-            columns,
             gains,
         }
     }
@@ -437,18 +433,10 @@ impl CubeResampler {
         let shift = (rotation / std::f32::consts::TAU).rem_euclid(1.0) * w as f32;
         let (whole, t) = (shift.floor() as usize % w, shift.fract());
         let texels = map.texels();
-        if t == 0.0 {
-            // A whole number of texels (no turn at all, for a map that changes in its own
-            // frame): source texel (i, j) is texel i + whole of row j, wrapping, read where it
-            // is gathered (the interpolation below would give the same floats).
-            return self.gather(out, |e| {
-                let (s, c) = (self.sources[e], self.columns[e] as usize + whole);
-                texels[if c >= w {
-                    s as usize + whole - w
-                } else {
-                    s as usize + whole
-                }]
-            });
+        if whole == 0 && t == 0.0 {
+            // Not turned (a map that changes in its own frame): the map is read where it is
+            // gathered, without the shifted copy (which would hold the same floats).
+            return self.gather(out, |s| texels[s]);
         }
         SHIFTED_SOURCE.with_borrow_mut(|lerped| {
             lerped.clear();
@@ -461,18 +449,17 @@ impl CubeResampler {
                 shifted.push(shifted[0]);
                 lerped.extend(shifted.windows(2).map(|p| p[0] * (1.0 - t) + p[1] * t));
             }
-            self.gather(out, |e| lerped[self.sources[e] as usize]);
+            self.gather(out, |s| lerped[s]);
         });
     }
 
-    /// Fills each cube texel with its sources' shares, the `e`-th share's source read as
-    /// `source(e)` (from `sources[e]`, and `columns[e]` where needed).
+    /// Fills each cube texel with its sources' shares, source texel `s` read as `source(s)`.
     fn gather(&self, out: &mut CubeMap, source: impl Fn(usize) -> Rgb) {
         for (texel, range) in out.texels.iter_mut().zip(self.starts.windows(2)) {
             let range = range[0] as usize..range[1] as usize;
             let mut sum = Rgb::ZERO;
-            for (e, g) in range.clone().zip(&self.gains[range]) {
-                sum += source(e) * *g;
+            for (s, g) in self.sources[range.clone()].iter().zip(&self.gains[range]) {
+                sum += source(*s as usize) * *g;
             }
             *texel = sum;
         }

@@ -126,35 +126,43 @@ impl BasisColumns {
 #[derive(Debug, Clone)]
 pub(crate) struct ShProjector {
     solid_angles: Vec<f32>,
-    /// The basis on one octant, where the geometry allows folding the projection.
-    octant: Option<OctantBasis>,
-    /// Else the basis at every texel.
-    table: Option<BasisTable>,
+    basis: ProjectorBasis,
+}
+
+/// The basis a projector sums with.
+#[derive(Debug, Clone)]
+enum ProjectorBasis {
+    /// On one octant, where the geometry allows folding the projection.
+    Octant(OctantBasis),
+    /// At every texel.
+    Texels(BasisTable),
 }
 
 impl ShProjector {
     pub(crate) fn new(geometry: &CubeGeometry, order: usize) -> Self {
-        let octant = OctantBasis::new(geometry, order);
+        let basis = match OctantBasis::new(geometry, order) {
+            Some(octant) => ProjectorBasis::Octant(octant),
+            None => ProjectorBasis::Texels(BasisTable::new(order, geometry.directions())),
+        };
         Self {
             solid_angles: geometry.solid_angles().to_vec(),
-            table: octant
-                .is_none()
-                .then(|| BasisTable::new(order, geometry.directions())),
-            octant,
+            basis,
         }
     }
 
     /// The basis folded into one octant, when the geometry is symmetric.
     pub(crate) fn octant(&self) -> Option<&OctantBasis> {
-        self.octant.as_ref()
+        match &self.basis {
+            ProjectorBasis::Octant(octant) => Some(octant),
+            ProjectorBasis::Texels(_) => None,
+        }
     }
 
     /// `SH(L)_k = Σ_t L_t Y_k(ω_t) Δω_t`.
     pub(crate) fn project(&self, map: &CubeMap) -> ShCoeffs<Rgb> {
-        match (&self.octant, &self.table) {
-            (Some(octant), _) => octant.project(map),
-            (None, Some(table)) => project_every_texel(table, &self.solid_angles, map),
-            (None, None) => unreachable!("a projector has a table where it has no octant"),
+        match &self.basis {
+            ProjectorBasis::Octant(octant) => octant.project(map),
+            ProjectorBasis::Texels(table) => project_every_texel(table, &self.solid_angles, map),
         }
     }
 }
@@ -357,11 +365,15 @@ mod tests {
     #[test]
     fn the_folded_projection_equals_the_sum_over_every_texel() {
         // An odd face size puts texels on the planes: no folding there.
-        assert!(ShProjector::new(&CubeGeometry::new(9), 3).octant.is_none());
+        assert!(
+            ShProjector::new(&CubeGeometry::new(9), 3)
+                .octant()
+                .is_none()
+        );
         for (size, order) in [(8, 3), (64, 5), (32, 8)] {
             let geometry = CubeGeometry::new(size);
             let projector = ShProjector::new(&geometry, order);
-            assert!(projector.octant.is_some(), "size {size} is symmetric");
+            assert!(projector.octant().is_some(), "size {size} is symmetric");
             let table = BasisTable::new(order, geometry.directions());
             let map = CubeMap::from_fn(&geometry, |w| {
                 let bump = (5.0 * w.x + 2.0 * w.y).sin() * (3.0 * w.z - w.x).cos();

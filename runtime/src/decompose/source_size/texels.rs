@@ -68,8 +68,7 @@ impl TexelTable<'_> {
     }
 
     /// Calls `visit` for each texel `(i, j)` within `radius` of `centre`, with its direction:
-    /// rows by polar angle,
-    /// then in each row the columns of an azimuth window around the centre's, in increasing
+    /// rows by polar angle, then in each row the columns of an azimuth window around the centre's, in increasing
     /// azimuth from the window's start (wrapping). Only the part of the window that can be
     /// that close (with two texels' margin) is tested.
     pub(super) fn for_each_within(
