@@ -9,8 +9,9 @@
 //!
 //! Two ways of turning the peaks into lights ([`DecomposeMode`]): the thesis' own, and an
 //! energy-consistent one in which the lights carry exactly the map's energy in their caps and
-//! the SH part is refitted to what remains.
+//! the SH part is refitted to what remains ([`consistent`]).
 
+mod consistent;
 mod decomposition;
 mod icosphere;
 mod octant;
@@ -77,9 +78,14 @@ pub struct Decomposer {
     /// Its smoothed luminance at the icosahedron's vertices.
     smoothed: Vec<f32>,
     ring: Vec<u32>,
-    /// The texels of the caps asked for in this frame, by centre and radius.
+    /// The texels of the caps asked for in this frame (the first `caps_used`), by centre and
+    /// radius; the rest keep their allocations for the next frame's.
     caps: Vec<(Vec3, f32, Vec<u32>)>,
+    caps_used: usize,
     owner: Vec<(u16, f32)>,
+    /// The unrefitted SH part at the texels of the last caps refitted (by texel): the
+    /// extraction's first step at the ranking's texels.
+    full_at: Vec<Rgb>,
     member_basis: MemberBasis,
 }
 
@@ -131,7 +137,9 @@ impl Decomposer {
             smoothed: Vec::new(),
             ring: Vec::new(),
             caps: Vec::new(),
+            caps_used: 0,
             owner: vec![(u16::MAX, 0.0); texels],
+            full_at: vec![Rgb::ZERO; texels],
         })
     }
 
@@ -151,7 +159,17 @@ impl Decomposer {
     /// Plain (unwindowed) SH projection of the whole map: the thesis' PRT baseline lighting.
     pub fn project(&mut self, map: &CubeMap) -> ShCoeffs<Rgb> {
         self.prepare_analysis(map);
-        self.projector.project(self.analysis_map(map))
+        self.project_analysis(map)
+    }
+
+    /// The SH projection of the analysis map of `map` (prepared).
+    fn project_analysis(&mut self, map: &CubeMap) -> ShCoeffs<Rgb> {
+        let analysis = if self.downsample.is_empty() {
+            map
+        } else {
+            &self.analysis_map
+        };
+        self.projector.project(analysis)
     }
 
     /// Box-filters `map` to the analysis resolution (when it is larger).
@@ -189,13 +207,13 @@ impl Decomposer {
             self.settings.face_size,
             "cube map of the wrong size"
         );
-        let total_power = map.total_power(&self.geometry);
-        self.caps.clear();
+        self.caps_used = 0;
         self.prepare_analysis(map);
-        let full = self.projector.project(self.analysis_map(map));
+        let total_power = self.power_and_luminances(map);
+        let full = self.project_analysis(map);
         let mut detection = full.clone();
         detection.scale_bands(&self.detection_window);
-        let directions = self.find_peaks(map, &detection, luminance(total_power) / (4.0 * PI));
+        let directions = self.find_peaks(&detection, luminance(total_power) / (4.0 * PI));
         let candidates = directions.len();
         let (sh, mut lights) = match self.settings.mode {
             DecomposeMode::Thesis => {
@@ -221,71 +239,34 @@ impl Decomposer {
         }
     }
 
-    /// What `map` holds around `centres` as the consistent mode measures a light: the excess
-    /// of the map over the refitted SH part in each centre's cap (texels shared by caps go to
-    /// the nearest centre). Measures a map's own "local level" where another map has a light.
-    pub fn cap_excess(&mut self, map: &CubeMap, centres: &[Vec3]) -> Vec<Rgb> {
-        assert_eq!(
-            map.size(),
-            self.settings.face_size,
-            "cube map of the wrong size"
-        );
-        self.prepare_analysis(map);
-        let full = self.projector.project(self.analysis_map(map));
-        self.caps.clear();
-        self.cap_powers(map, &full, centres, CONSISTENT_ITERATIONS)
-    }
-
-    /// The power of the excess in each of `centres`' caps after `iterations` refits ([`Self::
-    /// extract`]'s lights' powers, without their directions and sizes).
-    fn cap_powers(
-        &mut self,
-        map: &CubeMap,
-        full: &ShCoeffs<Rgb>,
-        centres: &[Vec3],
-        iterations: usize,
-    ) -> Vec<Rgb> {
-        let radius = self.settings.radius_deg.to_radians();
-        let members = self.cap_members(centres, radius);
-        let (_, excess) = self.refit(map, full, &members, iterations, false);
-        let mut power = vec![Rgb::ZERO; centres.len()];
-        for (e, &t) in excess.iter().zip(&members) {
-            let i = self.owner[t as usize].0 as usize;
-            power[i] += *e * self.geometry.solid_angles()[t as usize];
+    /// The total power of `map`, and the analysis map's luminances (prepared) into
+    /// `luminances`: one pass over the map when it is the analysis map.
+    fn power_and_luminances(&mut self, map: &CubeMap) -> Rgb {
+        let luminances = &mut self.luminances;
+        luminances.clear();
+        if self.downsample.is_empty() {
+            return map.total_power_visiting(&self.geometry, |c| luminances.push(luminance(c)));
         }
-        for &t in &members {
-            self.owner[t as usize] = (u16::MAX, 0.0);
-        }
-        power
+        luminances.extend(self.analysis_map.texels().iter().map(|c| luminance(*c)));
+        map.total_power(&self.geometry)
     }
 
     /// Steps 1, 2 and 4: smoothed map minus SH part on the icosahedron, its significant local
     /// maxima, refined: their directions, in decreasing order of the residual at the vertex
-    /// each was climbed to (the analysis map of `map` prepared).
-    fn find_peaks(
-        &mut self,
-        map: &CubeMap,
-        detection: &ShCoeffs<Rgb>,
-        mean_luminance: f32,
-    ) -> Vec<Vec3> {
-        let analysis = if self.downsample.is_empty() {
-            map
-        } else {
-            &self.analysis_map
-        };
+    /// each was climbed to (the analysis map of `map` prepared, its luminances measured).
+    fn find_peaks(&mut self, detection: &ShCoeffs<Rgb>, mean_luminance: f32) -> Vec<Vec3> {
         // Smoothing is linear: the luminance of the smoothed map is the smoothed luminance.
-        self.luminances.clear();
-        self.luminances
-            .extend(analysis.texels().iter().map(|c| luminance(*c)));
         self.smoothing
             .apply_scalar(&self.luminances, &mut self.smoothed);
+        // Luminance is linear too: the expansion's luminance is that of its coefficients.
+        let detection: Vec<f32> = detection.as_slice().iter().map(|c| luminance(*c)).collect();
         let mut expansion = Vec::new();
-        self.ico_basis.eval_all(detection, &mut expansion);
+        self.ico_basis.eval_scalar_all(&detection, &mut expansion);
         let residual: Vec<f32> = self
             .smoothed
             .iter()
             .zip(&expansion)
-            .map(|(s, p)| *s - luminance(*p))
+            .map(|(s, p)| *s - *p)
             .collect();
         let floor = self.settings.min_contrast * mean_luminance;
         let mut maxima: Vec<u32> = self
@@ -368,180 +349,6 @@ impl Decomposer {
                 share: 0.0,
             })
             .collect()
-    }
-
-    /// Consistent: lights carry the map's excess over the SH part in their caps; the SH part is
-    /// the projection of what remains.
-    fn consistent_lights(
-        &mut self,
-        map: &CubeMap,
-        full: &ShCoeffs<Rgb>,
-        centres: &[Vec3],
-    ) -> (ShCoeffs<Rgb>, Vec<DirectionalLight>) {
-        // One refit step is enough to rank the candidates.
-        let trial: Vec<f32> = self
-            .cap_powers(map, full, centres, 1)
-            .iter()
-            .map(|p| luminance(*p))
-            .collect();
-        let mut order: Vec<usize> = (0..trial.len()).filter(|&i| trial[i] > 0.0).collect();
-        order.sort_by(|a, b| trial[*b].total_cmp(&trial[*a]));
-        let luminances: Vec<f32> = order.iter().map(|&i| trial[i]).collect();
-        let kept: Vec<Vec3> = order[..self.keep_count(&luminances)]
-            .iter()
-            .map(|&i| centres[i])
-            .collect();
-        let (mut sh, mut lights) = self.extract(map, full, &kept, CONSISTENT_ITERATIONS);
-        sh.scale_bands(&self.sh_window);
-        lights.retain(|l| luminance(l.power) > 0.0);
-        lights.sort_by(|a, b| luminance(b.power).total_cmp(&luminance(a.power)));
-        (sh, lights)
-    }
-
-    /// The texels within `radius` of any of `centres`, each once, in the order found; each
-    /// texel's nearest centre is left in `owner` (the caller resets it).
-    fn cap_members(&mut self, centres: &[Vec3], radius: f32) -> Vec<u32> {
-        let mut members: Vec<u32> = Vec::new();
-        for (i, c) in centres.iter().enumerate() {
-            // The ranking and the extraction ask for the same caps: each is found once.
-            let cap = match self
-                .caps
-                .iter()
-                .position(|(d, r, _)| d == c && *r == radius)
-            {
-                Some(k) => &self.caps[k].2,
-                None => {
-                    let mut cap = Vec::new();
-                    self.geometry.texels_within(*c, radius, &mut cap);
-                    self.caps.push((*c, radius, cap));
-                    &self.caps[self.caps.len() - 1].2
-                }
-            };
-            for &t in cap {
-                let cos = self.geometry.directions()[t as usize].dot(*c);
-                let slot = &mut self.owner[t as usize];
-                if slot.0 == u16::MAX {
-                    members.push(t);
-                    *slot = (i as u16, cos);
-                } else if cos > slot.1 {
-                    *slot = (i as u16, cos);
-                }
-            }
-        }
-        members
-    }
-
-    /// The excess at each of `members` after `iterations` refits of the SH part, and that part
-    /// refitted to the last excess when `keep_sh` (else `full`).
-    fn refit(
-        &mut self,
-        map: &CubeMap,
-        full: &ShCoeffs<Rgb>,
-        members: &[u32],
-        iterations: usize,
-        keep_sh: bool,
-    ) -> (ShCoeffs<Rgb>, Vec<Rgb>) {
-        let texels = map.texels();
-        // At the analysis resolution the projector has the basis at every texel already (folded
-        // into one octant); otherwise it is evaluated at the members.
-        let octant = if self.downsample.is_empty() {
-            self.projector.octant()
-        } else {
-            None
-        };
-        if octant.is_none() {
-            self.member_basis
-                .set(members, &self.basis, self.geometry.directions());
-        }
-        let mut sh = full.clone();
-        let mut excess: Vec<Rgb> = vec![Rgb::ZERO; members.len()];
-        let (mut expansion, mut projected) = (Vec::new(), Vec::new());
-        for step in 0..iterations {
-            // P = SH(map) − SH(excess), P refitted to the map less the excess.
-            match octant {
-                Some(octant) => octant.eval_at(&sh, members, &mut expansion),
-                None => self.member_basis.eval_all(&sh, &mut expansion),
-            }
-            for ((e, &t), p) in excess.iter_mut().zip(members).zip(&expansion) {
-                *e = (texels[t as usize] - *p).max(Rgb::ZERO);
-            }
-            if step + 1 == iterations && !keep_sh {
-                break;
-            }
-            projected.clear();
-            projected.extend(
-                excess
-                    .iter()
-                    .zip(members)
-                    .map(|(e, &t)| *e * self.geometry.solid_angles()[t as usize]),
-            );
-            sh = match octant {
-                Some(octant) => octant.subtract(full, members, &projected),
-                None => self.member_basis.subtract(full, &projected),
-            };
-        }
-        (sh, excess)
-    }
-
-    /// For caps of radius R around `centres`: the excess `max(0, L − P)` of the map over the SH
-    /// part `P`, where `P` is refitted to the map minus that excess (a few fixed-point steps).
-    /// Texels in several caps belong to the nearest centre. Returns the final `P` and one light
-    /// per centre.
-    fn extract(
-        &mut self,
-        map: &CubeMap,
-        full: &ShCoeffs<Rgb>,
-        centres: &[Vec3],
-        iterations: usize,
-    ) -> (ShCoeffs<Rgb>, Vec<DirectionalLight>) {
-        let radius = self.settings.radius_deg.to_radians();
-        let members = self.cap_members(centres, radius);
-        let (sh, excess) = self.refit(map, full, &members, iterations, true);
-        // Each light: power, luminance-weighted centroid and spread of its excess.
-        let mut power = vec![Rgb::ZERO; centres.len()];
-        let mut moment = vec![Vec3::ZERO; centres.len()];
-        for (e, &t) in excess.iter().zip(&members) {
-            let i = self.owner[t as usize].0 as usize;
-            let d_omega = self.geometry.solid_angles()[t as usize];
-            power[i] += *e * d_omega;
-            moment[i] += self.geometry.directions()[t as usize] * (luminance(*e) * d_omega);
-        }
-        let directions: Vec<Vec3> = moment
-            .iter()
-            .zip(centres)
-            .map(|(m, c)| m.try_normalize().unwrap_or(*c))
-            .collect();
-        let mut spread = vec![0.0f32; centres.len()];
-        for (e, &t) in excess.iter().zip(&members) {
-            let i = self.owner[t as usize].0 as usize;
-            let theta = self.geometry.directions()[t as usize].angle_between(directions[i]);
-            spread[i] += theta * theta * luminance(*e) * self.geometry.solid_angles()[t as usize];
-        }
-        for &t in &members {
-            self.owner[t as usize] = (u16::MAX, 0.0);
-        }
-        let lights = (0..centres.len())
-            .map(|i| {
-                let lum = luminance(power[i]);
-                // A uniform disc of radius ρ has E[θ²] = ρ²/2.
-                let rho = if lum > 0.0 {
-                    (2.0 * spread[i] / lum).sqrt()
-                } else {
-                    0.0
-                }
-                .clamp(0.25f32.to_radians(), radius);
-                DirectionalLight {
-                    direction: directions[i],
-                    power: power[i],
-                    cap_radius: radius,
-                    angular_radius: rho,
-                    halo_radius: rho,
-                    core_fraction: 1.0,
-                    share: 0.0,
-                }
-            })
-            .collect();
-        (sh, lights)
     }
 }
 

@@ -24,6 +24,8 @@ type Slot = (u32, u8);
 
 /// Basis rows are padded to a multiple of this many values (two vectors of four).
 const LANES: usize = 8;
+/// Octets transformed at a time by the projection (a multiple of four).
+const PROJECTION_TILE: usize = 128;
 
 /// The basis of one order tabulated on one octant of a cube, with each texel's octant texel
 /// and reflection.
@@ -112,21 +114,29 @@ impl OctantBasis {
     pub(crate) fn project(&self, map: &CubeMap) -> ShCoeffs<Rgb> {
         let texels = map.texels();
         let count = self.octets.len();
-        // combos[class · count + o]: octet o's transform (radiance in a vector of four).
-        let mut combos = vec![Vec3A::ZERO; 8 * count];
-        for (o, octet) in self.octets.iter().enumerate() {
-            let mut v: [Vec3A; 8] = std::array::from_fn(|s| Vec3A::from(texels[octet[s] as usize]));
-            walsh_hadamard(&mut v);
-            for (class, value) in v.into_iter().enumerate() {
-                combos[class * count + o] = value;
+        // Four partial sums per coefficient (octet o into sum o mod 4).
+        let mut sums = vec![[Vec3A::ZERO; 4]; num_coeffs(self.order)];
+        // The transforms of a tile of octets (radiance in a vector of four), by class: the tile
+        // stays in the first-level cache while every coefficient passes over it.
+        let mut combos = [[Vec3A::ZERO; PROJECTION_TILE]; 8];
+        for first in (0..count).step_by(PROJECTION_TILE) {
+            let len = PROJECTION_TILE.min(count - first);
+            for (i, octet) in self.octets[first..first + len].iter().enumerate() {
+                let mut v: [Vec3A; 8] =
+                    std::array::from_fn(|s| Vec3A::from(texels[octet[s] as usize]));
+                walsh_hadamard(&mut v);
+                for (class, value) in v.into_iter().enumerate() {
+                    combos[class][i] = value;
+                }
+            }
+            for (k, sums) in sums.iter_mut().enumerate() {
+                let column = &self.columns[k * count + first..][..len];
+                add_weighted(sums, &combos[self.parity[k] as usize][..len], column);
             }
         }
-        let coeffs = (0..num_coeffs(self.order))
-            .map(|k| {
-                let column = &self.columns[k * count..][..count];
-                let class = self.parity[k] as usize;
-                Rgb::from(weighted_sum(&combos[class * count..][..count], column))
-            })
+        let coeffs = sums
+            .iter()
+            .map(|s| Rgb::from((s[0] + s[1]) + (s[2] + s[3])))
             .collect();
         ShCoeffs::from_vec(coeffs).expect("n² coefficients")
     }
@@ -140,15 +150,23 @@ impl OctantBasis {
             let (o, s) = self.slots[t as usize];
             let row = &self.rows[o as usize * self.stride..][..self.stride];
             let coeffs = &signed[s as usize * quads..][..quads];
-            // Four partial sums per channel (coefficient k into lane k mod 4).
-            let mut sums = [Vec4::ZERO; 3];
-            for (y, [r, g, b]) in row.chunks_exact(4).zip(coeffs) {
-                let y = Vec4::from_slice(y);
-                sums[0] += *r * y;
-                sums[1] += *g * y;
-                sums[2] += *b * y;
+            // Eight partial sums per channel (coefficient k into lane k mod 4 of the sums of
+            // even or of odd quads), so that the additions do not wait on one another.
+            let (mut even, mut odd) = ([Vec4::ZERO; 3], [Vec4::ZERO; 3]);
+            let pairs = row.chunks_exact(8).zip(coeffs.chunks_exact(2));
+            for (y, [[r0, g0, b0], [r1, g1, b1]]) in pairs.map(|(y, c)| (y, [c[0], c[1]])) {
+                let (y0, y1) = (Vec4::from_slice(&y[..4]), Vec4::from_slice(&y[4..]));
+                even[0] += r0 * y0;
+                even[1] += g0 * y0;
+                even[2] += b0 * y0;
+                odd[0] += r1 * y1;
+                odd[1] += g1 * y1;
+                odd[2] += b1 * y1;
             }
-            let [r, g, b] = sums.map(|v| (v.x + v.y) + (v.z + v.w));
+            let [r, g, b] = [0, 1, 2].map(|c| {
+                let v = even[c] + odd[c];
+                (v.x + v.y) + (v.z + v.w)
+            });
             Rgb::new(r, g, b)
         }));
     }
@@ -282,10 +300,9 @@ fn walsh_hadamard(v: &mut [Vec3A; 8]) {
     ];
 }
 
-/// `Σ_i values_i weights_i` in four partial sums (element `i` into sum `i mod 4`), added
-/// pairwise, the tail into the first.
-fn weighted_sum(values: &[Vec3A], weights: &[f32]) -> Vec3A {
-    let mut sums = [Vec3A::ZERO; 4];
+/// Adds `values_i weights_i` to four partial sums (element `i` into sum `i mod 4`), the
+/// remainder of a length not a multiple of four into the first.
+fn add_weighted(sums: &mut [Vec3A; 4], values: &[Vec3A], weights: &[f32]) {
     let (v_chunks, w_chunks) = (values.chunks_exact(4), weights.chunks_exact(4));
     for (v, w) in v_chunks.remainder().iter().zip(w_chunks.remainder()) {
         sums[0] += *v * *w;
@@ -295,7 +312,6 @@ fn weighted_sum(values: &[Vec3A], weights: &[f32]) -> Vec3A {
             sums[j] += v[j] * w[j];
         }
     }
-    (sums[0] + sums[1]) + (sums[2] + sums[3])
 }
 
 #[cfg(test)]

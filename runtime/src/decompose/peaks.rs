@@ -13,12 +13,16 @@ pub(crate) fn fit_quadric(samples: &[(f32, f32, f32, f32)]) -> Option<[f32; 6]> 
     for &(x, y, f, weight) in samples {
         let (x, y, weight) = (x as f64, y as f64, weight as f64);
         let row = [1.0, x, y, x * x, x * y, y * y];
+        // AᵀWA is symmetric: its upper triangle, mirrored below.
         for i in 0..6 {
-            for j in 0..6 {
+            for j in i..6 {
                 m[i][j] += weight * row[i] * row[j];
             }
             m[i][6] += weight * row[i] * f as f64;
         }
+    }
+    for (i, j) in (1..6).flat_map(|i| (0..i).map(move |j| (i, j))) {
+        m[i][j] = m[j][i];
     }
     let scale = (0..6).map(|i| m[i][i]).fold(0.0, f64::max);
     for col in 0..6 {

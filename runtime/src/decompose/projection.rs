@@ -89,6 +89,22 @@ impl BasisColumns {
         self.eval_with(coeffs, out, self.count, |column, i| column[i]);
     }
 
+    /// The value of the one-channel expansion `coeffs` (bands beyond the table's order
+    /// ignored) at every direction: for a luminance, a third of the work of [`Self::eval_all`].
+    pub(crate) fn eval_scalar_all(&self, coeffs: &[f32], out: &mut Vec<f32>) {
+        out.clear();
+        out.resize(self.count, 0.0);
+        let n = num_coeffs(self.order).min(coeffs.len());
+        for (c, column) in coeffs[..n]
+            .iter()
+            .zip(self.values.chunks_exact(self.count.max(1)))
+        {
+            for (o, y) in out.iter_mut().zip(column) {
+                *o += c * y;
+            }
+        }
+    }
+
     /// `count` values, the `i`-th with basis values `y(column_k, i)`, coefficient after
     /// coefficient.
     #[inline]
@@ -342,6 +358,13 @@ mod tests {
         BasisColumns::new(5, &directions).eval_all(&sh, &mut all);
         for (value, d) in all.iter().zip(&directions) {
             assert_eq!(value.to_array(), sh.eval(*d).to_array(), "direction {d}");
+        }
+        // One channel alone: the green channel's expansion.
+        let green: Vec<f32> = sh.as_slice().iter().map(|c| c.y).collect();
+        let mut scalar = Vec::new();
+        BasisColumns::new(5, &directions).eval_scalar_all(&green, &mut scalar);
+        for (value, rgb) in scalar.iter().zip(&all) {
+            assert_eq!(*value, rgb.y);
         }
     }
 
