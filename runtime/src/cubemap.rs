@@ -128,22 +128,11 @@ impl CubeMap {
 
     /// `∫ L dω` over the sphere.
     pub fn total_power(&self, geometry: &CubeGeometry) -> Rgb {
-        self.total_power_visiting(geometry, |_| {})
-    }
-
-    /// [`Self::total_power`], handing each texel to `visit` on the way: a frame that needs
-    /// something else of every texel reads the map once.
-    pub(crate) fn total_power_visiting(
-        &self,
-        geometry: &CubeGeometry,
-        mut visit: impl FnMut(Rgb),
-    ) -> Rgb {
         // Four partial sums (texel i into sum i mod 4), so that the additions do not wait on
         // one another: this runs every frame.
         let mut sums = [glam::Vec3A::ZERO; 4];
         for (i, (c, w)) in self.texels.iter().zip(&geometry.solid_angles).enumerate() {
             sums[i % 4] += glam::Vec3A::from(*c) * *w;
-            visit(*c);
         }
         Rgb::from((sums[0] + sums[1]) + (sums[2] + sums[3]))
     }

@@ -240,14 +240,16 @@ impl Decomposer {
     }
 
     /// The total power of `map`, and the analysis map's luminances (prepared) into
-    /// `luminances`: one pass over the map when it is the analysis map.
+    /// `luminances`. (Two passes measured faster than one that does both: each vectorizes.)
     fn power_and_luminances(&mut self, map: &CubeMap) -> Rgb {
-        let luminances = &mut self.luminances;
-        luminances.clear();
-        if self.downsample.is_empty() {
-            return map.total_power_visiting(&self.geometry, |c| luminances.push(luminance(c)));
-        }
-        luminances.extend(self.analysis_map.texels().iter().map(|c| luminance(*c)));
+        let analysis = if self.downsample.is_empty() {
+            map
+        } else {
+            &self.analysis_map
+        };
+        self.luminances.clear();
+        self.luminances
+            .extend(analysis.texels().iter().map(|c| luminance(*c)));
         map.total_power(&self.geometry)
     }
 
