@@ -33,6 +33,8 @@ enum Command {
     Bake(commands::bake::BakeArgs),
     /// Decompose an environment map into an SH polynomial plus directional lights.
     Decompose(commands::decompose::DecomposeArgs),
+    /// An HDR environment map from photographs: oriented shots or a mirror ball, bracketed.
+    Capture(commands::capture::CaptureArgs),
     /// Render a baked scene on the GPU: hybrid (SH + shadow-mapped lights) or plain PRT.
     Render(commands::render::RenderArgs),
     /// Render the CPU path-traced reference of a scene.
@@ -81,6 +83,7 @@ fn main() {
         Command::Bench(cmd) => commands::bench::run(cmd),
         Command::Scene(cmd) => commands::scene::run(cmd),
         Command::Decompose(args) => commands::decompose::run(args),
+        Command::Capture(args) => commands::capture::run(args),
         Command::Reference(args) => commands::reference::run(args),
         Command::Render(args) => commands::render::run(args),
         Command::View(args) => view::run(args),

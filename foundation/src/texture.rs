@@ -31,7 +31,7 @@ pub(crate) fn decode_image(bytes: &[u8]) -> Result<image::DynamicImage, TextureE
 
 /// [`decode_image`] with other limits: more than `max_pixels` pixels or a side over
 /// `max_side` is [`TextureError::TooLarge`].
-pub(crate) fn decode_image_within(
+pub fn decode_image_within(
     bytes: &[u8],
     max_pixels: u64,
     max_side: u32,

@@ -5,6 +5,7 @@
 
 pub mod bake;
 pub mod bench;
+pub mod capture;
 pub mod decompose;
 pub mod demo;
 pub mod export;

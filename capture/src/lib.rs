@@ -1,0 +1,37 @@
+//! HDR capture: an environment map from ordinary photographs (the mobile-AR paper's section
+//! 3.1; Debevec 1998 for the mirror ball).
+//!
+//! Three independent pieces, as OpenCV's photo module keeps them (docs/STYLE.md):
+//! - `response`: the camera's inverse response, recovered from overlapping exposures (Debevec
+//!   and Malik 1997), per channel;
+//! - `merge`: the radiance of one direction from its observations, weighted by a hat that
+//!   distrusts clipped and dark levels;
+//! - the views that say where a direction lands in a photograph: [`ShotCamera`] (an oriented
+//!   pinhole shot with radial distortion) and [`MirrorBall`] (a chrome ball seen in
+//!   perspective);
+//!
+//! and [`assemble`], which turns photographs and their views into a linear equirectangular
+//! map, its confidence and what no exposure resolved.
+
+#![deny(unreachable_pub)]
+
+mod assemble;
+mod ball;
+mod camera;
+mod description;
+mod error;
+mod load;
+mod merge;
+mod photo;
+mod response;
+pub mod synthetic;
+
+pub use assemble::{Assembled, AssemblySettings, assemble, calibrate};
+pub use ball::MirrorBall;
+pub use camera::ShotCamera;
+pub use description::{BallDescription, CaptureDescription, ShotDescription};
+pub use error::CaptureError;
+pub use load::load_capture;
+pub use merge::hat_weight;
+pub use photo::{Photo, View};
+pub use response::{InverseResponse, Observation, RESPONSE_BINS, calibrate_debevec};

@@ -1,0 +1,201 @@
+//! `hprt capture`: an HDR environment map from ordinary photographs (oriented shots or a
+//! mirror ball at several exposures), with its confidence and a preview.
+
+use crate::outputs::{check_outputs, open_outputs, write_outputs};
+use anyhow::Context;
+use capture::{Assembled, AssemblySettings, InverseResponse, RESPONSE_BINS};
+use clap::Args;
+use foundation::image_io::{RgbImageF32, exr_bytes, png_bytes, to_display_rgb8};
+use foundation::infra::limits::read_text_file;
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+pub struct CaptureArgs {
+    /// Capture description (TOML): [[shot]] entries (image, exposure, yaw, pitch, roll, fov,
+    /// k1, k2) or [[ball]] entries (image, exposure, centre, radius, fov, yaw, pitch,
+    /// reflectance); paths relative to it. See README, "Capture".
+    pub description: PathBuf,
+    /// The linear equirectangular map (EXR), relative radiance (the middle level of the
+    /// recovered response is 1).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Width of the map (its height is half).
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(64..=8192))]
+    pub width: u32,
+    /// Use this inverse response (CSV: level,r,g,b; 256 rows) instead of recovering one.
+    #[arg(long)]
+    pub response: Option<PathBuf>,
+    /// Write the inverse response used (CSV, as --response reads it).
+    #[arg(long)]
+    pub save_response: Option<PathBuf>,
+    /// Confidence image (PNG): grey from 0 (filled hole) to 1; red where every exposure clipped.
+    #[arg(long)]
+    pub coverage: Option<PathBuf>,
+    /// Tone-mapped preview (PNG) with filled holes tinted blue and clipped texels red.
+    #[arg(long)]
+    pub preview: Option<PathBuf>,
+    /// Multiply the radiance by this (an absolute scale: from a white card or a measured
+    /// illuminance).
+    #[arg(long, default_value_t = 1.0, value_parser = crate::cli::parse_finite)]
+    pub scale: f32,
+}
+
+pub fn run(args: CaptureArgs) -> anyhow::Result<()> {
+    let outputs = [
+        ("-o", Some(args.output.as_path())),
+        ("--save-response", args.save_response.as_deref()),
+        ("--coverage", args.coverage.as_deref()),
+        ("--preview", args.preview.as_deref()),
+    ];
+    let mut inputs = vec![args.description.as_path()];
+    inputs.extend(args.response.as_deref());
+    check_outputs(&inputs, &outputs)?;
+    if args.scale <= 0.0 {
+        anyhow::bail!("--scale {} must be positive", args.scale);
+    }
+    let files = open_outputs(&outputs)?;
+    let photos = capture::load_capture(&args.description)?;
+    let width = args.width as usize;
+    let settings = AssemblySettings {
+        width,
+        height: width / 2,
+        ..Default::default()
+    };
+    let response = match &args.response {
+        Some(path) => read_response(path)?,
+        None => capture::calibrate(&photos, &settings).with_context(|| {
+            format!(
+                "{}: cannot recover the response",
+                args.description.display()
+            )
+        })?,
+    };
+    let mut captured = capture::assemble(&photos, &response, &settings);
+    scale_map(&mut captured, args.scale);
+    report(&args.description, &captured, photos.len());
+    let image = RgbImageF32::new(width, width / 2, captured.map.texels().to_vec());
+    let mut bytes = vec![exr_bytes(&image)?];
+    if args.save_response.is_some() {
+        bytes.push(response_csv(&response).into_bytes());
+    }
+    if args.coverage.is_some() {
+        bytes.push(png_bytes(&coverage_rgb(&captured), width, width / 2)?);
+    }
+    if args.preview.is_some() {
+        bytes.push(png_bytes(
+            &preview_rgb(&captured, &image),
+            width,
+            width / 2,
+        )?);
+    }
+    write_outputs(files, bytes)
+}
+
+fn scale_map(captured: &mut Assembled, scale: f32) {
+    let (w, h) = (captured.map.width(), captured.map.height());
+    let texels = captured.map.texels().iter().map(|c| *c * scale).collect();
+    captured.map = foundation::envmap::EnvMap::new(w, h, texels);
+}
+
+/// What the capture resolved, and a warning for what no exposure did.
+fn report(description: &Path, captured: &Assembled, photos: usize) {
+    let (clipped_sr, clipped_share) = captured.saturation();
+    println!(
+        "{}: {photos} photographs; {:.1}% of the sphere resolved, {:.1}% filled from its \
+         surroundings",
+        description.display(),
+        100.0 * captured.covered_fraction(),
+        100.0 * filled_fraction(captured),
+    );
+    if clipped_sr > 0.0 {
+        log::warn!(
+            "{}: {clipped_sr:.4} sr were clipped in every exposure (marked red in --coverage); \
+             at their least possible radiance they carry {:.1}% of the map's power, and their \
+             true power may be far larger: add shorter exposures (an unclipped sun needs about \
+             1/10000 of the exposure of the sky)",
+            description.display(),
+            100.0 * clipped_share
+        );
+    }
+}
+
+fn filled_fraction(captured: &Assembled) -> f32 {
+    let w = captured.map.width();
+    let filled: f32 = (0..captured.filled.len())
+        .filter(|t| captured.filled[*t])
+        .map(|t| captured.map.texel_solid_angle(t / w))
+        .sum();
+    filled / (4.0 * std::f32::consts::PI)
+}
+
+fn coverage_rgb(captured: &Assembled) -> Vec<u8> {
+    let mut rgb = Vec::with_capacity(3 * captured.confidence.len());
+    for (t, c) in captured.confidence.iter().enumerate() {
+        let grey = (255.0 * c.sqrt()).round() as u8;
+        rgb.extend(if captured.saturated[t] {
+            [255, 0, 0]
+        } else {
+            [grey; 3]
+        });
+    }
+    rgb
+}
+
+fn preview_rgb(captured: &Assembled, image: &RgbImageF32) -> Vec<u8> {
+    let exposure = 0.5 / captured.map.mean_luminance().max(f32::MIN_POSITIVE);
+    let mut rgb = to_display_rgb8(image, exposure);
+    for (t, pixel) in rgb.chunks_exact_mut(3).enumerate() {
+        if captured.saturated[t] {
+            pixel.copy_from_slice(&[255, 0, 0]);
+        } else if captured.filled[t] {
+            pixel[2] = pixel[2].saturating_add(96);
+        }
+    }
+    rgb
+}
+
+fn response_csv(response: &InverseResponse) -> String {
+    let mut text = String::from("level,r,g,b\n");
+    for z in 0..RESPONSE_BINS {
+        let [r, g, b] = [0, 1, 2].map(|c| response.curves[c][z]);
+        text.push_str(&format!("{z},{r},{g},{b}\n"));
+    }
+    text
+}
+
+/// An inverse response as `--save-response` writes it.
+fn read_response(path: &Path) -> anyhow::Result<InverseResponse> {
+    let text = read_text_file(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut curves: [Vec<f32>; 3] = Default::default();
+    for (n, line) in text.lines().enumerate().skip(1) {
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        let values: Option<Vec<f32>> = fields.iter().map(|f| f.parse().ok()).collect();
+        match values.as_deref() {
+            Some([level, r, g, b]) if *level as usize == curves[0].len() => {
+                for (curve, v) in curves.iter_mut().zip([r, g, b]) {
+                    if !(v.is_finite() && *v >= 0.0) {
+                        anyhow::bail!("{} line {}: {v} is not an exposure", path.display(), n + 1);
+                    }
+                    curve.push(*v);
+                }
+            }
+            _ => anyhow::bail!(
+                "{} line {}: expected `{},r,g,b` (a response as --save-response writes it)",
+                path.display(),
+                n + 1,
+                curves[0].len()
+            ),
+        }
+    }
+    if curves[0].len() != RESPONSE_BINS {
+        anyhow::bail!(
+            "{}: {} levels, expected {RESPONSE_BINS}",
+            path.display(),
+            curves[0].len()
+        );
+    }
+    if curves.iter().any(|c| c.windows(2).any(|w| w[1] < w[0])) {
+        anyhow::bail!("{}: a response must not decrease", path.display());
+    }
+    Ok(InverseResponse { curves })
+}

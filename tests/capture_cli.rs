@@ -1,0 +1,184 @@
+//! `hprt capture` end to end: photographs written to files and a description, captured into a
+//! map the rest of hprt reads; and every kind of bad input refused with the file named.
+
+mod common;
+
+use capture::synthetic::{CameraResponse, photograph};
+use capture::{MirrorBall, ShotCamera, View};
+use common::*;
+use foundation::envmap::{self, EnvMap};
+use rand_pcg::Pcg32;
+use std::fmt::Write;
+use std::path::Path;
+
+const RESPONSE: CameraResponse = CameraResponse {
+    knee: [0.9, 1.0, 1.1],
+    gamma: 2.0,
+    noise: 0.5,
+};
+
+/// Exposure times for the bundled interior map (its lamps to its dark corners).
+const TIMES: [f32; 6] = [4e-5, 1.3e-4, 6e-4, 2.5e-3, 1.1e-2, 4.6e-2];
+
+fn interior() -> EnvMap {
+    let path = repo().join("scenes/env/interior.exr");
+    let map = envmap::load(&path, None).expect("the bundled map").map;
+    map.downsampled(map.width() / 128)
+}
+
+/// Writes a mirror ball seen from two sides at `times` as PNGs into `dir`, and a description
+/// of them; returns the description's text.
+fn write_ball_capture(dir: &Path, times: &[f32]) -> String {
+    let map = interior();
+    let mut rng = Pcg32::new(1, 2);
+    let mut toml = String::new();
+    for (v, yaw) in [0.0f32, 90.0].into_iter().enumerate() {
+        let camera = ShotCamera::new((yaw, 0.0, 0.0), 25.0, (96, 96), (0.0, 0.0));
+        let ball = MirrorBall::new(camera, (48.0, 48.0), 40.0, [0.6; 3]);
+        for (k, t) in times.iter().enumerate() {
+            let photo = photograph(&map, View::Ball(ball), (96, 96), *t, &RESPONSE, &mut rng);
+            let name = format!("ball{v}_{k}.png");
+            let bytes: Vec<u8> = photo.levels.iter().flatten().copied().collect();
+            image::save_buffer(
+                dir.join(&name),
+                &bytes,
+                96,
+                96,
+                image::ExtendedColorType::Rgb8,
+            )
+            .expect("a PNG");
+            write!(
+                toml,
+                "[[ball]]\nimage = \"{name}\"\nexposure = {t}\ncentre = [48.0, 48.0]\n\
+                 radius = 40.0\nfov = 25.0\nyaw = {yaw}\nreflectance = [0.6, 0.6, 0.6]\n\n"
+            )
+            .unwrap();
+        }
+    }
+    std::fs::write(dir.join("capture.toml"), &toml).unwrap();
+    toml
+}
+
+#[test]
+fn a_ball_capture_becomes_a_map_hprt_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    write_ball_capture(dir.path(), &TIMES);
+    let args = [
+        "capture",
+        "capture.toml",
+        "-o",
+        "captured.exr",
+        "--width",
+        "128",
+        "--coverage",
+        "coverage.png",
+        "--preview",
+        "preview.png",
+        "--save-response",
+        "response.csv",
+    ];
+    let out = hprt(dir.path(), &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let map = foundation::image_io::read_exr(&dir.path().join("captured.exr")).unwrap();
+    assert_eq!((map.width, map.height), (128, 64));
+    assert!(
+        map.pixels
+            .iter()
+            .all(|c| c.is_finite() && c.min_element() >= 0.0)
+    );
+    assert!(
+        stdout(&out).contains("of the sphere resolved"),
+        "{}",
+        stdout(&out)
+    );
+    for png in ["coverage.png", "preview.png"] {
+        let image = image::open(dir.path().join(png)).unwrap();
+        assert_eq!((image.width(), image.height()), (128, 64));
+    }
+    // The rest of hprt takes it; and the saved response gives the same map back.
+    let out = hprt(
+        dir.path(),
+        &["decompose", "captured.exr", "-o", "lights.json"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let again = [
+        "capture",
+        "capture.toml",
+        "-o",
+        "again.exr",
+        "--width",
+        "128",
+        "--response",
+        "response.csv",
+    ];
+    let out = hprt(dir.path(), &again);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let second = foundation::image_io::read_exr(&dir.path().join("again.exr")).unwrap();
+    for (a, b) in map.pixels.iter().zip(&second.pixels) {
+        assert!(
+            (*a - *b).abs().max_element() <= 1e-3 * a.max_element().max(1e-3),
+            "{a} vs {b}"
+        );
+    }
+}
+
+/// Runs `hprt capture` on `toml` in a folder of the ball capture and expects a clean failure
+/// naming `needles`, with no output written.
+fn refused(dir: &Path, toml: &str, needles: &[&str]) {
+    std::fs::write(dir.join("bad.toml"), toml).unwrap();
+    let out = hprt(
+        dir,
+        &["capture", "bad.toml", "-o", "bad.exr", "--width", "64"],
+    );
+    assert_clean_failure(&out, needles);
+    assert!(!dir.join("bad.exr").exists());
+}
+
+#[test]
+fn bad_captures_are_refused_with_the_file_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let good = write_ball_capture(d, &TIMES[..2]);
+    let first = good.split("\n\n").next().unwrap().to_string() + "\n";
+    // One exposure: nothing to recover the response from.
+    refused(d, &first, &["do not overlap in exposure"]);
+    // An exposure missing.
+    refused(
+        d,
+        &first.replace("exposure = 0.00004\n", ""),
+        &["bad.toml", "exposure"],
+    );
+    // A ball that is not in the picture.
+    refused(
+        d,
+        &good.replacen("centre = [48.0, 48.0]", "centre = [90.0, 48.0]", 1),
+        &["ball0_0.png", "not inside"],
+    );
+    // Photographs of different sizes.
+    image::save_buffer(
+        d.join("small.png"),
+        &[128u8; 3 * 96 * 90],
+        96,
+        90,
+        image::ExtendedColorType::Rgb8,
+    )
+    .unwrap();
+    refused(
+        d,
+        &good.replacen("ball0_1.png", "small.png", 1),
+        &["small.png", "one size"],
+    );
+    // A corrupt JPEG.
+    std::fs::write(d.join("broken.jpg"), b"\xff\xd8\xff\xe0 not really a jpeg").unwrap();
+    refused(
+        d,
+        &good.replacen("ball0_1.png", "broken.jpg", 1),
+        &["broken.jpg", "cannot be read"],
+    );
+    // A photograph that is not there.
+    refused(
+        d,
+        &good.replacen("ball0_1.png", "missing.png", 1),
+        &["missing.png"],
+    );
+}
