@@ -143,14 +143,15 @@ pub fn assemble(
     let groups = group_by_view(photos);
     let texels: Vec<Texel> = (0..w * h)
         .into_par_iter()
-        .map(|t| {
+        .map_init(Readings::default, |readings, t| {
             // n × n directions across the texel: a photograph sharper than the map would
             // otherwise be sampled at one point per texel, and a small bright source between
             // the points lost.
             let samples = (0..n * n).map(|k| {
                 let u = ((t % w) as f32 + (k % n) as f32 / n as f32 + 0.5 / n as f32) / w as f32;
                 let v = ((t / w) as f32 + (k / n) as f32 / n as f32 + 0.5 / n as f32) / h as f32;
-                merge_texel(&groups, response, foundation::envmap::direction_of_uv(u, v))
+                let d = foundation::envmap::direction_of_uv(u, v);
+                merge_texel(&groups, response, d, readings)
             });
             average(samples)
         })
@@ -234,11 +235,15 @@ fn group_by_view(photos: &[Photo]) -> Vec<Vec<&Photo>> {
 /// all readings at once let a view that sees a small source sharp and clipped in its long
 /// exposures drop out of them while a view that sees it blurred (a ball's rim) stayed in, with
 /// the long exposures' weight: the source came out a quarter short.
-fn merge_texel(groups: &[Vec<&Photo>], response: &InverseResponse, d: Vec3) -> Texel {
+fn merge_texel(
+    groups: &[Vec<&Photo>],
+    response: &InverseResponse,
+    d: Vec3,
+    readings: &mut Readings,
+) -> Texel {
     let (mut sum, mut total) = ([0.0f32; 3], [0.0f32; 3]);
     // Per channel, the least sensitivity at which a photograph clipped it.
     let mut clipped: [Option<f32>; 3] = [None; 3];
-    let mut readings: [Vec<Reading>; 3] = Default::default();
     let mut precision = 0.0;
     for group in groups {
         let Some((x, y, feather)) = group[0].view.locate(d) else {
@@ -246,13 +251,7 @@ fn merge_texel(groups: &[Vec<&Photo>], response: &InverseResponse, d: Vec3) -> T
         };
         readings.iter_mut().for_each(Vec::clear);
         for photo in group {
-            read_photo(
-                photo,
-                response,
-                (x, y, feather),
-                &mut readings,
-                &mut clipped,
-            );
+            read_photo(photo, response, (x, y, feather), readings, &mut clipped);
         }
         for c in 0..3 {
             if let Some((radiance, weight)) = merge_readings(&readings[c], response, c) {
@@ -279,12 +278,15 @@ fn merge_texel(groups: &[Vec<&Photo>], response: &InverseResponse, d: Vec3) -> T
     Texel::Unseen
 }
 
+/// One view's readings per channel: scratch space kept by each worker across texels.
+type Readings = [Vec<Reading>; 3];
+
 /// One photograph's readings at `(x, y)` (bilinear), per channel, or its clipping there.
 fn read_photo(
     photo: &Photo,
     response: &InverseResponse,
     (x, y, feather): (f32, f32, f32),
-    readings: &mut [Vec<Reading>; 3],
+    readings: &mut Readings,
     clipped: &mut [Option<f32>; 3],
 ) {
     let pixels = photo.bilinear(x, y);

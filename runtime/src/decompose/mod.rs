@@ -163,13 +163,8 @@ impl Decomposer {
     }
 
     /// The SH projection of the analysis map of `map` (prepared).
-    fn project_analysis(&mut self, map: &CubeMap) -> ShCoeffs<Rgb> {
-        let analysis = if self.downsample.is_empty() {
-            map
-        } else {
-            &self.analysis_map
-        };
-        self.projector.project(analysis)
+    fn project_analysis(&self, map: &CubeMap) -> ShCoeffs<Rgb> {
+        self.projector.project(self.analysis_map(map))
     }
 
     /// Box-filters `map` to the analysis resolution (when it is larger).
@@ -242,14 +237,15 @@ impl Decomposer {
     /// The total power of `map`, and the analysis map's luminances (prepared) into
     /// `luminances`. (Two passes measured faster than one that does both: each vectorizes.)
     fn power_and_luminances(&mut self, map: &CubeMap) -> Rgb {
-        let analysis = if self.downsample.is_empty() {
-            map
-        } else {
-            &self.analysis_map
-        };
-        self.luminances.clear();
-        self.luminances
-            .extend(analysis.texels().iter().map(|c| luminance(*c)));
+        let mut luminances = std::mem::take(&mut self.luminances);
+        luminances.clear();
+        luminances.extend(
+            self.analysis_map(map)
+                .texels()
+                .iter()
+                .map(|c| luminance(*c)),
+        );
+        self.luminances = luminances;
         map.total_power(&self.geometry)
     }
 
