@@ -61,14 +61,18 @@ impl Icosphere {
         }
     }
 
-    /// The local maxima of `values`, in increasing vertex order: the vertices no neighbour
-    /// exceeds. These are exactly where steepest ascent ends, from whichever vertex it starts
-    /// (an ascent leaves a vertex only for a strictly greater neighbour), so no chain has to
-    /// be followed.
-    pub(crate) fn hill_climb_maxima(&self, values: &[f32]) -> Vec<u32> {
+    /// The local maxima of `values` above `floor`, in increasing vertex order: the vertices no
+    /// neighbour exceeds. These are exactly where steepest ascent ends, from whichever vertex
+    /// it starts (an ascent leaves a vertex only for a strictly greater neighbour), so no chain
+    /// has to be followed.
+    pub(crate) fn hill_climb_maxima(&self, values: &[f32], floor: f32) -> Vec<u32> {
         (0..self.vertices.len() as u32)
             .filter(|&v| {
                 let value = values[v as usize];
+                // (NaN-safe: a value that is not above the floor is no maximum.)
+                if value.partial_cmp(&floor) != Some(std::cmp::Ordering::Greater) {
+                    return false;
+                }
                 // Without early exit: which neighbour is greater is not predictable.
                 !self.neighbours[v as usize]
                     .iter()
@@ -104,7 +108,7 @@ mod tests {
             .iter()
             .map(|v| 2.0 * (20.0 * (v.dot(a) - 1.0)).exp() + (20.0 * (v.dot(b) - 1.0)).exp())
             .collect();
-        let maxima = ico.hill_climb_maxima(&values);
+        let maxima = ico.hill_climb_maxima(&values, f32::NEG_INFINITY);
         assert_eq!(maxima.len(), 2, "{maxima:?}");
         let dirs: Vec<Vec3> = maxima.iter().map(|&m| ico.vertices[m as usize]).collect();
         assert!(dirs.iter().any(|d| d.angle_between(a) < 0.1));

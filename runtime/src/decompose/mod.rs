@@ -204,8 +204,11 @@ impl Decomposer {
         );
         self.caps_used = 0;
         self.prepare_analysis(map);
-        let total_power = self.power_and_luminances(map);
+        self.measure_luminances(map);
         let full = self.project_analysis(map);
+        // The DC coefficient is the map's power times Y₀₀ = 1/(2√π) (the analysis map keeps
+        // the map's integral): no pass of its own.
+        let total_power = full.as_slice()[0] * (2.0 * PI.sqrt());
         let mut detection = full.clone();
         detection.scale_bands(&self.detection_window);
         let directions = self.find_peaks(&detection, luminance(total_power) / (4.0 * PI));
@@ -234,9 +237,8 @@ impl Decomposer {
         }
     }
 
-    /// The total power of `map`, and the analysis map's luminances (prepared) into
-    /// `luminances`. (Two passes measured faster than one that does both: each vectorizes.)
-    fn power_and_luminances(&mut self, map: &CubeMap) -> Rgb {
+    /// The analysis map's luminances (prepared) into `luminances`.
+    fn measure_luminances(&mut self, map: &CubeMap) {
         let mut luminances = std::mem::take(&mut self.luminances);
         luminances.clear();
         luminances.extend(
@@ -246,7 +248,6 @@ impl Decomposer {
                 .map(|c| luminance(*c)),
         );
         self.luminances = luminances;
-        map.total_power(&self.geometry)
     }
 
     /// Steps 1, 2 and 4: smoothed map minus SH part on the icosahedron, its significant local
@@ -267,12 +268,7 @@ impl Decomposer {
             .map(|(s, p)| *s - *p)
             .collect();
         let floor = self.settings.min_contrast * mean_luminance;
-        let mut maxima: Vec<u32> = self
-            .ico
-            .hill_climb_maxima(&residual)
-            .into_iter()
-            .filter(|&v| residual[v as usize] > floor && residual[v as usize] > 0.0)
-            .collect();
+        let mut maxima: Vec<u32> = self.ico.hill_climb_maxima(&residual, floor.max(0.0));
         maxima.sort_by(|a, b| residual[*b as usize].total_cmp(&residual[*a as usize]));
         maxima.truncate(MAX_CANDIDATES);
         maxima

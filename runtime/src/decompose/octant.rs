@@ -15,14 +15,15 @@
 use crate::cubemap::{CubeGeometry, CubeMap};
 use foundation::Rgb;
 use foundation::sh::{ShBasis, ShCoeffs, num_coeffs};
-use glam::{Vec3, Vec3A, Vec4};
+use glam::{Vec3, Vec3A};
+use wide::f32x8;
 
 /// A texel with x, y, z > 0 and its images ([`OctantBasis`]).
 type Octet = [u32; 8];
 /// A texel's octant texel and reflection ([`OctantBasis`]).
 type Slot = (u32, u8);
 
-/// Basis rows are padded to a multiple of this many values (two vectors of four).
+/// Basis rows are padded to a multiple of this many values (one 8-wide vector).
 const LANES: usize = 8;
 /// Octets transformed at a time by the projection (a multiple of four).
 const PROJECTION_TILE: usize = 128;
@@ -114,11 +115,11 @@ impl OctantBasis {
     pub(crate) fn project(&self, map: &CubeMap) -> ShCoeffs<Rgb> {
         let texels = map.texels();
         let count = self.octets.len();
-        // Four partial sums per coefficient (octet o into sum o mod 4).
-        let mut sums = vec![[Vec3A::ZERO; 4]; num_coeffs(self.order)];
-        // The transforms of a tile of octets (radiance in a vector of four), by class: the tile
-        // stays in the first-level cache while every coefficient passes over it.
-        let mut combos = [[Vec3A::ZERO; PROJECTION_TILE]; 8];
+        // Eight partial sums per coefficient and channel (octet o into lane o mod 8).
+        let mut sums = vec![[f32x8::ZERO; 3]; num_coeffs(self.order)];
+        // The transforms of a tile of octets by class and channel: the tile stays in the
+        // first-level cache while every coefficient passes over it.
+        let mut combos = [[[0.0f32; PROJECTION_TILE]; 3]; 8];
         for first in (0..count).step_by(PROJECTION_TILE) {
             let len = PROJECTION_TILE.min(count - first);
             for (i, octet) in self.octets[first..first + len].iter().enumerate() {
@@ -126,17 +127,22 @@ impl OctantBasis {
                     std::array::from_fn(|s| Vec3A::from(texels[octet[s] as usize]));
                 walsh_hadamard(&mut v);
                 for (class, value) in v.into_iter().enumerate() {
-                    combos[class][i] = value;
+                    for (channel, value) in combos[class].iter_mut().zip(value.to_array()) {
+                        channel[i] = value;
+                    }
                 }
             }
             for (k, sums) in sums.iter_mut().enumerate() {
                 let column = &self.columns[k * count + first..][..len];
-                add_weighted(sums, &combos[self.parity[k] as usize][..len], column);
+                add_weighted(sums, &combos[self.parity[k] as usize], column);
             }
         }
         let coeffs = sums
             .iter()
-            .map(|s| Rgb::from((s[0] + s[1]) + (s[2] + s[3])))
+            .map(|s| {
+                let [r, g, b] = s.map(f32x8::reduce_add);
+                Rgb::new(r, g, b)
+            })
             .collect();
         ShCoeffs::from_vec(coeffs).expect("n² coefficients")
     }
@@ -144,29 +150,20 @@ impl OctantBasis {
     /// `coeffs` (of this order) at the texels `members`, into `out`.
     pub(crate) fn eval_at(&self, coeffs: &ShCoeffs<Rgb>, members: &[u32], out: &mut Vec<Rgb>) {
         let signed = self.signed_coeffs(coeffs);
-        let quads = self.stride / 4;
+        let octs = self.stride / LANES;
         out.clear();
         out.extend(members.iter().map(|&t| {
             let (o, s) = self.slots[t as usize];
             let row = &self.rows[o as usize * self.stride..][..self.stride];
-            let coeffs = &signed[s as usize * quads..][..quads];
-            // Eight partial sums per channel (coefficient k into lane k mod 4 of the sums of
-            // even or of odd quads), so that the additions do not wait on one another.
-            let (mut even, mut odd) = ([Vec4::ZERO; 3], [Vec4::ZERO; 3]);
-            let pairs = row.chunks_exact(8).zip(coeffs.chunks_exact(2));
-            for (y, [[r0, g0, b0], [r1, g1, b1]]) in pairs.map(|(y, c)| (y, [c[0], c[1]])) {
-                let (y0, y1) = (Vec4::from_slice(&y[..4]), Vec4::from_slice(&y[4..]));
-                even[0] += r0 * y0;
-                even[1] += g0 * y0;
-                even[2] += b0 * y0;
-                odd[0] += r1 * y1;
-                odd[1] += g1 * y1;
-                odd[2] += b1 * y1;
+            let coeffs = &signed[s as usize * octs..][..octs];
+            let mut sums = [f32x8::ZERO; 3];
+            for (y, c) in row.chunks_exact(LANES).zip(coeffs) {
+                let y = load(y);
+                for (sum, c) in sums.iter_mut().zip(c) {
+                    *sum = y.mul_add(*c, *sum);
+                }
             }
-            let [r, g, b] = [0, 1, 2].map(|c| {
-                let v = even[c] + odd[c];
-                (v.x + v.y) + (v.z + v.w)
-            });
+            let [r, g, b] = sums.map(f32x8::reduce_add);
             Rgb::new(r, g, b)
         }));
     }
@@ -180,19 +177,21 @@ impl OctantBasis {
         weighted: &[Rgb],
     ) -> ShCoeffs<Rgb> {
         // Sums by reflection, each over the octant texels' rows, then folded back by parity.
-        let stride = self.stride;
-        let mut sums = vec![0.0f32; 8 * 3 * stride];
+        // `sums[s · octs + q][channel]`: coefficients `LANES · q..` of reflection `s`.
+        let octs = self.stride / LANES;
+        let mut sums = vec![[f32x8::ZERO; 3]; 8 * octs];
         for (&t, w) in members.iter().zip(weighted) {
             let (o, s) = self.slots[t as usize];
-            let row = &self.rows[o as usize * stride..][..stride];
-            let (r, rest) = sums[s as usize * 3 * stride..][..3 * stride].split_at_mut(stride);
-            let (g, b) = rest.split_at_mut(stride);
-            for (((r, g), b), y) in r.iter_mut().zip(g).zip(b).zip(row) {
-                *r += w.x * y;
-                *g += w.y * y;
-                *b += w.z * y;
+            let row = &self.rows[o as usize * self.stride..][..self.stride];
+            let w = w.to_array().map(f32x8::splat);
+            for (y, sums) in row.chunks_exact(LANES).zip(&mut sums[s as usize * octs..]) {
+                let y = load(y);
+                for (sum, w) in sums.iter_mut().zip(w) {
+                    *sum = y.mul_add(w, *sum);
+                }
             }
         }
+        let sums: Vec<[[f32; LANES]; 3]> = sums.iter().map(|s| s.map(f32x8::to_array)).collect();
         let out = coeffs
             .as_slice()
             .iter()
@@ -200,8 +199,8 @@ impl OctantBasis {
             .map(|(k, c)| {
                 let mut total = Rgb::ZERO;
                 for s in 0..8 {
-                    let sum = |channel: usize| sums[(s * 3 + channel) * stride + k];
-                    let v = Rgb::new(sum(0), sum(1), sum(2));
+                    let sums = &sums[s * octs + k / LANES];
+                    let v = Rgb::new(sums[0][k % LANES], sums[1][k % LANES], sums[2][k % LANES]);
                     total += if self.odd(k, s) { -v } else { v };
                 }
                 *c - total
@@ -216,20 +215,23 @@ impl OctantBasis {
     }
 
     /// For each reflection `s`, the coefficients with the signs it gives their basis functions,
-    /// padded with zeros to the row stride, four at a time for each channel: entry
-    /// `s · stride / 4 + q` holds coefficients `4q..4q + 4`.
-    fn signed_coeffs(&self, coeffs: &ShCoeffs<Rgb>) -> Vec<[Vec4; 3]> {
-        let quads = self.stride / 4;
-        let mut signed = vec![[Vec4::ZERO; 3]; 8 * quads];
-        for (s, quads) in signed.chunks_exact_mut(quads).enumerate() {
+    /// padded with zeros to the row stride, [`LANES`] at a time for each channel: entry
+    /// `s · stride / LANES + q` holds coefficients `LANES · q..LANES · (q + 1)`.
+    fn signed_coeffs(&self, coeffs: &ShCoeffs<Rgb>) -> Vec<[f32x8; 3]> {
+        let octs = self.stride / LANES;
+        let mut signed = vec![[[0.0f32; LANES]; 3]; 8 * octs];
+        for (s, octs) in signed.chunks_exact_mut(octs).enumerate() {
             for (k, c) in coeffs.as_slice().iter().enumerate().take(self.parity.len()) {
                 let c = if self.odd(k, s) { -*c } else { *c };
-                for (channel, value) in quads[k / 4].iter_mut().zip(c.to_array()) {
-                    channel[k % 4] = value;
+                for (channel, value) in octs[k / LANES].iter_mut().zip(c.to_array()) {
+                    channel[k % LANES] = value;
                 }
             }
         }
         signed
+            .into_iter()
+            .map(|channels| channels.map(f32x8::new))
+            .collect()
     }
 }
 
@@ -300,18 +302,25 @@ fn walsh_hadamard(v: &mut [Vec3A; 8]) {
     ];
 }
 
-/// Adds `values_i weights_i` to four partial sums (element `i` into sum `i mod 4`), the
-/// remainder of a length not a multiple of four into the first.
-fn add_weighted(sums: &mut [Vec3A; 4], values: &[Vec3A], weights: &[f32]) {
-    let (v_chunks, w_chunks) = (values.chunks_exact(4), weights.chunks_exact(4));
-    for (v, w) in v_chunks.remainder().iter().zip(w_chunks.remainder()) {
-        sums[0] += *v * *w;
-    }
-    for (v, w) in v_chunks.zip(w_chunks) {
-        for j in 0..4 {
-            sums[j] += v[j] * w[j];
+/// Adds `values_i weights_i` for each channel to its eight partial sums (element `i` into
+/// lane `i mod 8`, a length not a multiple of eight padded with zeros).
+fn add_weighted(sums: &mut [f32x8; 3], channels: &[[f32; PROJECTION_TILE]; 3], weights: &[f32]) {
+    for (sum, values) in sums.iter_mut().zip(channels) {
+        let values = &values[..weights.len()];
+        let (v_chunks, w_chunks) = (values.chunks_exact(LANES), weights.chunks_exact(LANES));
+        if !v_chunks.remainder().is_empty() {
+            *sum += f32x8::from(v_chunks.remainder()) * f32x8::from(w_chunks.remainder());
+        }
+        for (v, w) in v_chunks.zip(w_chunks) {
+            *sum = load(v).mul_add(load(w), *sum);
         }
     }
+}
+
+/// Eight values as one vector (`values` holds exactly [`LANES`]).
+#[inline(always)]
+fn load(values: &[f32]) -> f32x8 {
+    f32x8::new(values.try_into().expect("one vector's worth"))
 }
 
 #[cfg(test)]

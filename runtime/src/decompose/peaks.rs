@@ -152,7 +152,7 @@ mod tests {
                 .iter()
                 .map(|v| 5.0 * (-(v.angle_between(truth) / 0.12).powi(2) / 2.0).exp())
                 .collect();
-            let maxima = ico.hill_climb_maxima(&values);
+            let maxima = ico.hill_climb_maxima(&values, f32::NEG_INFINITY);
             let best = *maxima
                 .iter()
                 .max_by(|a, b| values[**a as usize].total_cmp(&values[**b as usize]))

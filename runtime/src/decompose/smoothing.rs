@@ -9,7 +9,8 @@
 
 use crate::cubemap::{CubeGeometry, CubeMap};
 use foundation::Rgb;
-use glam::{Vec3, Vec4};
+use glam::Vec3;
+use wide::f32x8;
 
 /// Texels per block: two 4-wide vectors.
 const LANES: usize = 8;
@@ -98,17 +99,16 @@ impl GaussianSmoothing {
         };
         out.clear();
         out.extend(self.block_starts.windows(2).map(|r| {
-            // Two 4-wide sums (glam's SSE vectors), one per half of a block.
-            let (mut low, mut high) = (Vec4::ZERO, Vec4::ZERO);
+            // One 8-wide sum (two 4-wide halves where the CPU has no 8-wide vectors).
+            let mut sum = f32x8::ZERO;
             let blocks = r[0] as usize..r[1] as usize;
             let weights =
                 self.weights[blocks.start * LANES..blocks.end * LANES].chunks_exact(LANES);
             for (&t, w) in self.texels[blocks].iter().zip(weights) {
                 let texels = &values[t as usize..t as usize + LANES];
-                low += Vec4::from_slice(&texels[..4]) * Vec4::from_slice(&w[..4]);
-                high += Vec4::from_slice(&texels[4..]) * Vec4::from_slice(&w[4..]);
+                sum = f32x8::from(texels).mul_add(f32x8::from(w), sum);
             }
-            (low + high).element_sum()
+            sum.reduce_add()
         }));
     }
 

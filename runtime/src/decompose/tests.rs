@@ -481,3 +481,25 @@ fn the_smallest_uniform_maps_have_no_lights() {
         }
     }
 }
+
+/// The total power read off the projection's DC term is the cube map's own sum, at the
+/// analysis size and when the map is box-filtered down to it first.
+#[test]
+fn total_power_is_the_maps_integral() {
+    let map = three_suns().env_map();
+    for face_size in [64, 128] {
+        let cube = CubeSource::new(&map, face_size).cube(0.3);
+        let settings = DecomposeSettings {
+            face_size,
+            ..Default::default()
+        };
+        let result = Decomposer::new(settings).unwrap().decompose(&cube);
+        let want = cube.total_power(&CubeGeometry::new(face_size));
+        let error = (result.total_power - want).abs().max_element();
+        assert!(
+            error <= 1e-5 * want.max_element(),
+            "{face_size}: {} vs {want}",
+            result.total_power
+        );
+    }
+}
