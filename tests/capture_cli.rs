@@ -3,10 +3,11 @@
 
 mod common;
 
-use capture::synthetic::{CameraResponse, photograph};
+use capture::synthetic::{CameraResponse, CapturePlan, photograph, write_capture};
 use capture::{MirrorBall, ShotCamera, View};
 use common::*;
 use foundation::envmap::{self, EnvMap};
+use foundation::luminance;
 use rand_pcg::Pcg32;
 use std::fmt::Write;
 use std::path::Path;
@@ -146,7 +147,33 @@ fn bad_captures_are_refused_with_the_file_named() {
     refused(
         d,
         &first.replace("exposure = 0.00004\n", ""),
-        &["bad.toml", "exposure"],
+        &["ball0_0.png", "no exposure time"],
+    );
+    // A ball to be found in a picture that shows none.
+    let plain = ShotCamera::new((0.0, 0.0, 0.0), 60.0, (96, 96), (0.0, 0.0));
+    let mut rng = Pcg32::new(3, 4);
+    let photo = photograph(
+        &interior(),
+        View::Shot(plain),
+        (96, 96),
+        6e-4,
+        &RESPONSE,
+        &mut rng,
+    );
+    let bytes: Vec<u8> = photo.levels.iter().flatten().copied().collect();
+    image::save_buffer(
+        d.join("room.png"),
+        &bytes,
+        96,
+        96,
+        image::ExtendedColorType::Rgb8,
+    )
+    .unwrap();
+    refused(
+        d,
+        "[[ball]]\nimage = \"room.png\"\nexposure = 6e-4\nfov = 25.0\n\n\
+         [[ball]]\nimage = \"room.png\"\nexposure = 6e-3\nfov = 25.0\n",
+        &["room.png", "no mirror ball found"],
     );
     // A ball that is not in the picture.
     refused(
@@ -181,4 +208,60 @@ fn bad_captures_are_refused_with_the_file_named() {
         &good.replacen("ball0_1.png", "missing.png", 1),
         &["missing.png"],
     );
+}
+
+/// Photographs as a camera leaves them: JPEGs whose exposure is only in their EXIF. The
+/// capture reads the times and gives the map the same photographs give with their times
+/// written in the description.
+#[test]
+fn exposures_are_read_from_exif() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let plan = CapturePlan {
+        size: (200, 200),
+        orientations: Vec::new(),
+        fov: 90.0,
+        ball_yaws: vec![0.0, 90.0],
+        times: vec![5e-5, 4.6e-4, 3.7e-3, 3.8e-2],
+        response: RESPONSE,
+        samples: 4,
+        seed: 5,
+    };
+    write_capture(&interior(), &plan, d).unwrap();
+    let text = std::fs::read_to_string(d.join("capture.toml")).unwrap();
+    assert!(
+        !text.contains("exposure =") && !text.contains("centre ="),
+        "{text}"
+    );
+    // The outline write_capture used, given (each description in its own way).
+    let (mut exif, mut given) = (String::new(), String::new());
+    for (k, entry) in text.split("[[ball]]").skip(1).enumerate() {
+        let entry = entry.trim_end().to_string() + "\n";
+        let outline = "centre = [100.0, 100.0]\nradius = 84.0\n";
+        let t = plan.times[k % plan.times.len()];
+        writeln!(exif, "[[ball]]{entry}{outline}").unwrap();
+        write!(given, "[[ball]]{entry}{outline}exposure = {t}\n\n").unwrap();
+    }
+    std::fs::write(d.join("exif.toml"), exif).unwrap();
+    std::fs::write(d.join("given.toml"), given).unwrap();
+    for name in ["exif", "given"] {
+        let args = [
+            "capture",
+            &format!("{name}.toml"),
+            "-o",
+            &format!("{name}.exr"),
+            "--width",
+            "128",
+        ];
+        let out = hprt(d, &args);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let a = foundation::image_io::read_exr(&d.join("exif.exr")).unwrap();
+    let b = foundation::image_io::read_exr(&d.join("given.exr")).unwrap();
+    for (x, y) in a.pixels.iter().zip(&b.pixels) {
+        assert!(
+            (luminance(*x) - luminance(*y)).abs() <= 1e-3 * luminance(*y).max(1e-3),
+            "{x} vs {y}"
+        );
+    }
 }

@@ -46,6 +46,27 @@ impl MirrorBall {
         }
     }
 
+    /// A ball whose outline is the cone of rays around `axis` of half-angle `half_angle` (as
+    /// [`crate::find_ball`] measures it).
+    pub fn from_grazing_cone(
+        camera: ShotCamera,
+        axis: Vec3,
+        half_angle: f32,
+        reflectance: [f32; 3],
+    ) -> Self {
+        Self {
+            camera,
+            centre: axis.normalize(),
+            distance: 1.0 / half_angle.sin().max(1e-4),
+            reflectance,
+        }
+    }
+
+    /// The cone of rays that graze the ball: its axis and half-angle.
+    pub fn grazing_cone(&self) -> (Vec3, f32) {
+        (self.centre, (1.0 / self.distance).asin())
+    }
+
     /// The pixel that sees the environment's direction `d` on the ball, and how much to trust
     /// it (the cosine between the ball's normal and the view there), if the ball shows it.
     pub fn locate(&self, d: Vec3) -> Option<(f32, f32, f32)> {

@@ -20,8 +20,8 @@ pub struct CaptureDescription {
 #[serde(deny_unknown_fields)]
 pub struct ShotDescription {
     pub image: PathBuf,
-    /// Exposure time in seconds.
-    pub exposure: f32,
+    /// Exposure time in seconds, when the image's EXIF does not record it.
+    pub exposure: Option<f32>,
     #[serde(default)]
     pub yaw: f32,
     #[serde(default)]
@@ -41,12 +41,13 @@ pub struct ShotDescription {
 #[serde(deny_unknown_fields)]
 pub struct BallDescription {
     pub image: PathBuf,
-    /// Exposure time in seconds.
-    pub exposure: f32,
-    /// The ball's centre in the image, in pixels from the top-left corner.
-    pub centre: [f32; 2],
+    /// Exposure time in seconds, when the image's EXIF does not record it.
+    pub exposure: Option<f32>,
+    /// The ball's centre in the image, in pixels from the top-left corner (with `radius`;
+    /// found in the photograph when both are left out).
+    pub centre: Option<[f32; 2]>,
     /// The ball's radius in pixels.
-    pub radius: f32,
+    pub radius: Option<f32>,
     /// The camera's vertical field of view in degrees.
     pub fov: f32,
     /// The camera's orientation (degrees), as for a shot.

@@ -17,9 +17,11 @@
 
 mod assemble;
 mod ball;
+mod ball_finder;
 mod camera;
 mod description;
 mod error;
+mod exif;
 mod load;
 mod merge;
 mod photo;
@@ -28,10 +30,12 @@ pub mod synthetic;
 
 pub use assemble::{Assembled, AssemblySettings, assemble, calibrate};
 pub use ball::MirrorBall;
+pub use ball_finder::{Circle, FoundBall, find_ball};
 pub use camera::ShotCamera;
 pub use description::{BallDescription, CaptureDescription, ShotDescription};
 pub use error::CaptureError;
-pub use load::load_capture;
+pub use exif::{ExifExposure, exif_block, read_exposure};
+pub use load::{LoadedCapture, load_capture};
 pub use merge::hat_weight;
 pub use photo::{Photo, View};
 pub use response::{InverseResponse, Observation, RESPONSE_BINS, calibrate_debevec};

@@ -2,9 +2,11 @@
 //! and what is wrong with it.
 
 use crate::ball::MirrorBall;
+use crate::ball_finder::{FoundBall, find_ball};
 use crate::camera::ShotCamera;
 use crate::description::{BallDescription, CaptureDescription, ShotDescription};
 use crate::error::CaptureError;
+use crate::exif::{ExifExposure, read_exposure};
 use crate::photo::{Photo, View};
 use foundation::infra::limits::{
     MAX_BACKPLATE_PIXELS, MAX_BACKPLATE_SIDE, MAX_SIDE_FILE_BYTES, read_regular_file,
@@ -12,8 +14,25 @@ use foundation::infra::limits::{
 };
 use std::path::{Path, PathBuf};
 
-/// The photographs a capture description names, with their views.
-pub fn load_capture(path: &Path) -> Result<Vec<Photo>, CaptureError> {
+/// A capture's photographs and what loading them noticed (for the user to read).
+#[derive(Debug, Clone)]
+pub struct LoadedCapture {
+    pub photos: Vec<Photo>,
+    /// Warnings: exposures the EXIF and the description disagree on, settings that vary.
+    pub notes: Vec<String>,
+}
+
+/// One photograph as read, before its exposure and view are settled.
+struct Read {
+    file: PathBuf,
+    levels: Levels,
+    exif: Option<ExifExposure>,
+}
+
+/// The photographs a capture description names, with their views and exposures (from each
+/// image's EXIF when it records one, else from the description); balls without a given
+/// outline are found in their photographs.
+pub fn load_capture(path: &Path) -> Result<LoadedCapture, CaptureError> {
     let invalid = |message: String| CaptureError::Photo {
         path: path.to_path_buf(),
         message,
@@ -27,59 +46,178 @@ pub fn load_capture(path: &Path) -> Result<Vec<Photo>, CaptureError> {
         ));
     }
     let folder = path.parent().unwrap_or(Path::new("."));
+    let mut notes = Vec::new();
     let mut photos = Vec::new();
+    let mut given = Vec::new();
     for (i, shot) in description.shot.iter().enumerate() {
         check_shot(shot).map_err(|m| invalid(format!("shot {}: {m}", i + 1)))?;
-        let file = folder.join(&shot.image);
-        let (levels, width, height) = read_photo(&file)?;
+        let read = read_photo(&folder.join(&shot.image), &mut notes)?;
+        let (_, width, height) = read.levels;
         let camera = ShotCamera::new(
             (shot.yaw, shot.pitch, shot.roll),
             shot.fov,
             (width, height),
             (shot.k1, shot.k2),
         );
-        photos.push(photo(
-            file,
-            (levels, width, height),
-            shot.exposure,
-            View::Shot(camera),
-        ));
+        given.push(shot.exposure);
+        photos.push((read, View::Shot(camera)));
     }
-    for (i, ball) in description.ball.iter().enumerate() {
-        check_ball(ball).map_err(|m| invalid(format!("ball {}: {m}", i + 1)))?;
-        let file = folder.join(&ball.image);
-        let (levels, width, height) = read_photo(&file)?;
-        let [cx, cy] = ball.centre;
-        let r = ball.radius;
-        if cx - r < 0.0 || cy - r < 0.0 || cx + r > width as f32 || cy + r > height as f32 {
-            return Err(CaptureError::Photo {
-                path: file,
-                message: format!(
-                    "the ball (centre {cx}, {cy}, radius {r} pixels) is not inside the \
-                     {width}x{height} picture: check [[ball]] {}'s centre and radius",
-                    i + 1
-                ),
-            });
-        }
+    let balls = load_balls(&description.ball, folder, path, &mut notes)?;
+    for (ball, (read, view)) in description.ball.iter().zip(balls) {
+        given.push(ball.exposure);
+        photos.push((read, view));
+    }
+    let times = exposures(&photos, &given, &mut notes)?;
+    let photos: Vec<Photo> = photos
+        .into_iter()
+        .zip(times)
+        .map(|((read, view), time)| photo(read.file, read.levels, time, view))
+        .collect();
+    check_sizes(&photos)?;
+    Ok(LoadedCapture { photos, notes })
+}
+
+/// The mirror-ball photographs and their views: the outline as given, or found in the
+/// photograph (shared by the exposures of one camera: the clearest one's).
+fn load_balls(
+    balls: &[BallDescription],
+    folder: &Path,
+    description: &Path,
+    notes: &mut Vec<String>,
+) -> Result<Vec<(Read, View)>, CaptureError> {
+    let mut out: Vec<(Read, Option<MirrorBall>, ShotCamera)> = Vec::new();
+    for (i, ball) in balls.iter().enumerate() {
+        check_ball(ball).map_err(|message| CaptureError::Photo {
+            path: description.to_path_buf(),
+            message: format!("ball {}: {message}", i + 1),
+        })?;
+        let read = read_photo(&folder.join(&ball.image), notes)?;
+        let (_, width, height) = read.levels;
         let camera = ShotCamera::new(
             (ball.yaw, ball.pitch, 0.0),
             ball.fov,
             (width, height),
             (0.0, 0.0),
         );
-        let view = View::Ball(MirrorBall::new(camera, (cx, cy), r, ball.reflectance));
-        photos.push(photo(file, (levels, width, height), ball.exposure, view));
+        let given = match (ball.centre, ball.radius) {
+            (Some([cx, cy]), Some(r)) => {
+                check_ball_inside(&read.file, (cx, cy, r), (width, height), i)?;
+                Some(MirrorBall::new(camera, (cx, cy), r, ball.reflectance))
+            }
+            _ => None,
+        };
+        out.push((read, given, camera));
     }
-    check_sizes(&photos)?;
-    Ok(photos)
+    // Found outlines, per camera (one tripod position, several exposures).
+    let mut found: Vec<(ShotCamera, Option<FoundBall>)> = Vec::new();
+    for (k, (read, given, camera)) in out.iter().enumerate() {
+        if given.is_some() || found.iter().any(|(c, _)| c == camera) {
+            continue;
+        }
+        let best = out[k..]
+            .iter()
+            .filter(|(_, g, c)| g.is_none() && c == camera)
+            .filter_map(|(r, _, c)| find_ball(&r.levels.0, (r.levels.1, r.levels.2), c))
+            .max_by(|a, b| a.outline.support.total_cmp(&b.outline.support));
+        if best.is_none() {
+            return Err(CaptureError::Photo {
+                path: read.file.clone(),
+                message: "no mirror ball found in this photograph or its other exposures (a \
+                          ball's outline must be clear, at least a tenth of the picture across): \
+                          give the ball's centre and radius in pixels"
+                    .into(),
+            });
+        }
+        found.push((*camera, best));
+    }
+    Ok(out
+        .into_iter()
+        .zip(balls)
+        .map(|((read, given, camera), ball)| {
+            let view = given.unwrap_or_else(|| {
+                let (_, f) = found
+                    .iter()
+                    .find(|(c, _)| *c == camera)
+                    .expect("found above");
+                let f = f.expect("found above");
+                MirrorBall::from_grazing_cone(camera, f.axis, f.half_angle, ball.reflectance)
+            });
+            (read, View::Ball(view))
+        })
+        .collect())
 }
 
-fn photo(
-    path: PathBuf,
-    (levels, width, height): (Vec<[u8; 3]>, usize, usize),
-    time: f32,
-    view: View,
-) -> Photo {
+fn check_ball_inside(
+    file: &Path,
+    (cx, cy, r): (f32, f32, f32),
+    (width, height): (usize, usize),
+    i: usize,
+) -> Result<(), CaptureError> {
+    if cx - r < 0.0 || cy - r < 0.0 || cx + r > width as f32 || cy + r > height as f32 {
+        return Err(CaptureError::Photo {
+            path: file.to_path_buf(),
+            message: format!(
+                "the ball (centre {cx}, {cy}, radius {r} pixels) is not inside the \
+                 {width}x{height} picture: check [[ball]] {}'s centre and radius",
+                i + 1
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Each photograph's exposure: its EXIF time where recorded (times ISO/100 over N² when every
+/// photograph records both), else the description's; an error names a photograph with neither.
+fn exposures(
+    photos: &[(Read, View)],
+    given: &[Option<f32>],
+    notes: &mut Vec<String>,
+) -> Result<Vec<f32>, CaptureError> {
+    let full: Option<Vec<f32>> = photos
+        .iter()
+        .map(|(r, _)| r.exif.and_then(|e| e.relative()))
+        .collect();
+    if let Some(relative) = full {
+        // Relative to the first photograph's ISO and aperture: times stay times.
+        let first = photos[0].0.exif.expect("every photograph has EXIF");
+        let unit = first.time / relative[0];
+        return Ok(relative.iter().map(|r| r * unit).collect());
+    }
+    let isos: Vec<f32> = photos.iter().filter_map(|(r, _)| r.exif?.iso).collect();
+    if isos.iter().any(|i| *i != isos[0]) {
+        notes.push(
+            "the photographs' EXIF records different ISO speeds, but not every photograph \
+             records its ISO and aperture: exposure times alone are used"
+                .into(),
+        );
+    }
+    photos
+        .iter()
+        .zip(given)
+        .map(|((read, _), given)| match (read.exif, given) {
+            (Some(exif), Some(given)) => {
+                if (exif.time - given).abs() > 0.01 * exif.time {
+                    notes.push(format!(
+                        "{}: its EXIF records {} s, the description {given} s: the EXIF's is used",
+                        read.file.display(),
+                        exif.time
+                    ));
+                }
+                Ok(exif.time)
+            }
+            (Some(exif), None) => Ok(exif.time),
+            (None, Some(given)) => Ok(*given),
+            (None, None) => Err(CaptureError::Photo {
+                path: read.file.clone(),
+                message: "has no exposure time: its EXIF records none and the description \
+                          gives none (add `exposure = SECONDS` to its entry)"
+                    .into(),
+            }),
+        })
+        .collect()
+}
+
+fn photo(path: PathBuf, (levels, width, height): Levels, time: f32, view: View) -> Photo {
     Photo {
         path,
         width,
@@ -90,7 +228,10 @@ fn photo(
     }
 }
 
-fn check_exposure(exposure: f32) -> Result<(), String> {
+fn check_exposure(exposure: Option<f32>) -> Result<(), String> {
+    let Some(exposure) = exposure else {
+        return Ok(());
+    };
     if !(exposure.is_finite() && exposure > 0.0) {
         return Err(format!("exposure {exposure} s is not a positive time"));
     }
@@ -128,14 +269,18 @@ fn check_shot(shot: &ShotDescription) -> Result<(), String> {
 fn check_ball(ball: &BallDescription) -> Result<(), String> {
     check_exposure(ball.exposure)?;
     check_fov(ball.fov)?;
-    if !(ball.radius.is_finite() && ball.radius >= 4.0) {
-        return Err(format!(
-            "radius {} pixels: a ball needs at least 4",
-            ball.radius
-        ));
+    match (ball.centre, ball.radius) {
+        (Some(_), None) | (None, Some(_)) => {
+            return Err("give both centre and radius, or neither (to find the ball)".into());
+        }
+        (_, Some(r)) if !(r.is_finite() && r >= 4.0) => {
+            return Err(format!("radius {r} pixels: a ball needs at least 4"));
+        }
+        _ => {}
     }
     if !ball
         .centre
+        .unwrap_or_default()
         .iter()
         .chain(&[ball.yaw, ball.pitch])
         .all(|v| v.is_finite())
@@ -152,8 +297,8 @@ fn check_ball(ball: &BallDescription) -> Result<(), String> {
 type Levels = (Vec<[u8; 3]>, usize, usize);
 
 /// A JPEG, PNG or TIFF as 8-bit RGB levels (16-bit images keep their top 8 bits: the response
-/// is recovered at 256 levels), within the backplate's limits.
-fn read_photo(path: &Path) -> Result<Levels, CaptureError> {
+/// is recovered at 256 levels), within the backplate's limits, and its EXIF exposure.
+fn read_photo(path: &Path, notes: &mut Vec<String>) -> Result<Read, CaptureError> {
     let fail = |message: String| CaptureError::Photo {
         path: path.to_path_buf(),
         message,
@@ -169,8 +314,19 @@ fn read_photo(path: &Path) -> Result<Levels, CaptureError> {
             "is {width}x{height}: too small to be a photograph"
         )));
     }
+    let exif = read_exposure(&bytes).unwrap_or_else(|message| {
+        notes.push(format!(
+            "{}: {message}; its exposure is taken from the description",
+            path.display()
+        ));
+        None
+    });
     let levels = image.pixels().map(|p| p.0).collect();
-    Ok((levels, width, height))
+    Ok(Read {
+        file: path.to_path_buf(),
+        levels: (levels, width, height),
+        exif,
+    })
 }
 
 /// Refuses photographs of different sizes.

@@ -54,7 +54,11 @@ pub fn run(args: CaptureArgs) -> anyhow::Result<()> {
         anyhow::bail!("--scale {} must be positive", args.scale);
     }
     let files = open_outputs(&outputs)?;
-    let photos = capture::load_capture(&args.description)?;
+    let loaded = capture::load_capture(&args.description)?;
+    for note in &loaded.notes {
+        log::warn!("{note}");
+    }
+    let photos = loaded.photos;
     let width = args.width as usize;
     let settings = AssemblySettings {
         width,

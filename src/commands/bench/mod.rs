@@ -1,7 +1,9 @@
 //! `hprt bench`: benchmarks anyone can rerun; they print medians over repeats.
 
 mod bake;
+mod capture;
 mod composite;
+mod process;
 mod reference;
 mod reflections;
 mod render;
@@ -9,6 +11,7 @@ mod shards;
 mod turn;
 
 use bake::{BenchBakeArgs, bench_bake};
+use capture::{BenchCaptureArgs, bench_capture};
 use clap::Subcommand;
 use composite::{BenchCompositeArgs, bench_composite};
 use reference::{BenchReferenceArgs, bench_reference};
@@ -39,6 +42,9 @@ pub enum BenchCommand {
     /// Glossy reflections: the GPU time of prefiltering the map's remainder per lighting
     /// change, at each face size.
     Reflections(BenchReflectionsArgs),
+    /// Capture: photographs a map as a camera would (24 shots of 12 megapixels by default),
+    /// then times `hprt capture` on them and prints its peak memory.
+    Capture(BenchCaptureArgs),
 }
 
 pub fn run(command: BenchCommand) -> anyhow::Result<()> {
@@ -50,5 +56,6 @@ pub fn run(command: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Reflections(args) => bench_reflections(args),
         BenchCommand::Composite(args) => bench_composite(args),
         BenchCommand::Shards(args) => bench_shards(args),
+        BenchCommand::Capture(args) => bench_capture(args),
     }
 }

@@ -5,10 +5,10 @@
 //! the scene's objects side by side instead (generated, not shipped: K = 45 of the res2
 //! dragon is about 9 million triangles).
 
+use super::process::{Run, run_hprt};
 use anyhow::Context;
 use clap::Args;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 #[derive(Args)]
 pub struct BenchShardsArgs {
@@ -30,40 +30,6 @@ pub struct BenchShardsArgs {
     /// Folder for the shards, bakes and generated scene (default: a temporary one).
     #[arg(long)]
     pub work_dir: Option<PathBuf>,
-}
-
-/// One process's cost.
-struct Run {
-    seconds: f64,
-    peak_mib: f64,
-}
-
-/// Runs this hprt with `args`, returning its wall time and peak resident memory.
-fn run_hprt(args: &[String]) -> anyhow::Result<Run> {
-    let exe = std::env::current_exe().context("cannot find this hprt's own path")?;
-    let start = Instant::now();
-    let child = std::process::Command::new(exe)
-        .args(args)
-        .stdout(std::process::Stdio::null())
-        .spawn()
-        .context("cannot start hprt")?;
-    let pid = child.id() as libc::pid_t;
-    let mut status = 0;
-    // SAFETY: rusage is plain data the call fills; pid is our own child, waited for once.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    let waited = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
-    let seconds = start.elapsed().as_secs_f64();
-    anyhow::ensure!(waited == pid, "cannot wait for hprt {}", args.join(" "));
-    anyhow::ensure!(
-        libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
-        "hprt {} failed",
-        args.join(" ")
-    );
-    Ok(Run {
-        seconds,
-        // Linux reports ru_maxrss in KiB.
-        peak_mib: usage.ru_maxrss as f64 / 1024.0,
-    })
 }
 
 /// A scene file of `instances` copies of `scene`'s objects, each moved along +X by the
