@@ -265,3 +265,75 @@ fn exposures_are_read_from_exif() {
         );
     }
 }
+
+/// A ball whose outline the description leaves out is found in its photographs, and the map
+/// comes out as the true outline gives it.
+#[test]
+fn a_ball_found_in_the_pictures_gives_the_map_its_true_outline_gives() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let plan = CapturePlan {
+        size: (200, 200),
+        orientations: Vec::new(),
+        fov: 90.0,
+        ball_yaws: vec![0.0, 90.0],
+        times: vec![4e-5, 1.3e-4, 6e-4, 2.5e-3, 1.1e-2, 4.6e-2],
+        response: RESPONSE,
+        samples: 4,
+        seed: 6,
+    };
+    write_capture(&interior(), &plan, d).unwrap();
+    let text = std::fs::read_to_string(d.join("capture.toml")).unwrap();
+    // The outline write_capture drew: centred, 0.42 of the picture's side.
+    let given: String = text
+        .split("[[ball]]")
+        .skip(1)
+        .map(|entry| {
+            format!(
+                "[[ball]]\n{}\ncentre = [100.0, 100.0]\nradius = 84.0\n\n",
+                entry.trim()
+            )
+        })
+        .collect();
+    std::fs::write(d.join("given.toml"), given).unwrap();
+    for (description, output) in [("capture.toml", "found.exr"), ("given.toml", "given.exr")] {
+        let out = hprt(d, &["capture", description, "-o", output, "--width", "128"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    // Each against the map photographed (one white-balance scale per channel: the capture is
+    // in relative units).
+    let truth = interior();
+    let error = |name: &str| {
+        let map = foundation::image_io::read_exr(&d.join(name)).unwrap();
+        log_errors(&truth, &map.pixels, map.width)
+    };
+    let (found, given) = (error("found.exr"), error("given.exr"));
+    assert!(
+        found.0 <= given.0 * 1.2 + 0.005 && found.1 <= given.1 * 1.2 + 0.01,
+        "found: median {}, 90th percentile {}; given: {}, {}",
+        found.0,
+        found.1,
+        given.0,
+        given.1
+    );
+}
+
+/// The median and 90th percentile over texels of `|ln(captured · s_c / truth)|` (luminance),
+/// `s_c` per channel making the means agree.
+fn log_errors(truth: &EnvMap, captured: &[foundation::Rgb], width: usize) -> (f32, f32) {
+    let truth = truth.downsampled((truth.width() / width).max(1));
+    assert_eq!(truth.texels().len(), captured.len());
+    let sum = |texels: &[foundation::Rgb]| texels.iter().fold(foundation::Rgb::ZERO, |s, c| s + *c);
+    let scale = sum(truth.texels()) / sum(captured);
+    let mut errors: Vec<f32> = captured
+        .iter()
+        .zip(truth.texels())
+        .map(|(c, t)| {
+            (luminance(*c * scale).max(1e-6) / luminance(*t).max(1e-6))
+                .ln()
+                .abs()
+        })
+        .collect();
+    errors.sort_by(f32::total_cmp);
+    (errors[errors.len() / 2], errors[errors.len() * 9 / 10])
+}

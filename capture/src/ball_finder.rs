@@ -28,14 +28,16 @@ const RAYS: usize = 360;
 /// The least radius of a ball, as a share of the picture's shorter side: smaller circles are
 /// as often a texture's.
 const MIN_RADIUS: f32 = 0.1;
+/// How much busier a ball's disc must be than its surroundings ([`detail_ratio`]).
+const MIN_DETAIL_RATIO: f32 = 1.8;
 /// Coarse circles refined in search of the ball.
 const CANDIDATES: usize = 16;
 /// How near the grazing cone an edge must be to support a found ball (pixels): a ball's
 /// outline is found to a fraction of a pixel all round; a texture's edges only scatter near a
 /// circle.
-const SUPPORT_MARGIN: f32 = 0.75;
+const SUPPORT_MARGIN: f32 = 1.0;
 /// Least support for an outline to count as found.
-const MIN_SUPPORT: f32 = 0.75;
+const MIN_SUPPORT: f32 = 0.6;
 
 /// A ball found in a photograph.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,14 +49,14 @@ pub struct FoundBall {
     pub half_angle: f32,
 }
 
-/// The ball in a photograph's `levels` (`w × h`, row by row) taken through `camera`, if its
-/// outline is clear enough.
+/// The ball in the photographs of one view (`w × h` levels row by row, each with its exposure
+/// time) taken through `camera`, if its outline is clear enough.
 pub fn find_ball(
-    levels: &[[u8; 3]],
+    exposures: &[(&[[u8; 3]], f32)],
     (w, h): (usize, usize),
     camera: &ShotCamera,
 ) -> Option<FoundBall> {
-    let brightness = log_brightness(levels);
+    let brightness = log_brightness(exposures, w * h);
     let scale = w.max(h).div_ceil(VOTING_SIDE).max(1);
     let small = reduce(&brightness, w, h, scale);
     let s = scale as f32;
@@ -82,11 +84,47 @@ pub fn find_ball(
         {
             continue;
         }
-        if let Some(found) = grazing_cone(camera, circle, &points) {
+        let busier = detail_ratio(&brightness, (w, h), circle) >= MIN_DETAIL_RATIO;
+        if let Some(found) = grazing_cone(camera, circle, &points).filter(|_| busier) {
             best = Some(found);
         }
     }
     best
+}
+
+/// How much busier the picture is inside `circle` than around it: the mean log-brightness
+/// gradient over the disc's inner part against that over a ring outside (within the picture).
+/// A ball squeezes the whole room into its disc; a circle that happens to follow a texture's
+/// edges has the same texture on both sides.
+fn detail_ratio(values: &[f32], (w, h): (usize, usize), circle: Circle) -> f32 {
+    let (mut inside, mut outside) = ((0.0f32, 0u32), (0.0f32, 0u32));
+    let r = circle.radius;
+    let (x0, x1) = (
+        (circle.centre.x - 1.6 * r).max(1.0),
+        (circle.centre.x + 1.6 * r).min((w - 2) as f32),
+    );
+    let (y0, y1) = (
+        (circle.centre.y - 1.6 * r).max(1.0),
+        (circle.centre.y + 1.6 * r).min((h - 2) as f32),
+    );
+    if !(x0 < x1 && y0 < y1) {
+        return 0.0;
+    }
+    for y in y0 as usize..=y1 as usize {
+        for x in x0 as usize..=x1 as usize {
+            let d = Vec2::new(x as f32, y as f32).distance(circle.centre) / r;
+            let gx = values[y * w + x + 1] - values[y * w + x - 1];
+            let gy = values[(y + 1) * w + x] - values[(y - 1) * w + x];
+            let g = (gx * gx + gy * gy).sqrt();
+            if (0.2..0.85).contains(&d) {
+                inside = (inside.0 + g, inside.1 + 1);
+            } else if (1.15..1.6).contains(&d) {
+                outside = (outside.0 + g, outside.1 + 1);
+            }
+        }
+    }
+    let mean = |(sum, n): (f32, u32)| sum / n.max(1) as f32;
+    mean(inside) / mean(outside).max(1e-6)
 }
 
 /// The ball outlined by `points` (edges found along rays from `circle`'s centre), seen
@@ -152,11 +190,28 @@ fn fit_grazing_cone(mut rays: Vec<Vec3>, margin: f32) -> Option<(Vec3, f32)> {
     Some(cone)
 }
 
-/// `ln(1 + level)` of each pixel's mean level.
-fn log_brightness(levels: &[[u8; 3]]) -> Vec<f32> {
-    levels
-        .iter()
-        .map(|p| (1.0 + (p[0] as f32 + 2.0 * p[1] as f32 + p[2] as f32) / 4.0).ln())
+/// Per pixel, `ln((1 + level) / time)` of its mean level averaged over the exposures with a
+/// hat weight (the response is not known yet: a rough log radiance, but one in which the rim's
+/// step by the ball's reflectance shows in the dark and the bright parts of the room alike).
+fn log_brightness(exposures: &[(&[[u8; 3]], f32)], pixels: usize) -> Vec<f32> {
+    (0..pixels)
+        .map(|i| {
+            let (mut sum, mut total, mut fallback) = (0.0f32, 0.0f32, (f32::MAX, 0.0f32));
+            for (levels, time) in exposures {
+                let p = levels[i];
+                let z = (p[0] as f32 + 2.0 * p[1] as f32 + p[2] as f32) / 4.0;
+                let value = ((1.0 + z) / time.max(f32::MIN_POSITIVE)).ln();
+                let weight = z.min(255.0 - z).max(0.0);
+                sum += weight * value;
+                total += weight;
+                // Where every exposure is black or clipped: the one nearest mid-grey.
+                let distance = (z - 128.0).abs();
+                if distance < fallback.0 {
+                    fallback = (distance, value);
+                }
+            }
+            if total > 0.0 { sum / total } else { fallback.1 }
+        })
         .collect()
 }
 
@@ -180,14 +235,41 @@ fn reduce(values: &[f32], w: usize, h: usize, k: usize) -> (Vec<f32>, usize, usi
 
 /// The best-voted circles of a reduced image of at least `r_min` pixels' radius (centre and
 /// radius in its pixels, votes per unit of circumference as support), at most [`CANDIDATES`],
-/// no two alike.
+/// no two alike. As OpenCV's gradient method: every strong edge votes for the centres along
+/// its gradient line (both ways: the ball may be darker or brighter than the room), the votes
+/// blurred (a gradient's direction is off by a few degrees: the lines of a large circle cross
+/// over some pixels); then each of the best centres takes the radii its edges lie at.
 fn vote(values: &[f32], w: usize, h: usize, r_min: usize) -> Vec<Circle> {
     let r_max = w.min(h) / 2;
     if r_max <= r_min || w < 3 || h < 3 {
         return Vec::new();
     }
-    let radii = r_max - r_min + 1;
-    // Sobel gradients; only the strongest tenth of the edges vote.
+    let edges = strong_edges(values, w, h);
+    let mut votes = vec![0.0f32; w * h];
+    for (p, g) in &edges {
+        let direction = *g / g.length();
+        for sign in [-1.0f32, 1.0] {
+            for r in r_min..=r_max {
+                let c = *p + direction * (sign * r as f32);
+                let (cx, cy) = (c.x.round(), c.y.round());
+                if cx >= 0.0 && cy >= 0.0 && (cx as usize) < w && (cy as usize) < h {
+                    votes[cy as usize * w + cx as usize] += 1.0;
+                }
+            }
+        }
+    }
+    let votes = box_blur(&box_blur(&votes, w, h, 2), w, h, 2);
+    let mut candidates = Vec::new();
+    for centre in best_centres(&votes, w, h, CANDIDATES) {
+        candidates.extend(best_radii(&edges, centre, r_min, r_max));
+    }
+    candidates.sort_by(|a, b| b.support.total_cmp(&a.support));
+    candidates.truncate(CANDIDATES);
+    candidates
+}
+
+/// The image's pixels whose Sobel gradient is among the strongest quarter, with the gradient.
+fn strong_edges(values: &[f32], w: usize, h: usize) -> Vec<(Vec2, Vec2)> {
     let mut edges = Vec::new();
     for y in 1..h - 1 {
         for x in 1..w - 1 {
@@ -204,57 +286,85 @@ fn vote(values: &[f32], w: usize, h: usize, r_min: usize) -> Vec<Circle> {
             }
         }
     }
+    if edges.is_empty() {
+        return edges;
+    }
     let mut magnitudes: Vec<f32> = edges.iter().map(|(_, g)| g.length()).collect();
-    if magnitudes.is_empty() {
-        return Vec::new();
-    }
-    let cut = magnitudes.len() * 9 / 10;
+    let cut = magnitudes.len() * 3 / 4;
     let threshold = *magnitudes.select_nth_unstable_by(cut, f32::total_cmp).1;
-    // Per sign and radius, the best centre.
-    let mut candidates = Vec::new();
-    // Each sign of the step in turn: a ball darker than its surroundings, then brighter.
-    for sign in [-1.0f32, 1.0] {
-        let mut votes = vec![0.0f32; w * h * radii];
-        for (p, g) in edges.iter().filter(|(_, g)| g.length() >= threshold) {
-            let direction = *g / g.length() * sign;
-            for (k, r) in (r_min..=r_max).enumerate() {
-                let c = *p + direction * r as f32;
-                let (cx, cy) = (c.x.round(), c.y.round());
-                if cx >= 0.0 && cy >= 0.0 && (cx as usize) < w && (cy as usize) < h {
-                    votes[(cy as usize * w + cx as usize) * radii + k] += 1.0;
-                }
+    edges.retain(|(_, g)| g.length() >= threshold);
+    edges
+}
+
+/// The mean over `(2k + 1)²` pixels around each pixel (clamped at the edges).
+fn box_blur(values: &[f32], w: usize, h: usize, k: usize) -> Vec<f32> {
+    let mut out = vec![0.0f32; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let (y0, y1) = (y.saturating_sub(k), (y + k).min(h - 1));
+            let (x0, x1) = (x.saturating_sub(k), (x + k).min(w - 1));
+            let mut sum = 0.0;
+            for yy in y0..=y1 {
+                sum += values[yy * w + x0..=yy * w + x1].iter().sum::<f32>();
             }
+            out[y * w + x] = sum / ((y1 - y0 + 1) * (x1 - x0 + 1)) as f32;
         }
-        let mut per_radius = vec![(0.0f32, 0usize); radii];
-        for (i, chunk) in votes.chunks_exact(radii).enumerate() {
-            for (best, v) in per_radius.iter_mut().zip(chunk) {
-                if *v > best.0 {
-                    *best = (*v, i);
-                }
-            }
-        }
-        candidates.extend(per_radius.iter().enumerate().map(|(k, (v, i))| {
-            let r = (r_min + k) as f32;
-            Circle {
-                centre: Vec2::new((i % w) as f32, (i / w) as f32),
-                radius: r,
-                support: v / (std::f32::consts::TAU * r),
-            }
-        }));
     }
-    candidates.sort_by(|a, b| b.support.total_cmp(&a.support));
-    let mut chosen: Vec<Circle> = Vec::new();
-    for c in candidates {
-        let alike =
-            |o: &Circle| o.centre.distance(c.centre) < 3.0 && (o.radius - c.radius).abs() < 3.0;
-        if !chosen.iter().any(alike) {
+    out
+}
+
+/// The `count` best local maxima of `votes`, at least 3 pixels apart.
+fn best_centres(votes: &[f32], w: usize, h: usize, count: usize) -> Vec<Vec2> {
+    let mut order: Vec<usize> = (0..w * h).filter(|&i| votes[i] > 0.0).collect();
+    order.sort_by(|a, b| votes[*b].total_cmp(&votes[*a]));
+    let mut chosen: Vec<Vec2> = Vec::new();
+    for i in order {
+        let c = Vec2::new((i % w) as f32, (i / w) as f32);
+        if chosen.iter().all(|o| o.distance(c) >= 3.0) {
             chosen.push(c);
-        }
-        if chosen.len() == CANDIDATES {
-            break;
+            if chosen.len() == count {
+                break;
+            }
         }
     }
     chosen
+}
+
+/// The two radii (from `r_min` to `r_max`) at which most of `edges` whose gradient points
+/// along the radius lie around `centre`, as circles with their count per unit circumference.
+fn best_radii(edges: &[(Vec2, Vec2)], centre: Vec2, r_min: usize, r_max: usize) -> Vec<Circle> {
+    let mut histogram = vec![0.0f32; r_max + 2];
+    for (p, g) in edges {
+        let offset = *p - centre;
+        let r = offset.length();
+        if r < 1.0 || (r.round() as usize) > r_max {
+            continue;
+        }
+        // Only edges across the circle, not along it.
+        if (offset.dot(*g) / (r * g.length())).abs() > 0.9 {
+            histogram[r.round() as usize] += 1.0;
+        }
+    }
+    let score = |r: usize| {
+        let near = histogram[r - 1] + histogram[r] + histogram[r + 1];
+        near / (std::f32::consts::TAU * r as f32)
+    };
+    let mut radii: Vec<(usize, f32)> = (r_min.max(1)..=r_max).map(|r| (r, score(r))).collect();
+    radii.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let mut out: Vec<Circle> = Vec::new();
+    for (r, s) in radii {
+        if out.iter().all(|c| (c.radius - r as f32).abs() >= 3.0) {
+            out.push(Circle {
+                centre,
+                radius: r as f32,
+                support: s,
+            });
+            if out.len() == 2 {
+                break;
+            }
+        }
+    }
+    out
 }
 
 /// The outline near `circle` (within `reach` pixels of it), found along rays from its centre
@@ -436,7 +546,7 @@ mod tests {
             let camera = ShotCamera::new((yaw, 10.0, 0.0), 30.0, size, (0.0, 0.0));
             let ball = MirrorBall::new(camera, centre, radius, [0.6; 3]);
             let photo = photograph(&map, View::Ball(ball), size, 0.5, &response, &mut rng);
-            let found = find_ball(&photo.levels, size, &camera).expect("a ball");
+            let found = find_ball(&[(&photo.levels, photo.time)], size, &camera).expect("a ball");
             let (axis, half_angle) = ball.grazing_cone();
             let pixel = 2.0 * camera.tan_half_fov / size.1 as f32;
             let (axis_error, angle_error) = (
@@ -469,7 +579,7 @@ mod tests {
             &response,
             &mut Pcg32::new(1, 1),
         );
-        let found = find_ball(&photo.levels, (160, 120), &camera);
+        let found = find_ball(&[(&photo.levels, photo.time)], (160, 120), &camera);
         assert_eq!(found, None);
     }
 

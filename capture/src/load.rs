@@ -114,11 +114,18 @@ fn load_balls(
         if given.is_some() || found.iter().any(|(c, _)| c == camera) {
             continue;
         }
-        let best = out[k..]
+        // Its exposures, timed as the EXIF or the description says (a photograph with neither
+        // is refused later; here it counts as one second).
+        let exposures: Vec<(&[[u8; 3]], f32)> = out[k..]
             .iter()
-            .filter(|(_, g, c)| g.is_none() && c == camera)
-            .filter_map(|(r, _, c)| find_ball(&r.levels.0, (r.levels.1, r.levels.2), c))
-            .max_by(|a, b| a.outline.support.total_cmp(&b.outline.support));
+            .zip(&balls[k..])
+            .filter(|((_, g, c), _)| g.is_none() && c == camera)
+            .map(|((r, _, _), b)| {
+                let time = r.exif.map(|e| e.time).or(b.exposure).unwrap_or(1.0);
+                (r.levels.0.as_slice(), time)
+            })
+            .collect();
+        let best = find_ball(&exposures, (read.levels.1, read.levels.2), camera);
         if best.is_none() {
             return Err(CaptureError::Photo {
                 path: read.file.clone(),

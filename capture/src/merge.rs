@@ -60,22 +60,27 @@ pub(crate) fn merge_readings(
     channel: usize,
 ) -> Option<(f32, f32)> {
     let bins = response.curves[channel].len();
-    let estimate = |weight: &dyn Fn(&Reading) -> f32| {
-        let (mut sum, mut total) = (0.0, 0.0);
+    // In f64: where the response is flat, a reading's precision is huge, and its square
+    // would overflow f32 (an infinite weight makes the merge NaN).
+    let estimate = |weight: &dyn Fn(&Reading) -> f64| {
+        let (mut sum, mut total) = (0.0f64, 0.0f64);
         for r in readings {
             let w = weight(r);
-            sum += w * r.exposure / r.sensitivity;
+            sum += w * f64::from(r.exposure) / f64::from(r.sensitivity);
             total += w;
         }
-        (total > 0.0).then(|| (sum / total, total))
+        (total > 0.0 && total.is_finite()).then(|| ((sum / total) as f32, total))
     };
-    let (first, _) =
-        estimate(&|r| hat_at(r.level, bins) * r.feather * r.sensitivity * r.sensitivity)?;
+    let (first, _) = estimate(&|r| {
+        f64::from(hat_at(r.level, bins) * r.feather) * f64::from(r.sensitivity).powi(2)
+    })?;
     estimate(&|r| {
         let level = response.level_of(channel, first * r.sensitivity);
-        let precision = r.sensitivity / response.slope_at(channel, level).max(f32::MIN_POSITIVE);
-        hat_at(level, bins) * r.feather * precision * precision
+        let slope = f64::from(response.slope_at(channel, level)).max(1e-30);
+        let precision = f64::from(r.sensitivity) / slope;
+        f64::from(hat_at(level, bins) * r.feather) * precision * precision
     })
+    .map(|(radiance, total)| (radiance, total.min(f64::from(f32::MAX)) as f32))
     .or(Some((first, 0.0)))
 }
 
@@ -128,5 +133,21 @@ mod tests {
         assert!((radiance - 120.0 / 128.0).abs() < 1e-5, "{radiance}");
         // Only clipped or black readings: nothing to merge.
         assert!(merge_readings(&[reading(0.0, 0.0, 1.0)], &response, 1).is_none());
+    }
+
+    /// A response that is flat over some levels (fitted to inconsistent samples: a ball's
+    /// outline given too large) makes those readings' precision enormous: the merge stays
+    /// finite (its weights once overflowed and made the radiance NaN).
+    #[test]
+    fn a_flat_response_merges_to_a_finite_radiance() {
+        let mut response = InverseResponse::linear();
+        for curve in &mut response.curves {
+            for v in &mut curve[100..160] {
+                *v = 1.0;
+            }
+        }
+        let readings = [reading(120.0, 1.0, 1e-3), reading(130.0, 1.0, 2e-3)];
+        let (radiance, weight) = merge_readings(&readings, &response, 0).unwrap();
+        assert!(radiance.is_finite() && weight.is_finite(), "{radiance} {weight}");
     }
 }
