@@ -226,6 +226,7 @@ fn exposures_are_read_from_exif() {
         response: RESPONSE,
         samples: 4,
         seed: 5,
+        provenance: String::new(),
     };
     write_capture(&interior(), &plan, d).unwrap();
     let text = std::fs::read_to_string(d.join("capture.toml")).unwrap();
@@ -281,6 +282,7 @@ fn a_ball_found_in_the_pictures_gives_the_map_its_true_outline_gives() {
         response: RESPONSE,
         samples: 4,
         seed: 6,
+        provenance: String::new(),
     };
     write_capture(&interior(), &plan, d).unwrap();
     let text = std::fs::read_to_string(d.join("capture.toml")).unwrap();

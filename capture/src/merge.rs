@@ -148,6 +148,9 @@ mod tests {
         }
         let readings = [reading(120.0, 1.0, 1e-3), reading(130.0, 1.0, 2e-3)];
         let (radiance, weight) = merge_readings(&readings, &response, 0).unwrap();
-        assert!(radiance.is_finite() && weight.is_finite(), "{radiance} {weight}");
+        assert!(
+            radiance.is_finite() && weight.is_finite(),
+            "{radiance} {weight}"
+        );
     }
 }

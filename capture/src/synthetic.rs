@@ -128,6 +128,8 @@ pub struct CapturePlan {
     /// Directions averaged per pixel: `samples × samples`.
     pub samples: usize,
     pub seed: u64,
+    /// Written as comments at the top of the description: where the photographs come from.
+    pub provenance: String,
 }
 
 /// Photographs `map` as `plan` says into `dir` as JPEG files, each with its exposure time in
@@ -180,10 +182,12 @@ pub fn write_capture(
             );
             write_jpeg(&dir.join(name), &photo)
         })?;
-    let mut toml = String::from(
-        "# Synthetic photographs (hprt bench capture --keep): exposure times in each JPEG's \
-         EXIF.\n\n",
-    );
+    let mut toml: String = plan
+        .provenance
+        .lines()
+        .map(|line| format!("# {line}\n"))
+        .collect();
+    toml.push_str("# Exposure times are in each JPEG's EXIF.\n\n");
     for (_, _, _, entry) in &jobs {
         write!(toml, "{entry}").expect("a string");
     }

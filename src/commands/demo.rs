@@ -6,6 +6,7 @@ use crate::cli::{ImageSizeArgs, ReportOptions};
 use crate::commands::report::write_report;
 use crate::maps::maps_beside;
 use crate::support::load_scene;
+use anyhow::Context;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -72,6 +73,11 @@ const GLOSSY_TEAPOT: &str = "scenes/teapot_glossy.toml";
 const GLOSSY_DRAGON: &str = "scenes/dragon_glossy.toml";
 const GLOSSY_DRAGON_MAP: &str = "scenes/env/sunrise.exr";
 const GLOSSY_DRAGON_SPP: u32 = 512;
+/// Capture: photographs of the interior map (synthetic, through a known response; exposure
+/// times in their EXIF) captured back into a map, decomposed against the map photographed,
+/// and the teapot's report under it.
+const CAPTURE: &str = "scenes/capture/capture.toml";
+const CAPTURE_TRUTH: &str = "scenes/env/interior.exr";
 
 pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let bundled_scenes = args.scene.is_none();
@@ -149,6 +155,10 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         )?;
     }
 
+    if bundled_scenes {
+        demo_capture(&args.output.join("capture"), &scene, &options)?;
+    }
+
     // A model as users bring theirs: the textured glTF sample, placed on its own, through
     // bake, hybrid, PRT and the path-traced reference.
     println!("\nthe glTF sample {MODEL_SAMPLE}:");
@@ -166,4 +176,53 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         &sample_options,
         &args.output.join("crate"),
     )
+}
+
+/// The bundled capture through the whole chain: `hprt capture`, the decomposition of the
+/// captured map against that of the map photographed, and the report of `scene` under it.
+fn demo_capture(
+    output: &Path,
+    scene: &foundation::scene::Scene,
+    options: &ReportOptions,
+) -> anyhow::Result<()> {
+    println!("\nthe capture {CAPTURE} (photographs of {CAPTURE_TRUTH}):");
+    std::fs::create_dir_all(output).with_context(|| format!("cannot make {}", output.display()))?;
+    let captured = output.join("captured.exr");
+    crate::commands::capture::run(crate::commands::capture::CaptureArgs {
+        description: bundled(CAPTURE),
+        output: captured.clone(),
+        width: 512,
+        response: None,
+        save_response: Some(output.join("response.csv")),
+        coverage: Some(output.join("coverage.png")),
+        preview: Some(output.join("preview.png")),
+        scale: 1.0,
+    })?;
+    let strongest = |path: &Path| -> anyhow::Result<(glam::Vec3, f32)> {
+        let map = foundation::envmap::load(path, None)?.map;
+        let cube = runtime::CubeSource::new(&map, 64).cube(0.0);
+        let decomposition =
+            runtime::Decomposer::new(runtime::DecomposeSettings::default())?.decompose(&cube);
+        let light = decomposition
+            .lights
+            .first()
+            .with_context(|| format!("{}: no light found", path.display()))?;
+        Ok((light.direction, light.share))
+    };
+    let (a, b) = (strongest(&captured)?, strongest(&bundled(CAPTURE_TRUTH))?);
+    println!(
+        "captured against photographed: strongest light {:.2}° apart, {:.1}% against {:.1}% of \
+         the map's power",
+        a.0.angle_between(b.0).to_degrees(),
+        100.0 * a.1,
+        100.0 * b.1
+    );
+    let capture_options = ReportOptions {
+        spp: MODEL_SAMPLE_SPP,
+        target_noise: None,
+        thresholds: vec![0.0, 0.05],
+        frames: 1,
+        ..options.clone()
+    };
+    write_report(scene, &[captured], &capture_options, &output.join("report"))
 }

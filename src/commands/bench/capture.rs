@@ -92,6 +92,25 @@ pub(super) fn bench_capture(args: BenchCaptureArgs) -> anyhow::Result<()> {
         // benchmark's pictures need not be that sharp, and are made in seconds).
         samples: if w * h > 1_000_000 { 1 } else { 4 },
         seed: 1,
+        provenance: format!(
+            "Synthetic photographs of {} through a known response (knee {:?}, gamma {}, noise \
+             {} levels),\nmade by `hprt bench capture {} --size {w}x{h}{} --times {}{}`.",
+            args.map.display(),
+            RESPONSE.knee,
+            RESPONSE.gamma,
+            RESPONSE.noise,
+            args.map.display(),
+            if args.ball { " --ball" } else { "" },
+            args.times
+                .iter()
+                .map(f32::to_string)
+                .collect::<Vec<_>>()
+                .join(","),
+            args.keep
+                .as_ref()
+                .map(|k| format!(" --keep {}", k.display()))
+                .unwrap_or_default(),
+        ),
     };
     let start = Instant::now();
     let description = write_capture(&map, &plan, &dir)
