@@ -217,17 +217,7 @@ fn bad_captures_are_refused_with_the_file_named() {
 fn exposures_are_read_from_exif() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let plan = CapturePlan {
-        size: (200, 200),
-        orientations: Vec::new(),
-        fov: 90.0,
-        ball_yaws: vec![0.0, 90.0],
-        times: vec![5e-5, 4.6e-4, 3.7e-3, 3.8e-2],
-        response: RESPONSE,
-        samples: 4,
-        seed: 5,
-        provenance: String::new(),
-    };
+    let plan = ball_plan(vec![5e-5, 4.6e-4, 3.7e-3, 3.8e-2], 5);
     write_capture(&interior(), &plan, d).unwrap();
     let text = std::fs::read_to_string(d.join("capture.toml")).unwrap();
     assert!(
@@ -273,17 +263,7 @@ fn exposures_are_read_from_exif() {
 fn a_ball_found_in_the_pictures_gives_the_map_its_true_outline_gives() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let plan = CapturePlan {
-        size: (200, 200),
-        orientations: Vec::new(),
-        fov: 90.0,
-        ball_yaws: vec![0.0, 90.0],
-        times: vec![4e-5, 1.3e-4, 6e-4, 2.5e-3, 1.1e-2, 4.6e-2],
-        response: RESPONSE,
-        samples: 4,
-        seed: 6,
-        provenance: String::new(),
-    };
+    let plan = ball_plan(TIMES.to_vec(), 6);
     write_capture(&interior(), &plan, d).unwrap();
     let text = std::fs::read_to_string(d.join("capture.toml")).unwrap();
     // The outline write_capture drew: centred, 0.42 of the picture's side.
@@ -338,4 +318,20 @@ fn log_errors(truth: &EnvMap, captured: &[foundation::Rgb], width: usize) -> (f3
         .collect();
     errors.sort_by(f32::total_cmp);
     (errors[errors.len() / 2], errors[errors.len() * 9 / 10])
+}
+
+/// A mirror ball (0.42 of a 200-pixel picture across, centred) photographed from two sides at
+/// `times` by [`write_capture`].
+fn ball_plan(times: Vec<f32>, seed: u64) -> CapturePlan {
+    CapturePlan {
+        size: (200, 200),
+        orientations: Vec::new(),
+        fov: 90.0,
+        ball_yaws: vec![0.0, 90.0],
+        times,
+        response: RESPONSE,
+        samples: 4,
+        seed,
+        provenance: String::new(),
+    }
 }
