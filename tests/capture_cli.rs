@@ -335,3 +335,33 @@ fn ball_plan(times: Vec<f32>, seed: u64) -> CapturePlan {
         provenance: String::new(),
     }
 }
+
+/// An outline given a few pixels too large mixes the room around the ball into the response's
+/// samples: the capture still writes a finite map (its merge weights once overflowed there and
+/// the map came out with NaN texels, refused by the EXR writer).
+#[test]
+fn an_outline_given_too_large_still_gives_a_finite_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let plan = ball_plan(TIMES.to_vec(), 6);
+    write_capture(&interior(), &plan, d).unwrap();
+    let text = std::fs::read_to_string(d.join("capture.toml")).unwrap();
+    let large: String = text
+        .split("[[ball]]")
+        .skip(1)
+        .map(|entry| {
+            format!(
+                "[[ball]]\n{}\ncentre = [100.0, 100.0]\nradius = 88.0\n\n",
+                entry.trim()
+            )
+        })
+        .collect();
+    std::fs::write(d.join("large.toml"), large).unwrap();
+    let out = hprt(
+        d,
+        &["capture", "large.toml", "-o", "large.exr", "--width", "128"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let map = foundation::image_io::read_exr(&d.join("large.exr")).unwrap();
+    assert!(map.pixels.iter().all(|c| c.is_finite()));
+}
