@@ -13,7 +13,8 @@ use std::path::{Path, PathBuf};
 pub struct CaptureArgs {
     /// Capture description (TOML): [[shot]] entries (image, exposure, yaw, pitch, roll, fov,
     /// k1, k2) or [[ball]] entries (image, exposure, centre, radius, fov, yaw, pitch,
-    /// reflectance); paths relative to it. See README, "Capture".
+    /// reflectance); paths relative to it. Exposure times are read from each image's EXIF
+    /// when it records one; a ball without centre and radius is found. See README.
     pub description: PathBuf,
     /// The linear equirectangular map (EXR), relative radiance (the middle level of the
     /// recovered response is 1).
