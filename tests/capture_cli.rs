@@ -263,21 +263,9 @@ fn exposures_are_read_from_exif() {
 fn a_ball_found_in_the_pictures_gives_the_map_its_true_outline_gives() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let plan = ball_plan(TIMES.to_vec(), 6);
-    write_capture(&interior(), &plan, d).unwrap();
-    let text = std::fs::read_to_string(d.join("capture.toml")).unwrap();
+    write_capture(&interior(), &ball_plan(TIMES.to_vec(), 6), d).unwrap();
     // The outline write_capture drew: centred, 0.42 of the picture's side.
-    let given: String = text
-        .split("[[ball]]")
-        .skip(1)
-        .map(|entry| {
-            format!(
-                "[[ball]]\n{}\ncentre = [100.0, 100.0]\nradius = 84.0\n\n",
-                entry.trim()
-            )
-        })
-        .collect();
-    std::fs::write(d.join("given.toml"), given).unwrap();
+    with_outline(d, "given.toml", 84.0);
     for (description, output) in [("capture.toml", "found.exr"), ("given.toml", "given.exr")] {
         let out = hprt(d, &["capture", description, "-o", output, "--width", "128"]);
         assert!(out.status.success(), "{}", stderr(&out));
@@ -343,20 +331,8 @@ fn ball_plan(times: Vec<f32>, seed: u64) -> CapturePlan {
 fn an_outline_given_too_large_still_gives_a_finite_map() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let plan = ball_plan(TIMES.to_vec(), 6);
-    write_capture(&interior(), &plan, d).unwrap();
-    let text = std::fs::read_to_string(d.join("capture.toml")).unwrap();
-    let large: String = text
-        .split("[[ball]]")
-        .skip(1)
-        .map(|entry| {
-            format!(
-                "[[ball]]\n{}\ncentre = [100.0, 100.0]\nradius = 88.0\n\n",
-                entry.trim()
-            )
-        })
-        .collect();
-    std::fs::write(d.join("large.toml"), large).unwrap();
+    write_capture(&interior(), &ball_plan(TIMES.to_vec(), 6), d).unwrap();
+    with_outline(d, "large.toml", 88.0);
     let out = hprt(
         d,
         &["capture", "large.toml", "-o", "large.exr", "--width", "128"],
@@ -364,4 +340,21 @@ fn an_outline_given_too_large_still_gives_a_finite_map() {
     assert!(out.status.success(), "{}", stderr(&out));
     let map = foundation::image_io::read_exr(&d.join("large.exr")).unwrap();
     assert!(map.pixels.iter().all(|c| c.is_finite()));
+}
+
+/// Writes `name` beside `dir`'s `capture.toml`: the same balls with their outline given, centred
+/// in the 200-pixel pictures with `radius`.
+fn with_outline(dir: &Path, name: &str, radius: f32) {
+    let text = std::fs::read_to_string(dir.join("capture.toml")).unwrap();
+    let described: String = text
+        .split("[[ball]]")
+        .skip(1)
+        .map(|entry| {
+            format!(
+                "[[ball]]\n{}\ncentre = [100.0, 100.0]\nradius = {radius:.1}\n\n",
+                entry.trim()
+            )
+        })
+        .collect();
+    std::fs::write(dir.join(name), described).unwrap();
 }
