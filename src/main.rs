@@ -56,6 +56,7 @@ enum Command {
 }
 
 fn main() {
+    let runtime_dir = ensure_runtime_dir();
     env_logger::Builder::new()
         .parse_filters("warn,wgpu_core=error,wgpu_hal=error,naga=error")
         .parse_env("HPRT_LOG")
@@ -92,6 +93,27 @@ fn main() {
     };
     if let Err(error) = result {
         eprintln!("error: {error:#}");
+        drop(runtime_dir);
         std::process::exit(1);
     }
+}
+
+/// On a headless machine (a fresh server, a container) `XDG_RUNTIME_DIR` is often unset, and
+/// libwayland, which Mesa's GL and Vulkan drivers load to look for a display, then prints
+/// `error: XDG_RUNTIME_DIR is invalid or not set` at every adapter it probes: a private empty
+/// one (removed when the guard drops) silences it. Runs first in `main`, before any thread.
+fn ensure_runtime_dir() -> Option<tempfile::TempDir> {
+    let set =
+        std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|dir| std::path::Path::new(&dir).is_dir());
+    if set {
+        return None;
+    }
+    // tempfile makes it 0700, under a random name.
+    let dir = tempfile::Builder::new()
+        .prefix("hprt-runtime-")
+        .tempdir()
+        .ok()?;
+    // SAFETY: called at the start of main, before any other thread exists.
+    unsafe { std::env::set_var("XDG_RUNTIME_DIR", dir.path()) };
+    Some(dir)
 }

@@ -88,7 +88,7 @@ fn a_ball_capture_becomes_a_map_hprt_reads() {
             .all(|c| c.is_finite() && c.min_element() >= 0.0)
     );
     assert!(
-        stdout(&out).contains("of the sphere resolved"),
+        stdout(&out).contains("of the sphere resolved") && !stdout(&out).contains("-0.0%"),
         "{}",
         stdout(&out)
     );

@@ -126,10 +126,11 @@ fn report(description: &Path, captured: &Assembled, photos: usize) {
 
 fn filled_fraction(captured: &Assembled) -> f32 {
     let w = captured.map.width();
-    let filled: f32 = (0..captured.filled.len())
+    // Summed from +0 (an empty float sum is −0, printed "-0.0%").
+    let filled = (0..captured.filled.len())
         .filter(|t| captured.filled[*t])
         .map(|t| captured.map.texel_solid_angle(t / w))
-        .sum();
+        .fold(0.0f32, |sum, a| sum + a);
     filled / (4.0 * std::f32::consts::PI)
 }
 

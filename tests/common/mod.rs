@@ -31,6 +31,16 @@ pub fn hprt_with_env(dir: &Path, args: &[&str], vars: &[(&str, &Path)]) -> Outpu
     command.output().expect("hprt runs")
 }
 
+/// Runs the `hprt` binary as on a fresh headless machine: without `XDG_RUNTIME_DIR`.
+pub fn hprt_headless(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hprt"))
+        .args(args)
+        .current_dir(dir)
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .expect("hprt runs")
+}
+
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
