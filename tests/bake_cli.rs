@@ -200,3 +200,69 @@ fn bad_settings_and_destinations_fail_cleanly() {
         &["absent.toml"],
     );
 }
+
+/// `hprt bench bake --dump-rays` writes the bake's own rays: on an unoccluded quad every ray
+/// escapes, so each vertex's direct transfer is the albedo times the mean of the basis over
+/// the dumped directions of its fan.
+#[test]
+fn dumped_rays_are_the_bakes_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("quad.obj"), TRIANGLE_OBJ).unwrap();
+    let scene = write_scene(d, "s.toml", &obj_object("quad.obj"));
+    let scene = scene.to_str().unwrap();
+    let out = hprt(d, &["bake", scene, "-o", "out.bake"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (header, transfer) = precompute::bakefile::read(&d.join("out.bake")).unwrap();
+    let (order, samples) = (header.settings.order, header.settings.samples);
+    let args = [
+        "bench",
+        "bake",
+        scene,
+        "--order",
+        &order.to_string(),
+        "--samples",
+        &samples.to_string(),
+        "--bounces",
+        "0",
+        "--repeat",
+        "1",
+        "--dump-rays",
+        "rays.bin",
+    ];
+    let out = hprt(d, &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let bytes = std::fs::read(d.join("rays.bin")).unwrap();
+    assert_eq!(&bytes[..8], b"HPRTRAYS");
+    let u32_at = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().unwrap());
+    let u64_at = |i: usize| u64::from_le_bytes(bytes[i..i + 8].try_into().unwrap()) as usize;
+    let (fans, triangles) = (u64_at(16), u64_at(24));
+    assert_eq!((u32_at(8), u32_at(12), fans, triangles), (1, samples, 4, 2));
+    let rays_end = 32 + fans * samples as usize * 24;
+    assert_eq!(bytes.len(), rays_end + triangles * 36);
+    let floats: Vec<f32> = bytes[32..rays_end]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    let basis = foundation::sh::ShBasis::<f32>::new(order).unwrap();
+    let mut row = vec![0.0f32; (order + 1) * (order + 1)];
+    for (v, fan) in floats.chunks_exact(6 * samples as usize).enumerate() {
+        let mut mean = vec![0.0f32; row.len()];
+        for ray in fan.chunks_exact(6) {
+            assert_eq!(&ray[..3], &fan[..3], "one origin per fan");
+            let direction = glam::Vec3::new(ray[3], ray[4], ray[5]);
+            assert!((direction.length() - 1.0).abs() < 1e-5);
+            basis.eval(direction, &mut row);
+            for (m, y) in mean.iter_mut().zip(&row) {
+                *m += 0.5 * y / samples as f32;
+            }
+        }
+        let baked = transfer.direct.vector(v, 0);
+        for (a, b) in baked.iter().zip(&mean) {
+            assert!(
+                (a - b).abs() < 1e-5,
+                "vertex {v}: {baked:?} against {mean:?}"
+            );
+        }
+    }
+}

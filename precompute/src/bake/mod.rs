@@ -17,7 +17,7 @@ pub use bounce::InterreflectionOperator;
 pub use inside::VertexNeighbours;
 pub(crate) use inside::fill_inside;
 pub use transfer::TransferVectors;
-pub use visibility::INSIDE_BACKFACE_FRACTION;
+pub use visibility::{INSIDE_BACKFACE_FRACTION, RayFans};
 
 pub use foundation::bake_settings::{BakeSettings, MAX_BOUNCES, MAX_SAMPLES};
 use foundation::bvh::SceneBvh;

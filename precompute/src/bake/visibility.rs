@@ -106,7 +106,7 @@ pub(crate) fn trace_vertices(
         .map_init(
             || Scratch {
                 basis: vec![0.0; n],
-                hits: Vec::with_capacity(3 * tracer.samples.len()),
+                hits: Vec::with_capacity(3 * tracer.fans.len()),
             },
             |scratch, chunk_index| {
                 let vertices = first + chunk_index * CHUNK
@@ -166,14 +166,59 @@ pub(crate) fn vertex_costs(
     (0..vertex_count).map(|v| probes[v / stride]).collect()
 }
 
+/// How the bake's rays leave the vertices: a fan per vertex, every ray of it from one origin
+/// (the vertex moved off its surface along its normal), in directions cosine-distributed about
+/// the normal, rotated per vertex, in the order the bake traces them.
+pub struct RayFans {
+    samples: Vec<Vec2>,
+    offset: f32,
+    seed: u64,
+}
+
+impl RayFans {
+    pub fn new(geometry: &SceneMesh, settings: &BakeSettings) -> Self {
+        Self {
+            samples: base_samples(settings.samples),
+            offset: RAY_OFFSET_FRACTION * geometry.diagonal(),
+            seed: settings.seed,
+        }
+    }
+
+    /// Rays per fan.
+    pub fn len(&self) -> usize {
+        self.samples.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.samples.is_empty()
+    }
+
+    /// Vertex `v`'s fan: its origin and its rays' directions.
+    pub fn fan<'s>(
+        &'s self,
+        geometry: &SceneMesh,
+        v: usize,
+    ) -> (Vec3, impl Iterator<Item = Vec3> + 's) {
+        let mesh = &geometry.mesh;
+        let normal = mesh.normals[v];
+        let frame = Frame::from_normal(normal);
+        let origin = mesh.positions[v] + normal * self.offset;
+        let rotation = hash_to_unit2(mix64(self.seed ^ mix64(v as u64)));
+        let directions = self
+            .samples
+            .iter()
+            .map(move |u| frame.to_world(cosine_hemisphere(cranley_patterson(*u, rotation))));
+        (origin, directions)
+    }
+}
+
 /// What tracing one vertex's rays needs, shared by every vertex.
 struct VertexTracer<'a> {
     geometry: &'a SceneMesh,
     bvh: &'a SceneBvh,
     basis: ShBasis<f32>,
-    samples: Vec<Vec2>,
+    fans: RayFans,
     inv_samples: f32,
-    offset: f32,
     /// Whether hits are recorded (for the interreflection operator).
     record_hits: bool,
     front_normals: Vec<Vec3>,
@@ -187,9 +232,8 @@ impl<'a> VertexTracer<'a> {
             geometry,
             bvh,
             basis: ShBasis::<f32>::new(settings.order).expect("validated settings"),
-            samples: base_samples(settings.samples),
+            fans: RayFans::new(geometry, settings),
             inv_samples: 1.0 / settings.samples as f32,
-            offset: RAY_OFFSET_FRACTION * geometry.diagonal(),
             record_hits: settings.bounces > 0,
             front_normals: (0..mesh.triangle_count())
                 .map(|t| mesh.front_normal(t))
@@ -204,14 +248,10 @@ impl<'a> VertexTracer<'a> {
     #[inline]
     fn trace(&self, v: usize, scratch: &mut Scratch, visibility: &mut [f32]) -> bool {
         let mesh = &self.geometry.mesh;
-        let normal = mesh.normals[v];
-        let frame = Frame::from_normal(normal);
-        let origin = mesh.positions[v] + normal * self.offset;
-        let rotation = hash_to_unit2(mix64(self.seed ^ mix64(v as u64)));
+        let (origin, directions) = self.fans.fan(self.geometry, v);
         scratch.hits.clear();
         let mut back_faces = 0u32;
-        for u in &self.samples {
-            let direction = frame.to_world(cosine_hemisphere(cranley_patterson(*u, rotation)));
+        for direction in directions {
             let skip = Skip::VertexTriangles(v as u32);
             match self
                 .bvh
@@ -236,7 +276,7 @@ impl<'a> VertexTracer<'a> {
         for y in visibility.iter_mut() {
             *y *= self.inv_samples;
         }
-        back_faces as f32 > INSIDE_BACKFACE_FRACTION * self.samples.len() as f32
+        back_faces as f32 > INSIDE_BACKFACE_FRACTION * self.fans.len() as f32
     }
 
     /// BVH nodes visited by `rays` probe rays from vertex `v`, plus one per ray for the work
@@ -245,7 +285,7 @@ impl<'a> VertexTracer<'a> {
         let mesh = &self.geometry.mesh;
         let normal = mesh.normals[v];
         let frame = Frame::from_normal(normal);
-        let origin = mesh.positions[v] + normal * self.offset;
+        let origin = mesh.positions[v] + normal * self.fans.offset;
         let rotation = hash_to_unit2(mix64(self.seed ^ mix64(v as u64)));
         (0..rays)
             .map(|i| {

@@ -1,11 +1,13 @@
 //! `hprt bench bake`: the bake's throughput.
 
+use crate::outputs::{check_outputs, open_outputs, write_outputs};
 use crate::support::{load_scene, median, with_threads};
+use anyhow::Context;
 use clap::Args;
 use foundation::bvh::SceneBvh;
 use foundation::infra::progress::NoProgress;
 use precompute::bake::{self, BakeSettings};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub struct BenchBakeArgs {
@@ -24,6 +26,10 @@ pub struct BenchBakeArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Write the first scene's bake rays (every vertex's fan at --samples) to this file, so
+    /// that any tracer can be timed on them (layout: README, "hprt bench bake").
+    #[arg(long)]
+    pub dump_rays: Option<PathBuf>,
 }
 
 pub(super) fn bench_bake(args: BenchBakeArgs) -> anyhow::Result<()> {
@@ -34,6 +40,13 @@ pub(super) fn bench_bake(args: BenchBakeArgs) -> anyhow::Result<()> {
         seed: 0,
     };
     settings.validate()?;
+    if let Some(path) = &args.dump_rays {
+        let scene_path = args
+            .scenes
+            .first()
+            .context("no scene to take the rays of")?;
+        dump_rays(scene_path, &settings, path)?;
+    }
     println!(
         "bake benchmark: order {}, {} samples, {} bounces, {} threads, median of {}",
         args.order,
@@ -72,5 +85,53 @@ pub(super) fn bench_bake(args: BenchBakeArgs) -> anyhow::Result<()> {
             100.0 * bounce_ratio
         );
     }
+    Ok(())
+}
+
+/// The rays file's first eight bytes.
+const RAYS_MAGIC: &[u8; 8] = b"HPRTRAYS";
+
+/// Writes the bake's rays of the scene at `scene_path` and the triangles they are traced
+/// against: `HPRTRAYS`, then little-endian `u32` version (1), `u32` rays per fan, `u64` fan
+/// count, `u64` triangle count; then per ray six `f32` (origin x, y, z, direction x, y, z),
+/// fan after fan in vertex order, each fan's rays in the order traced; then per triangle nine
+/// `f32` (its corners, world space).
+fn dump_rays(scene_path: &Path, settings: &BakeSettings, path: &Path) -> anyhow::Result<()> {
+    let outputs = [("--dump-rays", Some(path))];
+    check_outputs(&[scene_path], &outputs)?;
+    let files = open_outputs(&outputs)?;
+    let scene = load_scene(scene_path)?;
+    let fans = bake::RayFans::new(&scene.geometry, settings);
+    let count = scene.geometry.mesh.vertex_count();
+    let mesh = &scene.geometry.mesh;
+    let mut bytes = Vec::with_capacity(32 + count * fans.len() * 24 + mesh.triangles.len() * 36);
+    bytes.extend_from_slice(RAYS_MAGIC);
+    bytes.extend_from_slice(&1u32.to_le_bytes());
+    bytes.extend_from_slice(&(fans.len() as u32).to_le_bytes());
+    bytes.extend_from_slice(&(count as u64).to_le_bytes());
+    bytes.extend_from_slice(&(mesh.triangles.len() as u64).to_le_bytes());
+    for v in 0..count {
+        let (origin, directions) = fans.fan(&scene.geometry, v);
+        for d in directions {
+            for x in origin.to_array().into_iter().chain(d.to_array()) {
+                bytes.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+    }
+    for triangle in &mesh.triangles {
+        for &corner in triangle {
+            for x in mesh.positions[corner as usize].to_array() {
+                bytes.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+    }
+    write_outputs(files, vec![bytes])?;
+    println!(
+        "wrote {} rays ({count} fans of {}) of {} to {}",
+        count * fans.len(),
+        fans.len(),
+        scene.name,
+        path.display()
+    );
     Ok(())
 }
