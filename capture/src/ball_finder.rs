@@ -1,12 +1,14 @@
 //! Finding a chrome ball's outline in a photograph when the description does not give it.
 //!
 //! A ball of reflectance ρ < 1 shows, just inside its rim, what lies just outside it (a grazing
-//! reflection sees past the ball), dimmed by ρ: along the whole outline the log of the
-//! brightness steps by about `ln ρ`, the same sign all round. Hence, as OpenCV's
-//! `HoughCircles` with its gradient method: every strong log-brightness edge of a reduced image
-//! votes for centres along its gradient, each radius's votes normalised by its circumference;
-//! the best circle is then refined at full resolution from the edge found along rays from its
-//! centre (sub-pixel), fitted by least squares with outliers dropped.
+//! reflection sees past the ball), dimmed by ρ: its outline is an edge of the log brightness
+//! all round. Hence, as OpenCV's `HoughCircles` with its gradient method: on a reduced image
+//! of the exposures fused, every strong edge votes for centres along its gradient line, and
+//! each best centre takes the radii its edges lie at. Each candidate is refined at full
+//! resolution from the edge found along rays from its centre (sub-pixel), fitted by least
+//! squares with outliers dropped, then as the cone of rays grazing the ball; the ball is the
+//! largest candidate whose edges lie on that cone and whose disc is busier than its
+//! surroundings.
 
 use crate::camera::ShotCamera;
 use glam::{Vec2, Vec3};
@@ -84,9 +86,10 @@ pub fn find_ball(
         {
             continue;
         }
-        let busier = detail_ratio(&brightness, (w, h), circle) >= MIN_DETAIL_RATIO;
-        if let Some(found) = grazing_cone(camera, circle, &points).filter(|_| busier) {
-            best = Some(found);
+        let found = grazing_cone(camera, circle, &points)
+            .filter(|_| detail_ratio(&brightness, (w, h), circle) >= MIN_DETAIL_RATIO);
+        if found.is_some() {
+            best = found;
         }
     }
     best

@@ -78,7 +78,7 @@ pub fn load_capture(path: &Path) -> Result<LoadedCapture, CaptureError> {
 }
 
 /// The mirror-ball photographs and their views: the outline as given, or found in the
-/// photograph (shared by the exposures of one camera: the clearest one's).
+/// photographs of one camera (one tripod position) together.
 fn load_balls(
     balls: &[BallDescription],
     folder: &Path,
@@ -109,7 +109,7 @@ fn load_balls(
         out.push((read, given, camera));
     }
     // Found outlines, per camera (one tripod position, several exposures).
-    let mut found: Vec<(ShotCamera, Option<FoundBall>)> = Vec::new();
+    let mut found: Vec<(ShotCamera, FoundBall)> = Vec::new();
     for (k, (read, given, camera)) in out.iter().enumerate() {
         if given.is_some() || found.iter().any(|(c, _)| c == camera) {
             continue;
@@ -125,16 +125,16 @@ fn load_balls(
                 (r.levels.0.as_slice(), time)
             })
             .collect();
-        let best = find_ball(&exposures, (read.levels.1, read.levels.2), camera);
-        if best.is_none() {
-            return Err(CaptureError::Photo {
-                path: read.file.clone(),
-                message: "no mirror ball found in this photograph or its other exposures (a \
+        let best =
+            find_ball(&exposures, (read.levels.1, read.levels.2), camera).ok_or_else(|| {
+                CaptureError::Photo {
+                    path: read.file.clone(),
+                    message: "no mirror ball found in this photograph or its other exposures (a \
                           ball's outline must be clear, at least a tenth of the picture across): \
                           give the ball's centre and radius in pixels"
-                    .into(),
-            });
-        }
+                        .into(),
+                }
+            })?;
         found.push((*camera, best));
     }
     Ok(out
@@ -146,7 +146,6 @@ fn load_balls(
                     .iter()
                     .find(|(c, _)| *c == camera)
                     .expect("found above");
-                let f = f.expect("found above");
                 MirrorBall::from_grazing_cone(camera, f.axis, f.half_angle, ball.reflectance)
             });
             (read, View::Ball(view))

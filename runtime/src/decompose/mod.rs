@@ -346,6 +346,12 @@ impl Decomposer {
     }
 }
 
+/// Eight values as one vector (`values` holds exactly eight): the 8-wide sums' loads.
+#[inline(always)]
+fn load(values: &[f32]) -> wide::f32x8 {
+    wide::f32x8::new(values.try_into().expect("one vector's worth"))
+}
+
 /// For each texel of an `analysis`-sized cube map, the `k × k` block of input texels it covers
 /// and their solid-angle weights (normalised to sum to 1), `k = input / analysis`.
 fn downsample_blocks(input: &CubeGeometry, analysis: usize) -> Vec<(Vec<u32>, Vec<f32>)> {

@@ -12,6 +12,7 @@
 //! symmetries are checked when it is set up; a geometry without them is projected texel by
 //! texel.
 
+use super::load;
 use crate::cubemap::{CubeGeometry, CubeMap};
 use foundation::Rgb;
 use foundation::sh::{ShBasis, ShCoeffs, num_coeffs};
@@ -315,12 +316,6 @@ fn add_weighted(sums: &mut [f32x8; 3], channels: &[[f32; PROJECTION_TILE]; 3], w
             *sum = load(v).mul_add(load(w), *sum);
         }
     }
-}
-
-/// Eight values as one vector (`values` holds exactly [`LANES`]).
-#[inline(always)]
-fn load(values: &[f32]) -> f32x8 {
-    f32x8::new(values.try_into().expect("one vector's worth"))
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@
 //! blocks of [`LANES`] texels with zero weights where a row does not fill its last block: the
 //! sum then reads the map in contiguous vectors instead of gathering texel by texel.
 
+use super::load;
 use crate::cubemap::{CubeGeometry, CubeMap};
 use foundation::Rgb;
 use glam::Vec3;
@@ -106,7 +107,7 @@ impl GaussianSmoothing {
                 self.weights[blocks.start * LANES..blocks.end * LANES].chunks_exact(LANES);
             for (&t, w) in self.texels[blocks].iter().zip(weights) {
                 let texels = &values[t as usize..t as usize + LANES];
-                sum = f32x8::from(texels).mul_add(f32x8::from(w), sum);
+                sum = load(texels).mul_add(load(w), sum);
             }
             sum.reduce_add()
         }));
