@@ -14,6 +14,7 @@
 mod consistent;
 mod decomposition;
 mod icosphere;
+mod lanes;
 mod octant;
 mod peaks;
 mod projection;
@@ -344,12 +345,6 @@ impl Decomposer {
             })
             .collect()
     }
-}
-
-/// Eight values as one vector (`values` holds exactly eight): the 8-wide sums' loads.
-#[inline(always)]
-fn load(values: &[f32]) -> wide::f32x8 {
-    wide::f32x8::new(values.try_into().expect("one vector's worth"))
 }
 
 /// For each texel of an `analysis`-sized cube map, the `k × k` block of input texels it covers

@@ -12,7 +12,7 @@
 //! symmetries are checked when it is set up; a geometry without them is projected texel by
 //! texel.
 
-use super::load;
+use super::lanes::load;
 use crate::cubemap::{CubeGeometry, CubeMap};
 use foundation::Rgb;
 use foundation::sh::{ShBasis, ShCoeffs, num_coeffs};

@@ -7,7 +7,7 @@
 //! blocks of [`LANES`] texels with zero weights where a row does not fill its last block: the
 //! sum then reads the map in contiguous vectors instead of gathering texel by texel.
 
-use super::load;
+use super::lanes::load;
 use crate::cubemap::{CubeGeometry, CubeMap};
 use foundation::Rgb;
 use glam::Vec3;
