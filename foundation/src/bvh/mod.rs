@@ -1,5 +1,6 @@
 //! Ray casting against the scene: obvhs builds the tree, [`wide`] lays it out four-wide for
-//! the CPU, and the traversals here visit it.
+//! the CPU, and the traversals here visit it, one ray at a time or, for rays sharing an origin,
+//! eight at a time ([`fan`]).
 
 use crate::infra::huge_pages::HugePageTable;
 use crate::mesh::TriangleMesh;
@@ -9,6 +10,10 @@ use obvhs::triangle::Triangle;
 use std::mem::MaybeUninit;
 use wide::{Bvh4, ChildRef, NO_TRIANGLE, TrianglePacket, WideRay, moller_trumbore};
 
+mod fan;
+mod packet;
+#[cfg(test)]
+mod testing;
 mod wide;
 
 /// Where the ray-epsilon scale of a scene comes from: a fraction of its bounding-box diagonal.
@@ -58,16 +63,16 @@ struct SegmentRay {
 /// tree pushes at most three per level: 256 holds any tree up to 85 levels deep).
 const STACK: usize = 256;
 
-/// The traversal stack: children still to visit, with the distance at which the ray enters
-/// them.
-struct Stack {
+/// The traversal stack: children still to visit, with what culls them when they come up (for
+/// one ray, the distance at which it enters them).
+struct Stack<T> {
     /// Entries below `top` are written; the rest are not (no per-ray clearing).
-    entries: [MaybeUninit<(ChildRef, f32)>; STACK],
+    entries: [MaybeUninit<T>; STACK],
     top: usize,
-    spilled: Vec<(ChildRef, f32)>,
+    spilled: Vec<T>,
 }
 
-impl Stack {
+impl<T: Copy> Stack<T> {
     #[inline(always)]
     fn new() -> Self {
         Self {
@@ -78,17 +83,17 @@ impl Stack {
     }
 
     #[inline(always)]
-    fn push(&mut self, child: ChildRef, t: f32) {
+    fn push(&mut self, entry: T) {
         if self.top < STACK {
-            self.entries[self.top].write((child, t));
+            self.entries[self.top].write(entry);
             self.top += 1;
         } else {
-            self.spilled.push((child, t));
+            self.spilled.push(entry);
         }
     }
 
     #[inline(always)]
-    fn pop(&mut self) -> Option<(ChildRef, f32)> {
+    fn pop(&mut self) -> Option<T> {
         if let Some(entry) = self.spilled.pop() {
             return Some(entry);
         }
@@ -177,12 +182,37 @@ impl SceneBvh {
         };
         let wide = WideRay::new(ray.origin, ray.direction, tmin);
         let mut closest = None;
+        let search = (&wide, tmin, skip);
+        self.closest_below(
+            self.tree.root()?,
+            search,
+            &mut ray.tmax,
+            &mut closest,
+            tally,
+        );
+        closest.map(|slot| self.finish(&ray, slot))
+    }
+
+    /// Searches the subtree at `start` for a hit nearer than `tmax` (the closest so far, in
+    /// slot `closest`), updating both; children are visited nearest first, and of equidistant
+    /// triangles the first met is kept. Returns whether a triangle other than the closest was
+    /// met at its very distance (a tie, which only this order settles).
+    #[inline(always)]
+    fn closest_below(
+        &self,
+        start: ChildRef,
+        (wide, tmin, skip): (&WideRay, f32, Skip),
+        tmax: &mut f32,
+        closest: &mut Option<usize>,
+        tally: &mut impl Tally,
+    ) -> bool {
+        let mut tied = false;
         let mut stack = Stack::new();
-        let mut current = self.tree.root()?;
+        let mut current = start;
         loop {
             tally.add(1);
             if current.is_inner() {
-                let (t_near, mut entered) = self.tree.enter(current.index, &wide, ray.tmax);
+                let (t_near, mut entered) = self.tree.enter(current.index, wide, *tmax);
                 if entered != 0 {
                     // Nearest first: the others wait on the stack, the nearest is next.
                     let mut order = [(0.0f32, current); 4];
@@ -200,35 +230,47 @@ impl SceneBvh {
                     }
                     for &(t, child) in &order[..n - 1] {
                         self.prefetch(child);
-                        stack.push(child, t);
+                        stack.push((child, t));
                     }
                     current = order[n - 1].1;
                     continue;
                 }
             } else {
                 for packet in Self::packets_of(current) {
-                    let (t, mut hits) = self.packets[packet].intersect(&wide, tmin, ray.tmax);
+                    let (t, mut hits) = self.packets[packet].intersect(wide, tmin, *tmax);
                     while hits != 0 {
                         let lane = hits.trailing_zeros() as usize;
                         hits &= hits - 1;
                         let slot = 4 * packet + lane;
-                        if t[lane] < ray.tmax && !self.skipped(slot, skip) {
-                            ray.tmax = t[lane];
-                            closest = Some(slot);
+                        if self.skipped(slot, skip) {
+                            continue;
+                        }
+                        if t[lane] < *tmax {
+                            *tmax = t[lane];
+                            *closest = Some(slot);
+                        } else if t[lane] == *tmax {
+                            tied |= self.other_triangle(slot, *closest);
                         }
                     }
                 }
             }
             loop {
                 let Some((child, t)) = stack.pop() else {
-                    return closest.map(|slot| self.finish(&ray, slot));
+                    return tied;
                 };
-                if t <= ray.tmax {
+                if t <= *tmax {
                     current = child;
                     break;
                 }
             }
         }
+    }
+
+    /// Whether `slot` holds a triangle other than `closest`'s (a triangle the builder split
+    /// sits in several leaves: meeting it again is no tie).
+    #[inline(always)]
+    fn other_triangle(&self, slot: usize, closest: Option<usize>) -> bool {
+        closest.is_some_and(|c| self.ids[c] != self.ids[slot])
     }
 
     /// Whether anything but `skip` blocks `origin + t·direction`, `t` in `[tmin, tmax]`.
@@ -253,7 +295,7 @@ impl SceneBvh {
                     entered &= entered - 1;
                     let child = self.tree.child(current.index, k);
                     self.prefetch(child);
-                    stack.push(child, 0.0);
+                    stack.push(child);
                 }
             } else {
                 for packet in Self::packets_of(current) {
@@ -268,7 +310,7 @@ impl SceneBvh {
                 }
             }
             match stack.pop() {
-                Some((child, _)) => current = child,
+                Some(child) => current = child,
                 None => return false,
             }
         }
@@ -355,6 +397,7 @@ impl Tally for u32 {
 
 #[cfg(test)]
 mod tests {
+    use super::testing::Soup;
     use super::*;
     use crate::mesh::box_mesh;
 
@@ -392,54 +435,15 @@ mod tests {
     /// some along the axes.
     #[test]
     fn traversals_agree_with_testing_every_triangle() {
-        use rand_core::Rng;
-        let mut rng = rand_pcg::Pcg32::new(7, 0);
-        let mut uniform = move || (rng.next_u32() >> 8) as f32 / (1u32 << 24) as f32;
-        let mut point = |scale: f32| {
-            Vec3::new(uniform(), uniform(), uniform()) * 2.0 * scale - Vec3::splat(scale)
-        };
-        let mut mesh = TriangleMesh::default();
-        for k in 0..3000u32 {
-            let centre = point(4.0);
-            let size = if k % 10 == 0 { 3.0 } else { 0.2 };
-            for _ in 0..3 {
-                mesh.positions.push(centre + point(size));
-                mesh.normals.push(Vec3::Y);
-            }
-            mesh.triangles.push([3 * k, 3 * k + 1, 3 * k + 2]);
-        }
-        let bvh = SceneBvh::build(&mesh);
-        // One triangle at a time, with the acceptance rule written out.
-        let distance = |t: usize, origin: Vec3, direction: Vec3, tmax: f32| {
-            let [a, b, c] = mesh.corners(t);
-            let (u, v, d) = moller_trumbore(
-                origin.to_array(),
-                direction.to_array(),
-                a.to_array(),
-                (b - a).to_array(),
-                (c - a).to_array(),
-            );
-            if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && d >= 0.0 && d <= tmax {
-                d
-            } else {
-                f32::INFINITY
-            }
-        };
+        let mut soup = Soup::new(7);
+        let bvh = SceneBvh::build(&soup.mesh);
         let mut hits = 0;
         for k in 0..4000 {
-            let origin = point(if k % 2 == 0 { 3.0 } else { 9.0 });
-            let direction = match k % 7 {
-                0 => Vec3::X,
-                1 => Vec3::NEG_Y,
-                _ => (point(1.0) - point(1.0) * 0.01).normalize_or(Vec3::Z),
-            };
+            let origin = soup.point(if k % 2 == 0 { 3.0 } else { 9.0 });
+            let direction = soup.direction(k);
             let tmax = if k % 3 == 0 { 2.0 } else { f32::INFINITY };
             let skip = Skip::Triangle(k % 3000);
-            let expected = (0..mesh.triangle_count())
-                .filter(|t| Skip::Triangle(*t as u32) != skip)
-                .map(|t| (distance(t, origin, direction, tmax), t as u32))
-                .filter(|(t, _)| t.is_finite())
-                .min_by(|a, b| a.0.total_cmp(&b.0));
+            let expected = soup.closest(origin, direction, tmax, skip);
             let found = bvh.closest_hit(origin, direction, 0.0, tmax, skip);
             assert_eq!(
                 found.map(|h| (h.t, h.triangle)),

@@ -179,6 +179,19 @@ impl Bvh4 {
         }
     }
 
+    /// `node`'s four children's boxes as planes (see [`Node4`]).
+    #[inline(always)]
+    pub(super) fn planes(&self, node: u32) -> &[Vec4; 6] {
+        &self.nodes[node as usize].planes
+    }
+
+    /// The mask of `node`'s slots that hold a child (an empty slot's box is inside out).
+    #[inline(always)]
+    pub(super) fn occupied(&self, node: u32) -> u32 {
+        let count = &self.nodes[node as usize].count;
+        (0..4).fold(0, |mask, k| mask | (u32::from(count[k] != 0) << k))
+    }
+
     /// Entry distance of the ray into each of `node`'s four children, and the mask of those
     /// it enters within `[tmin, tmax]`.
     #[inline(always)]
@@ -198,7 +211,8 @@ impl Bvh4 {
 
 /// Slack on the far distance so that rounding never loses a box the ray grazes (Ize 2013:
 /// `1 + 2γ₃`).
-const ROUNDING: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+pub(super) const ROUNDING: f32 =
+    1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 /// A ray prepared for box and packet tests: each component splatted across four lanes.
 #[derive(Debug, Clone, Copy)]
@@ -215,33 +229,26 @@ pub(super) struct WideRay {
 
 impl WideRay {
     pub(super) fn new(origin: Vec3A, direction: Vec3A, tmin: f32) -> Self {
-        // A zero component would give 0 · ∞ = NaN; a tiny one keeps the arithmetic finite
-        // and the answer the same.
-        let inverse = |d: f32| {
-            1.0 / if d.abs() < 1e-30 {
-                1e-30f32.copysign(d)
-            } else {
-                d
-            }
-        };
         let inv = [
-            inverse(direction.x),
-            inverse(direction.y),
-            inverse(direction.z),
+            safe_inverse(direction.x),
+            safe_inverse(direction.y),
+            safe_inverse(direction.z),
         ];
+        Self::with_inverse(origin.to_array(), direction.to_array(), inv, tmin)
+    }
+
+    /// The ray with its direction's inverse already worked out (by [`safe_inverse`]).
+    pub(super) fn with_inverse(
+        origin: [f32; 3],
+        direction: [f32; 3],
+        inv: [f32; 3],
+        tmin: f32,
+    ) -> Self {
         let near = |k: usize| if inv[k] >= 0.0 { k } else { k + 3 };
         let far = |k: usize| if inv[k] >= 0.0 { k + 3 } else { k };
         Self {
-            origin: [
-                Vec4::splat(origin.x),
-                Vec4::splat(origin.y),
-                Vec4::splat(origin.z),
-            ],
-            direction: [
-                Vec4::splat(direction.x),
-                Vec4::splat(direction.y),
-                Vec4::splat(direction.z),
-            ],
+            origin: origin.map(Vec4::splat),
+            direction: direction.map(Vec4::splat),
             inv: inv.map(Vec4::splat),
             near: [near(0), near(1), near(2)],
             far: [far(0), far(1), far(2)],
@@ -253,8 +260,19 @@ impl WideRay {
     }
 }
 
+/// `1 / d` for a slab test. A zero component would give 0 · ∞ = NaN; a tiny one keeps the
+/// arithmetic finite and the answer the same.
+#[inline(always)]
+pub(super) fn safe_inverse(d: f32) -> f32 {
+    1.0 / if d.abs() < 1e-30 {
+        1e-30f32.copysign(d)
+    } else {
+        d
+    }
+}
+
 /// Nearest distance at which a box counts as entered (obvhs's `EPSILON`).
-const MIN_BOX_DISTANCE: f32 = 1e-4;
+pub(super) const MIN_BOX_DISTANCE: f32 = 1e-4;
 
 /// Arithmetic on one value or on four side by side: what the triangle test is written over.
 pub(super) trait Lanes:
@@ -275,8 +293,12 @@ impl Lanes for Vec4 {
     const ONE: Self = Vec4::ONE;
 }
 
+impl Lanes for wide::f32x8 {
+    const ONE: Self = wide::f32x8::ONE;
+}
+
 #[inline(always)]
-fn cross<T: Lanes>(a: [T; 3], b: [T; 3]) -> [T; 3] {
+pub(super) fn cross<T: Lanes>(a: [T; 3], b: [T; 3]) -> [T; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -285,7 +307,7 @@ fn cross<T: Lanes>(a: [T; 3], b: [T; 3]) -> [T; 3] {
 }
 
 #[inline(always)]
-fn dot<T: Lanes>(a: [T; 3], b: [T; 3]) -> T {
+pub(super) fn dot<T: Lanes>(a: [T; 3], b: [T; 3]) -> T {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 

@@ -2,7 +2,7 @@
 
 use super::bounce::OperatorBlock;
 use super::{BakeSettings, InterreflectionOperator, RAY_OFFSET_FRACTION, TransferVectors};
-use foundation::bvh::{SceneBvh, Skip};
+use foundation::bvh::{Hit, SceneBvh, Skip};
 use foundation::color::Rgb;
 use foundation::infra::progress::Progress;
 use foundation::sampling::{
@@ -73,6 +73,9 @@ fn base_samples(count: u32) -> Vec<Vec2> {
 /// Per-thread buffers reused across vertices.
 struct Scratch {
     basis: Vec<f32>,
+    /// A fan's directions and what each ray hit.
+    directions: Vec<Vec3>,
+    found: Vec<Option<Hit>>,
     hits: Vec<(u32, f32)>,
 }
 
@@ -106,6 +109,8 @@ pub(crate) fn trace_vertices(
         .map_init(
             || Scratch {
                 basis: vec![0.0; n],
+                directions: Vec::with_capacity(tracer.fans.len()),
+                found: Vec::with_capacity(tracer.fans.len()),
                 hits: Vec::with_capacity(3 * tracer.fans.len()),
             },
             |scratch, chunk_index| {
@@ -249,14 +254,18 @@ impl<'a> VertexTracer<'a> {
     fn trace(&self, v: usize, scratch: &mut Scratch, visibility: &mut [f32]) -> bool {
         let mesh = &self.geometry.mesh;
         let (origin, directions) = self.fans.fan(self.geometry, v);
+        scratch.directions.clear();
+        scratch.directions.extend(directions);
+        // The fan's rays share their origin: traced together, eight at a time.
+        let skip = Skip::VertexTriangles(v as u32);
+        let range = (0.0, f32::INFINITY);
+        let (directions, found) = (&scratch.directions, &mut scratch.found);
+        self.bvh
+            .closest_hits(origin, directions, range, skip, found);
         scratch.hits.clear();
         let mut back_faces = 0u32;
-        for direction in directions {
-            let skip = Skip::VertexTriangles(v as u32);
-            match self
-                .bvh
-                .closest_hit(origin, direction, 0.0, f32::INFINITY, skip)
-            {
+        for (&direction, hit) in scratch.directions.iter().zip(&scratch.found) {
+            match hit {
                 None => accumulate_basis(&self.basis, direction, &mut scratch.basis, visibility),
                 Some(hit) => {
                     if direction.dot(self.front_normals[hit.triangle as usize]) > 0.0 {

@@ -1,0 +1,316 @@
+//! Tracing a fan: rays that leave one point (the bake's rays of a vertex), eight at a time
+//! down the tree together ([`RayPacket`]), each packet visiting a node's children nearest
+//! first. A ray gets the answer it gets alone ([`SceneBvh::closest_hit`],
+//! [`SceneBvh::occluded`]), bit for bit; what it saves is the box and triangle work its
+//! neighbours share.
+//!
+//! Where two triangles are hit at exactly the same distance (overlapping triangles of a
+//! scanned mesh), a lone ray keeps the one it meets first, which depends on the order it
+//! visits the tree in; a packet visits it in another. Such a lane is traced again alone, so
+//! that its answer is the lone ray's (about one ray in 10⁴ on the dragon).
+
+use super::packet::{LANES, RayPacket};
+use super::wide::ChildRef;
+use super::{Hit, NoTally, SceneBvh, SegmentRay, Skip, Stack};
+use glam::Vec3;
+use wide::f32x8;
+
+/// Lanes few enough to be traced alone from where they are: a single ray tests a node's four
+/// boxes, and a leaf's triangles four at a time, in one vector operation where a packet takes
+/// one per box and per triangle.
+const ALONE: u32 = 1;
+
+/// A child a packet has still to visit: the lanes that entered it, and where each did.
+#[derive(Clone, Copy)]
+struct Pending {
+    child: ChildRef,
+    lanes: u32,
+    near: f32x8,
+}
+
+/// A packet's closest hits so far: per lane, its distance (the search's far end) and slot,
+/// and the lanes that met two triangles at their closest distance.
+struct Closest {
+    tmax: f32x8,
+    slot: [Option<usize>; LANES],
+    tied: u32,
+}
+
+impl SceneBvh {
+    /// The closest hit of each ray from `origin` along `directions`, `t` in `[tmin, tmax]`,
+    /// ignoring `skip`: into `hits`, one per direction, in order.
+    pub fn closest_hits(
+        &self,
+        origin: Vec3,
+        directions: &[Vec3],
+        (tmin, tmax): (f32, f32),
+        skip: Skip,
+        hits: &mut Vec<Option<Hit>>,
+    ) {
+        hits.clear();
+        for chunk in directions.chunks(LANES) {
+            let packet = RayPacket::new(origin, chunk, tmin);
+            let closest = self.packet_closest(&packet, tmin, tmax, skip);
+            let distances = closest.tmax.to_array();
+            for (lane, direction) in chunk.iter().enumerate() {
+                hits.push(if closest.tied & (1 << lane) != 0 {
+                    self.closest_hit(origin, *direction, tmin, tmax, skip)
+                } else {
+                    let ray = SegmentRay {
+                        origin: origin.into(),
+                        direction: (*direction).into(),
+                        tmax: distances[lane],
+                    };
+                    closest.slot[lane].map(|slot| self.finish(&ray, slot))
+                });
+            }
+        }
+    }
+
+    /// Whether anything but `skip` blocks each ray from `origin` along `directions`, `t` in
+    /// `[tmin, tmax]`: into `blocked`, one per direction, in order.
+    pub fn occluded_fan(
+        &self,
+        origin: Vec3,
+        directions: &[Vec3],
+        (tmin, tmax): (f32, f32),
+        skip: Skip,
+        blocked: &mut Vec<bool>,
+    ) {
+        blocked.clear();
+        for chunk in directions.chunks(LANES) {
+            let packet = RayPacket::new(origin, chunk, tmin);
+            let mask = self.packet_occluded(&packet, tmin, tmax, skip);
+            blocked.extend((0..chunk.len()).map(|lane| mask & (1 << lane) != 0));
+        }
+    }
+
+    fn packet_closest(&self, packet: &RayPacket, tmin: f32, tmax: f32, skip: Skip) -> Closest {
+        let mut closest = Closest {
+            tmax: f32x8::splat(tmax),
+            slot: [None; LANES],
+            tied: 0,
+        };
+        let Some(mut current) = self.tree.root() else {
+            return closest;
+        };
+        let mut lanes = packet.lanes;
+        let mut stack = Stack::<Pending>::new();
+        loop {
+            if lanes.count_ones() <= ALONE {
+                self.lanes_alone(current, lanes, packet, (tmin, skip), &mut closest);
+            } else if current.is_inner() {
+                if let Some(next) = self.descend(current, lanes, packet, closest.tmax, &mut stack) {
+                    (current, lanes) = next;
+                    continue;
+                }
+            } else {
+                self.leaf_closest(current, lanes, packet, (tmin, skip), &mut closest);
+            }
+            // The next child some lane still has to visit: one whose box it enters before
+            // its closest hit so far.
+            loop {
+                let Some(pending) = stack.pop() else {
+                    return closest;
+                };
+                let open = pending.lanes & pending.near.simd_le(closest.tmax).to_bitmask();
+                if open != 0 {
+                    (current, lanes) = (pending.child, open);
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Tests inner node `node`'s children for the packet's `lanes`; of those entered, leaves
+    /// all but the nearest on the stack (farthest deepest) and returns the nearest with its
+    /// lanes. A child's distance is its nearest lane's entry.
+    #[inline(always)]
+    fn descend(
+        &self,
+        node: ChildRef,
+        lanes: u32,
+        packet: &RayPacket,
+        tmax: f32x8,
+        stack: &mut Stack<Pending>,
+    ) -> Option<(ChildRef, u32)> {
+        let children = (self.tree.occupied(node.index), lanes);
+        let entries = packet.enter(self.tree.planes(node.index), children, tmax);
+        let mut order = [(0.0f32, 0usize, 0u32); 4];
+        let mut n = 0;
+        for k in 0..4 {
+            let entered = entries.lanes[k];
+            if entered == 0 {
+                continue;
+            }
+            let distance = entries.nearest[k];
+            let mut at = n;
+            while at > 0 && order[at - 1].0 < distance {
+                order[at] = order[at - 1];
+                at -= 1;
+            }
+            order[at] = (distance, k, entered);
+            n += 1;
+        }
+        let (_, nearest, nearest_lanes) = *order[..n].last()?;
+        for &(_, k, entered) in &order[..n - 1] {
+            let child = self.tree.child(node.index, k);
+            self.prefetch(child);
+            stack.push(Pending {
+                child,
+                lanes: entered,
+                near: entries.near[k],
+            });
+        }
+        Some((self.tree.child(node.index, nearest), nearest_lanes))
+    }
+
+    /// Searches the subtree at `start` for each of the packet's `lanes` alone (as
+    /// [`SceneBvh::closest_hit`] does), from its closest hit so far.
+    #[inline(always)]
+    fn lanes_alone(
+        &self,
+        start: ChildRef,
+        mut lanes: u32,
+        packet: &RayPacket,
+        (tmin, skip): (f32, Skip),
+        closest: &mut Closest,
+    ) {
+        let mut tmax = closest.tmax.to_array();
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            let ray = packet.lane(lane, tmin);
+            let search = (&ray, tmin, skip);
+            let slot = &mut closest.slot[lane];
+            if self.closest_below(start, search, &mut tmax[lane], slot, &mut NoTally) {
+                closest.tied |= 1 << lane;
+            }
+        }
+        closest.tmax = f32x8::new(tmax);
+    }
+
+    /// Tests a leaf's triangles for the packet's `lanes`, keeping each lane's closest hit.
+    #[inline(always)]
+    fn leaf_closest(
+        &self,
+        leaf: ChildRef,
+        lanes: u32,
+        packet: &RayPacket,
+        (tmin, skip): (f32, Skip),
+        closest: &mut Closest,
+    ) {
+        let first = leaf.index as usize;
+        for slot in first..first + leaf.count as usize {
+            let triangle = self.packets[slot / 4].lane(slot % 4);
+            let (t, hits) = packet.intersect(triangle, tmin, closest.tmax);
+            let mut hits = hits & lanes;
+            if hits == 0 || self.skipped(slot, skip) {
+                continue;
+            }
+            let t = t.to_array();
+            let mut tmax = closest.tmax.to_array();
+            while hits != 0 {
+                let lane = hits.trailing_zeros() as usize;
+                hits &= hits - 1;
+                if t[lane] < tmax[lane] {
+                    tmax[lane] = t[lane];
+                    closest.slot[lane] = Some(slot);
+                } else if t[lane] == tmax[lane] && self.other_triangle(slot, closest.slot[lane]) {
+                    closest.tied |= 1 << lane;
+                }
+            }
+            closest.tmax = f32x8::new(tmax);
+        }
+    }
+
+    /// The mask of the packet's lanes that something but `skip` blocks; a lane stops at its
+    /// first blocker, the packet when every lane has.
+    fn packet_occluded(&self, packet: &RayPacket, tmin: f32, tmax: f32, skip: Skip) -> u32 {
+        let far = f32x8::splat(tmax);
+        let mut blocked = 0;
+        let Some(mut current) = self.tree.root() else {
+            return blocked;
+        };
+        let mut lanes = packet.lanes;
+        let mut stack = Stack::<(ChildRef, u32)>::new();
+        loop {
+            if current.is_inner() {
+                let children = (self.tree.occupied(current.index), lanes);
+                let entries = packet.enter(self.tree.planes(current.index), children, far);
+                for (k, &entered) in entries.lanes.iter().enumerate() {
+                    if entered != 0 {
+                        let child = self.tree.child(current.index, k);
+                        self.prefetch(child);
+                        stack.push((child, entered));
+                    }
+                }
+            } else {
+                let first = current.index as usize;
+                for slot in first..first + current.count as usize {
+                    let triangle = self.packets[slot / 4].lane(slot % 4);
+                    let (_, hits) = packet.intersect(triangle, tmin, far);
+                    let hits = hits & lanes & !blocked;
+                    if hits != 0 && !self.skipped(slot, skip) {
+                        blocked |= hits;
+                        if packet.lanes & !blocked == 0 {
+                            return blocked;
+                        }
+                    }
+                }
+            }
+            loop {
+                let Some((child, waiting)) = stack.pop() else {
+                    return blocked;
+                };
+                if waiting & !blocked != 0 {
+                    (current, lanes) = (child, waiting & !blocked);
+                    break;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::Soup;
+    use super::*;
+
+    /// Fans from inside and outside a triangle soup, of sizes that leave partial packets:
+    /// every ray's hit, bit for bit, and its occlusion are those it gets alone, and those of
+    /// testing every triangle.
+    #[test]
+    fn fans_agree_with_single_rays_and_with_testing_every_triangle() {
+        let mut soup = Soup::new(11);
+        let bvh = SceneBvh::build(&soup.mesh);
+        let (mut hits, mut rays) = (0, 0);
+        let (mut found, mut blocked) = (Vec::new(), Vec::new());
+        for fan in 0..120u32 {
+            let origin = soup.point(if fan % 2 == 0 { 3.0 } else { 9.0 });
+            let count = [1, 7, 8, 9, 37, 64][fan as usize % 6];
+            let directions: Vec<Vec3> = (0..count).map(|k| soup.direction(fan + k)).collect();
+            let tmax = if fan % 3 == 0 { 2.0 } else { f32::INFINITY };
+            let skip = Skip::Triangle(fan * 17 % 3000);
+            bvh.closest_hits(origin, &directions, (0.0, tmax), skip, &mut found);
+            bvh.occluded_fan(origin, &directions, (0.0, tmax), skip, &mut blocked);
+            assert_eq!(
+                (found.len(), blocked.len()),
+                (directions.len(), directions.len())
+            );
+            for (k, &direction) in directions.iter().enumerate() {
+                let alone = bvh.closest_hit(origin, direction, 0.0, tmax, skip);
+                assert_eq!(found[k], alone, "fan {fan}, ray {k}");
+                let expected = soup.closest(origin, direction, tmax, skip);
+                assert_eq!(found[k].map(|h| (h.t, h.triangle)), expected);
+                assert_eq!(blocked[k], expected.is_some(), "fan {fan}, ray {k}");
+                hits += usize::from(expected.is_some());
+                rays += 1;
+            }
+        }
+        assert!(
+            hits > rays / 4 && hits < rays * 3 / 4,
+            "{hits} hits of {rays}"
+        );
+    }
+}
