@@ -44,3 +44,11 @@ export HPRT_MITSUBA_PYTHON="$venv/bin/python" HPRT_MITSUBA_INSTALL_LOG="$log"
 
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 cargo test --workspace --locked "$@"
+
+# The bake's ray packets are 8-wide vectors: AVX where the building CPU has it (the workspace
+# builds for the native CPU), two SSE halves on one without. That portable path is tested too,
+# built for the baseline x86-64 in a target folder of its own.
+if [ "$(uname -m)" = x86_64 ] && [ $# -eq 0 ]; then
+    RUSTFLAGS="-C target-cpu=x86-64" CARGO_TARGET_DIR=target/portable \
+        CARGO_PROFILE_DEV_DEBUG=0 cargo test --locked -p foundation --lib bvh::
+fi

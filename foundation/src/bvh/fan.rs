@@ -276,6 +276,7 @@ impl SceneBvh {
 mod tests {
     use super::super::testing::Soup;
     use super::*;
+    use crate::mesh::TriangleMesh;
 
     /// Fans from inside and outside a triangle soup, of sizes that leave partial packets:
     /// every ray's hit, bit for bit, and its occlusion are those it gets alone, and those of
@@ -312,5 +313,57 @@ mod tests {
             hits > rays / 4 && hits < rays * 3 / 4,
             "{hits} hits of {rays}"
         );
+    }
+
+    /// Two tessellations of one square, cells of 1 and of 2, split along opposite diagonals:
+    /// every ray meets two triangles at exactly the same distance (all the arithmetic is
+    /// exact up to powers of two), often in different leaves, where a lone ray keeps the one
+    /// its order meets first. Fans must keep the same one.
+    #[test]
+    fn fans_settle_ties_as_single_rays_do() {
+        let mut mesh = TriangleMesh::default();
+        for (cell, flip) in [(1.0, false), (2.0, true)] {
+            let n = (8.0 / cell) as usize;
+            for (i, j) in (0..n).flat_map(|i| (0..n).map(move |j| (i, j))) {
+                let corner = |di: usize, dj: usize| {
+                    Vec3::new((i + di) as f32 * cell, (j + dj) as f32 * cell, 0.0)
+                };
+                let [a, b, c, d] = [corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)];
+                let halves = if flip {
+                    [[a, b, d], [b, c, d]]
+                } else {
+                    [[a, b, c], [a, c, d]]
+                };
+                for triangle in halves {
+                    let first = mesh.positions.len() as u32;
+                    mesh.positions.extend(triangle);
+                    mesh.normals.extend([Vec3::Z; 3]);
+                    mesh.triangles.push([first, first + 1, first + 2]);
+                }
+            }
+        }
+        let bvh = SceneBvh::build(&mesh);
+        let mut soup = Soup::new(3);
+        let mut found = Vec::new();
+        let mut hits = 0;
+        for fan in 0..200 {
+            let origin = Vec3::new(4.0, 4.0, 3.0) + soup.point(3.0) * Vec3::new(1.0, 1.0, 0.0);
+            let directions: Vec<Vec3> = (0..32)
+                .map(|_| (soup.point(1.0) * Vec3::new(1.0, 1.0, 0.0) - Vec3::Z).normalize())
+                .collect();
+            bvh.closest_hits(
+                origin,
+                &directions,
+                (0.0, f32::INFINITY),
+                Skip::Nothing,
+                &mut found,
+            );
+            for (k, &direction) in directions.iter().enumerate() {
+                let alone = bvh.closest_hit(origin, direction, 0.0, f32::INFINITY, Skip::Nothing);
+                assert_eq!(found[k], alone, "fan {fan}, ray {k}");
+                hits += usize::from(alone.is_some());
+            }
+        }
+        assert!(hits > 3000, "{hits} of 6400 rays reach the square");
     }
 }

@@ -4,7 +4,7 @@
 //! share is computed once: the origin's offsets to the box planes, and the triangle terms that
 //! depend on the origin alone.
 
-use super::wide::{Lanes, MIN_BOX_DISTANCE, ROUNDING, WideRay, cross, dot, safe_inverse};
+use super::wide::{Lanes, MIN_BOX_DISTANCE, ROUNDING, WideRay, cross, dot};
 use glam::{Vec3, Vec4};
 use wide::{f32x8, i32x8};
 
@@ -29,6 +29,14 @@ fn lane_mask(bits: u32) -> f32x8 {
     let lane_bits = i32x8::new([1, 2, 4, 8, 16, 32, 64, 128]);
     let set = (i32x8::splat(bits as i32) & lane_bits).simd_eq(lane_bits);
     wide::bytemuck::cast(set)
+}
+
+/// [`super::wide::safe_inverse`] of each lane, bit for bit.
+#[inline(always)]
+fn safe_inverses(d: f32x8) -> f32x8 {
+    let tiny = f32x8::splat(1e-30);
+    let signed_tiny = (d & f32x8::splat(-0.0)) | tiny;
+    f32x8::ONE / d.abs().simd_lt(tiny).bitselect(signed_tiny, d)
 }
 
 /// The smallest lane (no NaN among them).
@@ -62,8 +70,8 @@ impl RayPacket {
     pub(super) fn new(origin: Vec3, directions: &[Vec3], tmin: f32) -> Self {
         debug_assert!((1..=LANES).contains(&directions.len()));
         let lane = |k: usize| directions.get(k).unwrap_or(&directions[0]);
-        let axis = |a: usize, f: fn(f32) -> f32| f32x8::new(std::array::from_fn(|k| f(lane(k)[a])));
-        let inv = [0, 1, 2].map(|a| axis(a, safe_inverse));
+        let direction = [0, 1, 2].map(|a| f32x8::new(std::array::from_fn(|k| lane(k)[a])));
+        let inv = direction.map(safe_inverses);
         let signs = inv.map(|v| v.simd_ge(f32x8::ZERO).to_bitmask());
         let octant = signs
             .iter()
@@ -71,7 +79,7 @@ impl RayPacket {
             .then(|| signs.map(|s| s == 0xff));
         Self {
             origin: origin.to_array(),
-            direction: [0, 1, 2].map(|a| axis(a, |d| d)),
+            direction,
             inv,
             octant,
             box_tmin: f32x8::splat(tmin.max(MIN_BOX_DISTANCE)),
@@ -166,5 +174,48 @@ impl RayPacket {
             & t.simd_ge(f32x8::splat(tmin))
             & t.simd_le(tmax);
         (t, hit.to_bitmask())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::wide::safe_inverse;
+    use super::*;
+
+    #[test]
+    fn inverses_are_the_single_rays() {
+        let values = [
+            1.0,
+            -2.5,
+            0.0,
+            -0.0,
+            1e-31,
+            -1e-31,
+            1e-30,
+            -3e-29,
+            7.5e8,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            0.3,
+            -0.7,
+            1e-12,
+            -1e-12,
+            2.0,
+        ];
+        for chunk in values.chunks(LANES) {
+            let lanes = safe_inverses(f32x8::new(chunk.try_into().unwrap())).to_array();
+            for (d, inv) in chunk.iter().zip(lanes) {
+                assert_eq!(inv.to_bits(), safe_inverse(*d).to_bits(), "1/{d}");
+            }
+        }
+    }
+
+    #[test]
+    fn lane_masks_and_smallest_lanes() {
+        let v = f32x8::new([5.0, 3.0, 8.0, 1.0, 9.0, 2.0, 7.0, 4.0]);
+        assert_eq!(lane_mask(0b1010_0101).to_bitmask(), 0b1010_0101);
+        assert_eq!(smallest(v), 1.0);
+        let picked = lane_mask(0b0100_0101).bitselect(v, f32x8::splat(f32::INFINITY));
+        assert_eq!(smallest(picked), 5.0);
     }
 }

@@ -334,4 +334,43 @@ mod tests {
         let mean_step: f32 = s.windows(2).map(|w| w[0].distance(w[1])).sum::<f32>() / 1023.0;
         assert!(mean_step < 0.1, "{mean_step}");
     }
+
+    /// On the dragon, whose scan has overlapping triangles that rays meet at exactly the same
+    /// distance, the bake's fans give every ray its lone answer, ties included.
+    #[test]
+    fn fans_on_the_dragon_give_each_ray_its_own_hit() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/dragon.toml");
+        let scene = foundation::scene::Scene::open(std::path::Path::new(path)).unwrap();
+        let settings = BakeSettings {
+            order: 2,
+            samples: 256,
+            bounces: 0,
+            seed: 0,
+        };
+        let geometry = &scene.geometry;
+        let bvh = SceneBvh::build(&geometry.mesh);
+        let fans = RayFans::new(geometry, &settings);
+        let (mut found, mut ties) = (Vec::new(), 0);
+        for v in 0..600 {
+            let (origin, directions) = fans.fan(geometry, v);
+            let directions: Vec<Vec3> = directions.collect();
+            let skip = Skip::VertexTriangles(v as u32);
+            bvh.closest_hits(origin, &directions, (0.0, f32::INFINITY), skip, &mut found);
+            for (&d, hit) in directions.iter().zip(&found) {
+                let alone = bvh.closest_hit(origin, d, 0.0, f32::INFINITY, skip);
+                assert_eq!(*hit, alone, "vertex {v}, direction {d}");
+                // Another triangle at the very same distance?
+                if let Some(hit) = hit {
+                    let just_past = f32::from_bits(hit.t.to_bits() + 1);
+                    let other = Skip::Triangle(hit.triangle);
+                    let second = bvh.closest_hit(origin, d, 0.0, just_past, other);
+                    ties += usize::from(second.is_some_and(|s| s.t == hit.t));
+                }
+            }
+        }
+        assert!(
+            ties > 0,
+            "no ties among these vertices' rays: the test misses its point"
+        );
+    }
 }
