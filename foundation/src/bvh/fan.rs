@@ -11,7 +11,7 @@
 
 use super::packet::{LANES, RayPacket};
 use super::wide::ChildRef;
-use super::{Hit, NoTally, SceneBvh, SegmentRay, Skip, Stack};
+use super::{Hit, NoTally, SceneBvh, SegmentRay, Skip, Stack, insert_farthest_first};
 use glam::Vec3;
 use wide::f32x8;
 
@@ -136,24 +136,17 @@ impl SceneBvh {
     ) -> Option<(ChildRef, u32)> {
         let children = (self.tree.occupied(node.index), lanes);
         let entries = packet.enter(self.tree.planes(node.index), children, tmax);
-        let mut order = [(0.0f32, 0usize, 0u32); 4];
+        let mut order = [(0.0f32, (0usize, 0u32)); 4];
         let mut n = 0;
         for k in 0..4 {
             let entered = entries.lanes[k];
             if entered == 0 {
                 continue;
             }
-            let distance = entries.nearest[k];
-            let mut at = n;
-            while at > 0 && order[at - 1].0 < distance {
-                order[at] = order[at - 1];
-                at -= 1;
-            }
-            order[at] = (distance, k, entered);
-            n += 1;
+            insert_farthest_first(&mut order, &mut n, (entries.nearest[k], (k, entered)));
         }
-        let (_, nearest, nearest_lanes) = *order[..n].last()?;
-        for &(_, k, entered) in &order[..n - 1] {
+        let (_, (nearest, nearest_lanes)) = *order[..n].last()?;
+        for &(_, (k, entered)) in &order[..n - 1] {
             let child = self.tree.child(node.index, k);
             self.prefetch(child);
             stack.push(Pending {
@@ -213,10 +206,7 @@ impl SceneBvh {
             while hits != 0 {
                 let lane = hits.trailing_zeros() as usize;
                 hits &= hits - 1;
-                if t[lane] < tmax[lane] {
-                    tmax[lane] = t[lane];
-                    closest.slot[lane] = Some(slot);
-                } else if t[lane] == tmax[lane] && self.other_triangle(slot, closest.slot[lane]) {
+                if self.keep_closer(t[lane], slot, &mut tmax[lane], &mut closest.slot[lane]) {
                     closest.tied |= 1 << lane;
                 }
             }

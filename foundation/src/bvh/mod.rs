@@ -220,13 +220,8 @@ impl SceneBvh {
                     while entered != 0 {
                         let k = entered.trailing_zeros() as usize;
                         entered &= entered - 1;
-                        let mut at = n;
-                        while at > 0 && order[at - 1].0 < t_near[k] {
-                            order[at] = order[at - 1];
-                            at -= 1;
-                        }
-                        order[at] = (t_near[k], self.tree.child(current.index, k));
-                        n += 1;
+                        let child = self.tree.child(current.index, k);
+                        insert_farthest_first(&mut order, &mut n, (t_near[k], child));
                     }
                     for &(t, child) in &order[..n - 1] {
                         self.prefetch(child);
@@ -242,14 +237,8 @@ impl SceneBvh {
                         let lane = hits.trailing_zeros() as usize;
                         hits &= hits - 1;
                         let slot = 4 * packet + lane;
-                        if self.skipped(slot, skip) {
-                            continue;
-                        }
-                        if t[lane] < *tmax {
-                            *tmax = t[lane];
-                            *closest = Some(slot);
-                        } else if t[lane] == *tmax {
-                            tied |= self.other_triangle(slot, *closest);
+                        if !self.skipped(slot, skip) {
+                            tied |= self.keep_closer(t[lane], slot, tmax, closest);
                         }
                     }
                 }
@@ -266,11 +255,25 @@ impl SceneBvh {
         }
     }
 
-    /// Whether `slot` holds a triangle other than `closest`'s (a triangle the builder split
-    /// sits in several leaves: meeting it again is no tie).
+    /// Keeps a hit at `t` on the triangle in `slot` if it is nearer than the closest so far
+    /// (at `tmax`, in slot `closest`). Returns whether it is a tie: as near, on another
+    /// triangle (a triangle the builder split sits in several leaves: meeting it again is no
+    /// tie). Of equidistant triangles the first met stays.
     #[inline(always)]
-    fn other_triangle(&self, slot: usize, closest: Option<usize>) -> bool {
-        closest.is_some_and(|c| self.ids[c] != self.ids[slot])
+    fn keep_closer(
+        &self,
+        t: f32,
+        slot: usize,
+        tmax: &mut f32,
+        closest: &mut Option<usize>,
+    ) -> bool {
+        if t < *tmax {
+            *tmax = t;
+            *closest = Some(slot);
+            false
+        } else {
+            t == *tmax && closest.is_some_and(|c| self.ids[c] != self.ids[slot])
+        }
     }
 
     /// Whether anything but `skip` blocks `origin + t·direction`, `t` in `[tmin, tmax]`.
@@ -364,6 +367,19 @@ impl SceneBvh {
             Skip::VertexTriangles(v) => self.corners[slot].contains(&v),
         }
     }
+}
+
+/// Inserts `entry` into the first `n` entries of `order`, kept sorted by decreasing distance
+/// (a node's entered children: the nearest last, visited next).
+#[inline(always)]
+fn insert_farthest_first<T: Copy>(order: &mut [(f32, T); 4], n: &mut usize, entry: (f32, T)) {
+    let mut at = *n;
+    while at > 0 && order[at - 1].0 < entry.0 {
+        order[at] = order[at - 1];
+        at -= 1;
+    }
+    order[at] = entry;
+    *n += 1;
 }
 
 /// Triangles a ray ignores: those at its origin, which it would otherwise hit at `t ≈ 0`.
