@@ -9,7 +9,7 @@ pub fn prefetch<T>(value: *const T) {
 
 /// [`prefetch`] for `count` values from `first` on.
 #[inline(always)]
-pub(crate) fn prefetch_range<T>(first: *const T, count: usize) {
+pub fn prefetch_range<T>(first: *const T, count: usize) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};

@@ -18,7 +18,7 @@ pub mod rotation;
 
 use glam::Vec3;
 use num_traits::Float;
-use std::ops::{Add, AddAssign, Mul};
+use std::ops::{Add, AddAssign, Mul, Sub};
 
 /// Highest SH order (number of bands) the project supports.
 pub const MAX_ORDER: usize = 20;
@@ -104,25 +104,29 @@ impl<F: Float> ShBasis<F> {
     }
 
     /// Writes `Y_k(w)` for every `k` into `out[..n²]`; `w` must be a unit vector given as
-    /// world `[x, y, z]`.
+    /// world `[x, y, z]`. `V` is `F`, or a vector of `F` (one direction per lane, each lane's
+    /// arithmetic exactly the scalar one's).
     #[inline]
-    pub(crate) fn eval_into(&self, w: [F; 3], out: &mut [F]) {
+    pub(crate) fn eval_into<V>(&self, w: [V; 3], out: &mut [V])
+    where
+        V: Copy + From<F> + Add<Output = V> + Sub<Output = V> + Mul<Output = V>,
+    {
         let n = self.order;
         let out = &mut out[..n * n];
         // Textbook frame: polar axis = world +Y, azimuth from +Z toward +X.
         let (x, y, z) = (w[2], w[0], w[1]);
-        let sqrt2 = F::from(std::f64::consts::SQRT_2).unwrap_or_else(F::one);
+        let sqrt2 = V::from(F::from(std::f64::consts::SQRT_2).unwrap_or_else(F::one));
         // (c, s) = Re, Im of (x + i y)^m, i.e. sin^m θ (cos mφ, sin mφ).
-        let (mut c, mut s) = (F::one(), F::zero());
-        let mut p_mm = F::one();
+        let (mut c, mut s) = (V::from(F::one()), V::from(F::zero()));
+        let mut p_mm = V::from(F::one());
         for m in 0..n {
-            p_mm = p_mm * self.diagonal[m];
+            p_mm = p_mm * V::from(self.diagonal[m]);
             if m > 0 {
                 let c_next = x * c - y * s;
                 s = x * s + y * c;
                 c = c_next;
             }
-            let write = |out: &mut [F], l: usize, p: F| {
+            let write = |out: &mut [V], l: usize, p: V| {
                 if m == 0 {
                     out[index(l, 0)] = p;
                 } else {
@@ -135,11 +139,11 @@ impl<F: Float> ShBasis<F> {
                 continue;
             }
             let mut p_prev = p_mm;
-            let mut p = self.first_off_diagonal[m] * z * p_mm;
+            let mut p = V::from(self.first_off_diagonal[m]) * z * p_mm;
             write(out, m + 1, p);
             for l in m + 2..n {
                 let (a, b) = self.three_term[index(l, m as isize)];
-                let p_next = a * (z * p - b * p_prev);
+                let p_next = V::from(a) * (z * p - V::from(b) * p_prev);
                 p_prev = p;
                 p = p_next;
                 write(out, l, p);
@@ -153,6 +157,14 @@ impl ShBasis<f32> {
     #[inline]
     pub fn eval(&self, w: Vec3, out: &mut [f32]) {
         self.eval_into(w.to_array(), out);
+    }
+
+    /// Evaluates every basis function at eight unit directions at once (`w` holds their
+    /// `x`, `y` and `z`): lane `i` of `out[k]` is, bit for bit, what [`Self::eval`] gives
+    /// for direction `i`.
+    #[inline]
+    pub fn eval_lanes(&self, w: [wide::f32x8; 3], out: &mut [wide::f32x8]) {
+        self.eval_into(w, out);
     }
 
     /// Convenience: a freshly allocated vector of basis values.
@@ -355,6 +367,39 @@ mod tests {
     use super::*;
     use crate::sh::quadrature::SphereQuadrature;
     use glam::DVec3;
+
+    /// Eight directions at once give each direction's scalar values, bit for bit (the bake
+    /// sums them into transfer that must not change with how it is computed).
+    #[test]
+    fn lanes_are_the_scalar_values_bit_for_bit() {
+        use wide::f32x8;
+        let mut directions: Vec<Vec3> = (0..61)
+            .map(|i| {
+                let (a, b) = (i as f32 * 2.399_963, (i as f32 + 0.5) / 61.0);
+                let y = 1.0 - 2.0 * b;
+                let r = (1.0 - y * y).max(0.0).sqrt();
+                Vec3::new(r * a.cos(), y, r * a.sin())
+            })
+            .collect();
+        directions.extend([Vec3::Y, -Vec3::Y, Vec3::X, -Vec3::Z]);
+        for order in [1, 2, 5, 8, MAX_ORDER] {
+            let basis = ShBasis::<f32>::new(order).unwrap();
+            let mut lanes = vec![f32x8::ZERO; basis.num_coeffs()];
+            let mut scalar = vec![0.0; basis.num_coeffs()];
+            for chunk in directions.chunks(8) {
+                let lane = |i: usize| chunk[i.min(chunk.len() - 1)];
+                let w = [0, 1, 2].map(|a| f32x8::new(std::array::from_fn(|i| lane(i)[a])));
+                basis.eval_lanes(w, &mut lanes);
+                for (i, d) in chunk.iter().enumerate() {
+                    basis.eval(*d, &mut scalar);
+                    for (k, (v, s)) in lanes.iter().zip(&scalar).enumerate() {
+                        let v = v.as_array()[i];
+                        assert_eq!(v.to_bits(), s.to_bits(), "order {order}, Y{k}({d})");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn orthonormal_up_to_order_10_and_beyond() {

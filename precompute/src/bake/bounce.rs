@@ -2,7 +2,11 @@
 
 use super::TransferVectors;
 use foundation::color::Rgb;
+use foundation::infra::prefetch::prefetch_range;
 use rayon::prelude::*;
+
+/// How many operator entries ahead the bounce asks the cache for the row it will gather.
+const GATHER_AHEAD: usize = 6;
 
 /// Sparse vertex-to-vertex operator `W`: `W[v][j]` is the fraction of vertex `v`'s
 /// cosine-distributed rays that land on the front of a triangle, weighted by the barycentric
@@ -112,20 +116,37 @@ impl InterreflectionOperator {
             first_vertex += block.rows();
             rest = tail;
         }
+        // Each row is summed apart and its output written once: adding into the fresh zeros
+        // would fault twice per page (read, then write), each write fault flushing every
+        // thread's TLB.
         work.into_par_iter()
             .for_each(|(block, first_vertex, out_rows)| {
+                let mut row_sum = vec![0.0f32; stride];
+                let mut entry = 0;
                 for (r, row_out) in out_rows.chunks_exact_mut(stride).enumerate() {
+                    row_sum.fill(0.0);
                     let (columns, weights) = block.row(r);
                     for (&j, &w) in columns.iter().zip(weights) {
+                        // The rows gathered are scattered over the whole transfer: ask for
+                        // one a few entries ahead so that its misses overlap this one's.
+                        if let Some(&ahead) = block.columns.get(entry + GATHER_AHEAD) {
+                            let row = input.as_ptr().wrapping_add(ahead as usize * stride);
+                            prefetch_range(row, stride);
+                        }
+                        entry += 1;
                         let src = &input[j as usize * stride..(j as usize + 1) * stride];
-                        for (o, s) in row_out.iter_mut().zip(src) {
+                        for (o, s) in row_sum.iter_mut().zip(src) {
                             *o += w * s;
                         }
                     }
                     let rho = albedo[first_vertex + r];
-                    for c in 0..3 {
-                        for o in &mut row_out[c * per_channel..(c + 1) * per_channel] {
-                            *o *= rho[c];
+                    for (c, (out, sum)) in row_out
+                        .chunks_exact_mut(per_channel)
+                        .zip(row_sum.chunks_exact(per_channel))
+                        .enumerate()
+                    {
+                        for (o, s) in out.iter_mut().zip(sum) {
+                            *o = s * rho[c];
                         }
                     }
                 }

@@ -90,40 +90,82 @@ impl TracedScene {
     /// `Σ_{k=1..b+1} diag(a) W (diag(ρ) W)^(k-1) T_direct(ρ)`, with `ρ` the reflected and `a`
     /// the vertex albedo (the same unless the scene is textured).
     pub fn cumulative_indirect(&self, bounces: u32) -> impl Iterator<Item = TransferVectors> + '_ {
-        let order = self.direct.order();
-        let mut previous = match &self.textured {
-            Some((reflected_direct, _)) => reflected_direct.clone(),
-            None => self.direct.clone(),
-        };
-        let mut sum = TransferVectors::zeros(order, self.direct.vertex_count());
-        // A textured scene gathers once and scales twice (reflected, stored).
-        let ones = self
+        let mut series = NeumannSeries::new(self, bounces);
+        (0..bounces).map(move |_| series.step().clone())
+    }
+}
+
+/// The Neumann series summed one bounce at a time. Every large vector is written before it
+/// is read: adding into fresh zeros would first map the shared zero page and then fault
+/// again on the write, each fault flushing every thread's TLB.
+struct NeumannSeries<'a> {
+    scene: &'a TracedScene,
+    /// What the next bounce gathers from (`None`: the direct transfer, not yet copied).
+    previous: Option<TransferVectors>,
+    /// The indirect transfer so far (`None` before the first bounce).
+    sum: Option<TransferVectors>,
+    /// Bounces still to add.
+    remaining: u32,
+    /// A textured scene gathers once and scales twice (reflected, stored).
+    ones: Option<Vec<foundation::color::Rgb>>,
+}
+
+impl<'a> NeumannSeries<'a> {
+    fn new(scene: &'a TracedScene, bounces: u32) -> Self {
+        let ones = scene
             .textured
             .as_ref()
-            .map(|_| vec![foundation::color::Rgb::ONE; self.direct.vertex_count()]);
-        (0..bounces).map(move |_| {
-            let add = |sum: &mut TransferVectors, x: &TransferVectors| {
-                for (acc, x) in sum.as_mut_slice().iter_mut().zip(x.as_slice()) {
-                    *acc += x;
-                }
-            };
-            match (&self.textured, &ones) {
-                (Some((_, albedo)), Some(ones)) => {
-                    let gathered = self.operator.apply(&previous, ones);
-                    previous = gathered.scaled_per_vertex(&self.reflected_albedo);
-                    fill_inside(&mut previous, &self.inside, &self.neighbours);
-                    let mut stored = gathered.scaled_per_vertex(albedo);
-                    fill_inside(&mut stored, &self.inside, &self.neighbours);
-                    add(&mut sum, &stored);
-                }
-                _ => {
-                    previous = self.operator.apply(&previous, &self.reflected_albedo);
-                    fill_inside(&mut previous, &self.inside, &self.neighbours);
-                    add(&mut sum, &previous);
-                }
+            .map(|_| vec![foundation::color::Rgb::ONE; scene.direct.vertex_count()]);
+        Self {
+            scene,
+            previous: None,
+            sum: None,
+            remaining: bounces,
+            ones,
+        }
+    }
+
+    /// Adds the next bounce; returns the indirect transfer so far.
+    fn step(&mut self) -> &TransferVectors {
+        let scene = self.scene;
+        let input = match (&self.previous, &scene.textured) {
+            (Some(previous), _) => previous,
+            (None, Some((reflected_direct, _))) => reflected_direct,
+            (None, None) => &scene.direct,
+        };
+        self.remaining = self.remaining.saturating_sub(1);
+        let fill = |mut t: TransferVectors| {
+            fill_inside(&mut t, &scene.inside, &scene.neighbours);
+            t
+        };
+        let (next, stored) = match (&scene.textured, &self.ones) {
+            (Some((_, albedo)), Some(ones)) => {
+                let gathered = scene.operator.apply(input, ones);
+                let next = fill(gathered.scaled_per_vertex(&scene.reflected_albedo));
+                (next, Some(fill(gathered.scaled_per_vertex(albedo))))
             }
-            sum.clone()
-        })
+            _ => (
+                fill(scene.operator.apply(input, &scene.reflected_albedo)),
+                None,
+            ),
+        };
+        match (&mut self.sum, stored) {
+            (Some(sum), stored) => sum.add(stored.as_ref().unwrap_or(&next)),
+            (None, Some(stored)) => self.sum = Some(stored.plus_zero()),
+            // The last bounce of an untextured scene: nothing gathers from it again.
+            (None, None) if self.remaining == 0 => {
+                self.sum = Some(next.plus_zero());
+                return self.sum.as_ref().expect("just set");
+            }
+            (None, None) => self.sum = Some(next.clone().plus_zero()),
+        }
+        self.previous = Some(next);
+        self.sum.as_ref().expect("set above")
+    }
+
+    /// The indirect transfer of every bounce added (`None` if none was).
+    fn into_sum(self) -> Option<TransferVectors> {
+        self.sum
     }
 }
 
@@ -214,16 +256,18 @@ fn sum_bounces(
         operator_entries: traced.operator.entries(),
         ..Default::default()
     };
-    let mut indirect = TransferVectors::zeros(settings.order, vertex_count);
-    let mut bounce_start = Instant::now();
-    for (bounce, sum) in traced.cumulative_indirect(settings.bounces).enumerate() {
+    let mut series = NeumannSeries::new(&traced, settings.bounces);
+    for bounce in 0..settings.bounces {
+        let bounce_start = Instant::now();
+        series.step();
         stats
             .bounce_seconds
             .push(bounce_start.elapsed().as_secs_f64());
         progress.status(&format!("bounce {}/{}", bounce + 1, settings.bounces));
-        indirect = sum;
-        bounce_start = Instant::now();
     }
+    let indirect = series
+        .into_sum()
+        .unwrap_or_else(|| TransferVectors::zeros(settings.order, vertex_count));
     stats.total_seconds = traced.seconds + start.elapsed().as_secs_f64();
     progress.finish();
     (

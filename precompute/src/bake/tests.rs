@@ -312,3 +312,41 @@ fn rejects_bad_settings() {
         );
     }
 }
+
+/// The bake's indirect transfer is the Neumann series summed term by term, `Σ_k T_k` with
+/// `T_k = diag(ρ) W T_{k-1}` from `T_0` the direct transfer, bit for bit: with one bounce
+/// (its term becomes the sum) and with three (each term is kept for the next).
+#[test]
+fn bounces_sum_the_series_term_by_term() {
+    let albedo = Rgb::new(0.8, 0.6, 0.4);
+    let geometry = scene_of(&open_box(), albedo);
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let no_progress = &foundation::infra::progress::NoProgress;
+    for bounces in [1, 3] {
+        let settings = BakeSettings {
+            order: 3,
+            samples: 64,
+            bounces,
+            seed: 4,
+        };
+        let traced = trace(&geometry, &bvh, &settings, no_progress).unwrap();
+        let albedos = vec![albedo; geometry.mesh.vertex_count()];
+        let mut term = traced.direct.clone();
+        let mut sum = TransferVectors::zeros(settings.order, albedos.len());
+        for _ in 0..bounces {
+            term = traced.operator.apply(&term, &albedos);
+            fill_inside(&mut term, &traced.inside, &traced.neighbours);
+            for (s, t) in sum.as_mut_slice().iter_mut().zip(term.as_slice()) {
+                *s += t;
+            }
+        }
+        let partial_sums: Vec<TransferVectors> = traced.cumulative_indirect(bounces).collect();
+        let (transfer, _) = sum_bounces(&geometry, &settings, traced, no_progress);
+        let bits =
+            |t: &TransferVectors| t.as_slice().iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert!(sum.as_slice().iter().any(|&x| x > 0.01), "no light bounced");
+        assert_eq!(bits(&transfer.indirect), bits(&sum), "{bounces} bounces");
+        assert_eq!(partial_sums.len(), bounces as usize);
+        assert_eq!(bits(partial_sums.last().unwrap()), bits(&sum));
+    }
+}

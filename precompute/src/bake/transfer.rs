@@ -136,6 +136,25 @@ impl TransferVectors {
         out
     }
 
+    /// Adds `other` in place.
+    pub(crate) fn add(&mut self, other: &TransferVectors) {
+        assert_eq!(
+            (self.order, self.vertex_count),
+            (other.order, other.vertex_count)
+        );
+        for (a, b) in self.data.iter_mut().zip(&other.data) {
+            *a += b;
+        }
+    }
+
+    /// `0 + t` (what adding to zeros gives: `-0` becomes `+0`), without the zeros.
+    pub(crate) fn plus_zero(mut self) -> Self {
+        for x in &mut self.data {
+            *x += 0.0;
+        }
+        self
+    }
+
     pub fn sum(&self, other: &TransferVectors) -> TransferVectors {
         assert_eq!(
             (self.order, self.vertex_count),

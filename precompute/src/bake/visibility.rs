@@ -12,6 +12,7 @@ use foundation::scene::SceneMesh;
 use foundation::sh::{ShBasis, num_coeffs};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
+use wide::f32x8;
 
 /// What the tracing pass found for a run of vertices (all of them, or a shard's).
 #[derive(Debug, Clone, PartialEq)]
@@ -72,7 +73,9 @@ fn base_samples(count: u32) -> Vec<Vec2> {
 
 /// Per-thread buffers reused across vertices.
 struct Scratch {
-    basis: Vec<f32>,
+    /// The SH basis at up to eight escaping directions, and those directions.
+    basis: Vec<f32x8>,
+    escaped: Vec<Vec3>,
     /// A fan's directions and what each ray hit.
     directions: Vec<Vec3>,
     found: Vec<Option<Hit>>,
@@ -108,7 +111,8 @@ pub(crate) fn trace_vertices(
         .into_par_iter()
         .map_init(
             || Scratch {
-                basis: vec![0.0; n],
+                basis: vec![f32x8::ZERO; n],
+                escaped: Vec::with_capacity(8),
                 directions: Vec::with_capacity(tracer.fans.len()),
                 found: Vec::with_capacity(tracer.fans.len()),
                 hits: Vec::with_capacity(3 * tracer.fans.len()),
@@ -263,10 +267,23 @@ impl<'a> VertexTracer<'a> {
         self.bvh
             .closest_hits(origin, directions, range, skip, found);
         scratch.hits.clear();
+        scratch.escaped.clear();
         let mut back_faces = 0u32;
         for (&direction, hit) in scratch.directions.iter().zip(&scratch.found) {
             match hit {
-                None => accumulate_basis(&self.basis, direction, &mut scratch.basis, visibility),
+                None => {
+                    // The escaping rays' basis values, eight at a time, summed in ray order.
+                    scratch.escaped.push(direction);
+                    if scratch.escaped.len() == 8 {
+                        accumulate_basis(
+                            &self.basis,
+                            &scratch.escaped,
+                            &mut scratch.basis,
+                            visibility,
+                        );
+                        scratch.escaped.clear();
+                    }
+                }
                 Some(hit) => {
                     if direction.dot(self.front_normals[hit.triangle as usize]) > 0.0 {
                         back_faces += 1;
@@ -281,6 +298,14 @@ impl<'a> VertexTracer<'a> {
                     }
                 }
             }
+        }
+        if !scratch.escaped.is_empty() {
+            accumulate_basis(
+                &self.basis,
+                &scratch.escaped,
+                &mut scratch.basis,
+                visibility,
+            );
         }
         for y in visibility.iter_mut() {
             *y *= self.inv_samples;
@@ -307,11 +332,22 @@ impl<'a> VertexTracer<'a> {
     }
 }
 
+/// Adds the basis at each of `directions` (one to eight) to `sum`, one direction after the
+/// other: the sum a direction at a time gives, bit for bit.
 #[inline]
-fn accumulate_basis(basis: &ShBasis<f32>, direction: Vec3, scratch: &mut [f32], sum: &mut [f32]) {
-    basis.eval(direction, scratch);
-    for (s, y) in sum.iter_mut().zip(scratch.iter()) {
-        *s += y;
+fn accumulate_basis(
+    basis: &ShBasis<f32>,
+    directions: &[Vec3],
+    values: &mut [f32x8],
+    sum: &mut [f32],
+) {
+    let lane = |i: usize| directions[i.min(directions.len() - 1)];
+    let w = [0, 1, 2].map(|a| f32x8::new(std::array::from_fn(|i| lane(i)[a])));
+    basis.eval_lanes(w, values);
+    for i in 0..directions.len() {
+        for (s, y) in sum.iter_mut().zip(values.iter()) {
+            *s += y.as_array()[i];
+        }
     }
 }
 
