@@ -23,6 +23,7 @@ pub mod envmap;
 pub mod image_io;
 pub mod material;
 pub mod mesh;
+pub mod probe;
 pub mod sampling;
 pub mod scene;
 pub mod settings;

@@ -10,6 +10,7 @@ use crate::material::{MAX_SHININESS, Material, check_energy};
 use crate::mesh::{
     self, LoadOptions, MeshCleanup, MeshError, TriangleMesh, annulus_mesh, box_mesh,
 };
+use crate::probe::ProbeSource;
 use crate::texture::AlbedoTexture;
 use glam::{Mat3, Mat4, Vec3};
 use std::path::Path;
@@ -65,6 +66,10 @@ impl Scene {
         }
         let backplate = check_roles(&geometry, file.backplate.as_ref()).map_err(invalid)?;
         let backplate = backplate.map(|b| b.resolve(dir));
+        let probes: Vec<ProbeSource> = (file.probes.iter().enumerate())
+            .map(|(index, probe)| probe.resolve(dir, index))
+            .collect();
+        check_probes(&geometry, &probes).map_err(invalid)?;
         let environment = file.environment.map(|env| EnvironmentSpec {
             map: dir.join(env.map),
             rotation_deg: env.rotation_deg,
@@ -92,6 +97,7 @@ impl Scene {
                 })
                 .collect(),
             backplate,
+            probes,
         })
     }
 }
@@ -122,6 +128,39 @@ fn check_roles<'a>(
         }
         other => Ok(other),
     }
+}
+
+/// Checks a scene's probes: named once each, at finite positions inside the room (the
+/// bounds of the proxies, which a scene with probes must have).
+fn check_probes(geometry: &SceneMesh, probes: &[ProbeSource]) -> Result<(), String> {
+    if probes.is_empty() {
+        return Ok(());
+    }
+    let room = geometry.subset(|o| o.role == ObjectRole::Proxy);
+    let Some((lo, hi)) = room.mesh.bounds() else {
+        return Err("[[probe]] needs the room the probes light: objects with \
+                    role = \"proxy\""
+            .into());
+    };
+    for (index, probe) in probes.iter().enumerate() {
+        let name = &probe.name;
+        if name.is_empty() {
+            return Err(format!("[[probe]] {}: the name is empty", index + 1));
+        }
+        if probes[..index].iter().any(|p| p.name == *name) {
+            return Err(format!("[[probe]] \"{name}\" is named twice"));
+        }
+        let p = probe.position;
+        if !p.is_finite() {
+            return Err(format!("probe \"{name}\": position {p} is not finite"));
+        }
+        if p.cmplt(lo).any() || p.cmpgt(hi).any() {
+            return Err(format!(
+                "probe \"{name}\" at {p} is outside every proxy: the room spans {lo} to {hi}"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Loads `object` (the `index`-th of the scene file at `path`), checks its material and

@@ -23,6 +23,51 @@ pub struct SceneFile {
     /// The picture the virtual objects are composited into (CONVENTIONS.md, "Compositing").
     #[serde(skip_serializing_if = "Option::is_none")]
     pub backplate: Option<BackplateSpec>,
+    /// Light probes of the room the proxies model (CONVENTIONS.md, "Light probes").
+    #[serde(rename = "probe", default, skip_serializing_if = "Vec::is_empty")]
+    pub probes: Vec<ProbeSpec>,
+}
+
+/// `[[probe]]`: a light probe of the room.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeSpec {
+    /// Default: `probe1`, `probe2`... in the file's order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    pub position: [f32; 3],
+    /// Its equirectangular radiance map (EXR or HDR), relative to the scene file; default
+    /// `probes/NAME.exr` (where `hprt probes` writes it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub image: Option<PathBuf>,
+    /// Its distances to the room (an EXR of the image's size, `0` where it sees out);
+    /// default: traced from the proxies.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distances: Option<PathBuf>,
+}
+
+impl ProbeSpec {
+    /// The probe's name: its own, or `probeN` for the `index`-th (from 0).
+    pub fn name(&self, index: usize) -> String {
+        self.name
+            .clone()
+            .unwrap_or_else(|| format!("probe{}", index + 1))
+    }
+
+    /// Where the probe is and its files, resolved against the scene's folder `dir`.
+    pub fn resolve(&self, dir: &std::path::Path, index: usize) -> crate::probe::ProbeSource {
+        let name = self.name(index);
+        crate::probe::ProbeSource {
+            image: dir.join(
+                self.image
+                    .clone()
+                    .unwrap_or_else(|| PathBuf::from("probes").join(format!("{name}.exr"))),
+            ),
+            distances: self.distances.as_ref().map(|d| dir.join(d)),
+            position: Vec3::from(self.position),
+            name,
+        }
+    }
 }
 
 /// `[backplate]`: the picture to composite into, seen through the scene's `[camera]`.

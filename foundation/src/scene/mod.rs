@@ -10,8 +10,8 @@ pub mod model;
 pub use backplate::{BackplateError, load_backplate_image};
 pub use build::MAX_MATERIAL_ALBEDO;
 pub use description::{
-    AnnulusSpec, Backplate, BackplateSpec, BoxSpec, EnvironmentSpec, ObjectRole, ObjectSpec, Scale,
-    SceneFile, Transform,
+    AnnulusSpec, Backplate, BackplateSpec, BoxSpec, EnvironmentSpec, ObjectRole, ObjectSpec,
+    ProbeSpec, Scale, SceneFile, Transform,
 };
 pub use geometry::{NO_TEXTURE, SceneMesh, SceneObject};
 
@@ -53,6 +53,8 @@ pub struct Scene {
     pub bake: BakeSettings,
     /// The picture its objects are composited into, when it has proxies.
     pub backplate: Option<Backplate>,
+    /// The light probes of its room (the proxies), files resolved.
+    pub probes: Vec<crate::probe::ProbeSource>,
     /// Every file the scene was read from: the scene file (or model) and each object's mesh.
     pub sources: Vec<PathBuf>,
 }
@@ -96,6 +98,48 @@ mod tests {
                 .all(|a| *a == Rgb::new(0.5, 0.4, 0.3))
         );
         assert_eq!(scene.bake, BakeSettings::default());
+    }
+
+    /// `[[probe]]` entries resolve against the scene's folder, default their names and
+    /// images, and must be named once each, inside the room, in a scene that has one.
+    #[test]
+    fn probes_are_resolved_and_checked() {
+        let dir = tempfile::tempdir().unwrap();
+        let object = "[[object]]\nname = \"model\"\nbox = { min = [0,0,0], max = [1,1,1] }\nalbedo = [0.5, 0.5, 0.5]\n";
+        let room = "[[object]]\nname = \"room\"\nrole = \"proxy\"\nbox = { min = [-4,0,-4], max = [4,3,4] }\nalbedo = [0.3, 0.3, 0.3]\n";
+        let plate = "[backplate]\nimage = \"environment\"\n";
+        let load = |text: String| Scene::load(&write_scene(dir.path(), &text));
+        let probes = "[[probe]]\nposition = [1, 1.5, 0]\n\
+                      [[probe]]\nname = \"door\"\nposition = [-3, 1, 2]\nimage = \"d.hdr\"\ndistances = \"d.exr\"\n";
+        let scene = load(format!("{CAMERA}{plate}{object}{room}{probes}")).unwrap();
+        let expected = [
+            crate::probe::ProbeSource {
+                name: "probe1".into(),
+                position: Vec3::new(1.0, 1.5, 0.0),
+                image: dir.path().join("probes/probe1.exr"),
+                distances: None,
+            },
+            crate::probe::ProbeSource {
+                name: "door".into(),
+                position: Vec3::new(-3.0, 1.0, 2.0),
+                image: dir.path().join("d.hdr"),
+                distances: Some(dir.path().join("d.exr")),
+            },
+        ];
+        assert_eq!(scene.probes, expected);
+
+        let error = |text: String| load(text).unwrap_err().to_string();
+        let outside = "[[probe]]\nname = \"yard\"\nposition = [9, 1, 0]\n";
+        let message = error(format!("{CAMERA}{plate}{object}{room}{outside}"));
+        assert!(
+            message.contains("\"yard\"") && message.contains("outside"),
+            "{message}"
+        );
+        let twice = "[[probe]]\nname = \"a\"\nposition = [0, 1, 0]\n[[probe]]\nname = \"a\"\nposition = [1, 1, 0]\n";
+        let message = error(format!("{CAMERA}{plate}{object}{room}{twice}"));
+        assert!(message.contains("named twice"), "{message}");
+        let message = error(format!("{CAMERA}{object}{probes}"));
+        assert!(message.contains("role = \"proxy\""), "{message}");
     }
 
     #[test]

@@ -96,6 +96,7 @@ pub fn scene_file_for_model(
         bake: BakeSettings::default(),
         objects,
         backplate: None,
+        probes: Vec::new(),
     })
 }
 

@@ -1,11 +1,11 @@
 //! The environment map at any point of a room, blended from the room's probes on its proxies
 //! (CONVENTIONS.md, "Light probes").
 
-use super::probe::Probe;
 use crate::cubemap::{CubeGeometry, CubeMap};
 use foundation::Rgb;
 use foundation::bvh::{SceneBvh, Skip};
 use foundation::envmap::EnvMap;
+use foundation::probe::Probe;
 use glam::Vec3;
 use rayon::prelude::*;
 

@@ -8,6 +8,7 @@ use foundation::Rgb;
 use foundation::bvh::{SceneBvh, Skip};
 use foundation::envmap::EnvMap;
 use foundation::mesh::{TriangleMesh, box_mesh};
+use foundation::probe::{DistanceMap, Probe, ProbeError};
 use glam::Vec3;
 
 /// Boxes `(min, max, faces left out: +x, −x, +y, −y, +z, −z)` as one mesh.
