@@ -39,6 +39,8 @@ enum Command {
     Render(commands::render::RenderArgs),
     /// Render the CPU path-traced reference of a scene.
     Reference(commands::reference::ReferenceArgs),
+    /// Path-trace a room's light probes (radiance and distance) for its [[probe]] entries.
+    Probes(commands::probes::ProbesArgs),
     /// Write the scene as a Mitsuba 3 scene, to cross-check the reference.
     Export(commands::export::ExportArgs),
     /// Error statistics of plain PRT and the hybrid against the path-traced reference.
@@ -89,6 +91,7 @@ fn main() {
         Command::Render(args) => commands::render::run(args),
         Command::View(args) => view::run(args),
         Command::Export(args) => commands::export::run(args),
+        Command::Probes(args) => commands::probes::run(args),
         Command::Slurm(args) => commands::slurm::run(args),
     };
     if let Err(error) = result {

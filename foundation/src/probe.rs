@@ -76,6 +76,12 @@ impl DistanceMap {
     pub fn distance(&self, w: Vec3) -> f32 {
         self.map.radiance(w)[0]
     }
+
+    /// The distance through texel `(i, j)` (column, row from the top).
+    #[inline]
+    pub fn at(&self, i: usize, j: usize) -> f32 {
+        self.map.texel(i, j)[0]
+    }
 }
 
 /// A light probe: where it was captured, what arrives there, and how far the room is.
@@ -211,7 +217,10 @@ mod tests {
             traced.distance(Vec3::X).is_infinite(),
             "the open side sees out"
         );
-        assert!((traced.distance(-Vec3::X) - 2.5).abs() < 0.05, "a texel beside -x");
+        assert!(
+            (traced.distance(-Vec3::X) - 2.5).abs() < 0.05,
+            "a texel beside -x"
+        );
         let image = dir.path().join("p.exr");
         write_exr(&image, &RgbImageF32::filled(64, 32, Rgb::ONE)).unwrap();
         let distances = dir.path().join("p.distance.exr");

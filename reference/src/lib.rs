@@ -23,8 +23,10 @@ pub use sampler::{MAX_SOBOL_SAMPLES, PathSampler, PixelSampler, SamplerKind, Sob
 use foundation::bvh::SceneBvh;
 use foundation::camera::Camera;
 use foundation::color::Rgb;
+use foundation::envmap::EnvMap;
 use foundation::image_io::RgbImageF32;
 use foundation::infra::progress::Progress;
+use foundation::probe::{DistanceMap, Probe};
 use foundation::sampling::mix64;
 use foundation::scene::SceneMesh;
 use rand_pcg::Pcg32;
@@ -246,6 +248,54 @@ pub fn render_rows(
             seconds: start.elapsed().as_secs_f64(),
         },
     }
+}
+
+/// A synthetic light probe: the radiance arriving at `position` through the centre of each
+/// texel of a `width × height` equirectangular map, each texel's paths as a pixel's (its
+/// random stream from the seed and the texel index), and the distance to `geometry` through
+/// each texel. `progress` counts rows.
+pub fn render_probe(
+    geometry: &SceneMesh,
+    bvh: &SceneBvh,
+    light: &EnvironmentLight,
+    position: glam::Vec3,
+    (width, height): (usize, usize),
+    settings: &ReferenceSettings,
+    progress: &dyn Progress,
+) -> (Probe, RenderStats) {
+    let start = Instant::now();
+    let blank = EnvMap::uniform(width, height, Rgb::ZERO);
+    let integrator = Integrator::new(geometry, bvh, light, settings.bounces);
+    progress.start(height as u64);
+    let rows: Vec<(Vec<Rgb>, u64)> = (0..height)
+        .into_par_iter()
+        .map(|j| {
+            let mut rays = 0u64;
+            let row = (0..width)
+                .map(|i| {
+                    let direction = blank.texel_direction(i, j);
+                    let index = (j * width + i) as u64;
+                    render_pixel(&integrator, position, direction, index, settings, &mut rays)
+                        .radiance
+                })
+                .collect();
+            progress.advance(1);
+            (row, rays)
+        })
+        .collect();
+    progress.finish();
+    let texels = rows
+        .iter()
+        .flat_map(|(row, _)| row.iter().copied())
+        .collect();
+    let radiance = EnvMap::new(width, height, texels);
+    let distances = DistanceMap::trace(bvh, position, width, height);
+    let probe = Probe::new(position, radiance, distances).expect("maps of one size");
+    let stats = RenderStats {
+        rays: rows.iter().map(|(_, rays)| rays).sum::<u64>() + (width * height) as u64,
+        seconds: start.elapsed().as_secs_f64(),
+    };
+    (probe, stats)
 }
 
 /// The paths of pixel `index`, whose centre's ray leaves `origin` in `direction`.

@@ -385,3 +385,62 @@ fn glossy_plane_reflects_the_lobe_convolved_sky() {
         "{got} vs {expected}"
     );
 }
+
+/// A probe inside the white furnace's open box sees 1 everywhere (the walls' radiance and
+/// the sky through the top), and its distances are the box's; a probe under a sunny sky sees
+/// the map itself, bit for bit, wherever it sees out.
+#[test]
+fn probes_see_the_furnace_and_the_sky() {
+    let no_progress = &foundation::infra::progress::NoProgress;
+    let geometry = scene_of(&[(&open_box(), Rgb::ONE)]);
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let map = EnvMap::uniform(64, 32, Rgb::ONE);
+    let light = EnvironmentLight::new(&map, 0.0);
+    let settings = ReferenceSettings::new(16, 64, 3);
+    let at = Vec3::new(0.2, 0.7, -0.1);
+    let (probe, stats) = render_probe(
+        &geometry,
+        &bvh,
+        &light,
+        at,
+        (64, 32),
+        &settings,
+        no_progress,
+    );
+    assert!(stats.rays > 64 * 32 * 16);
+    let texels = probe.radiance.texels();
+    let mean = texels.iter().map(|t| t.y).sum::<f32>() / texels.len() as f32;
+    assert!((mean - 1.0).abs() < 0.01, "furnace probe mean {mean}");
+    assert!(probe.distances.distance(Vec3::Y).is_infinite());
+    assert!((probe.distances.distance(-Vec3::Y) - 0.7).abs() < 0.05);
+
+    let geometry = sphere_on_plane();
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let map = sunny_map();
+    let light = EnvironmentLight::new(&map, 0.0);
+    let at = Vec3::new(1.5, 0.5, 1.0);
+    let (probe, _) = render_probe(
+        &geometry,
+        &bvh,
+        &light,
+        at,
+        (128, 64),
+        &settings,
+        no_progress,
+    );
+    let mut outside = 0;
+    for j in 0..64 {
+        for i in 0..128 {
+            let w = probe.radiance.texel_direction(i, j);
+            if probe.distances.distance(w).is_infinite() {
+                assert_eq!(
+                    probe.radiance.texel(i, j),
+                    light.radiance(w),
+                    "texel ({i}, {j})"
+                );
+                outside += 1;
+            }
+        }
+    }
+    assert!(outside > 128 * 20, "{outside} texels see the sky");
+}

@@ -10,6 +10,7 @@ pub mod decompose;
 pub mod demo;
 pub mod export;
 mod mitsuba;
+pub mod probes;
 pub mod reference;
 pub mod render;
 pub mod report;

@@ -43,6 +43,9 @@ pub struct FusionStats {
     pub unseen: usize,
 }
 
+/// Texels traced together by one worker.
+const FAN: usize = 64;
+
 /// Where one texel's radiance came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Source {
@@ -91,10 +94,20 @@ impl<'a> ProbeFusion<'a> {
             };
             return (map, stats);
         }
+        // The texels' rays share their origin: traced as fans, eight at a time.
         let texels: Vec<(Rgb, Source)> = geometry
             .directions()
-            .par_iter()
-            .map(|&w| self.texel(p, w))
+            .par_chunks(FAN)
+            .flat_map_iter(|directions| {
+                let mut hits = Vec::with_capacity(directions.len());
+                let range = (0.0, f32::INFINITY);
+                self.proxies
+                    .closest_hits(p, directions, range, Skip::Nothing, &mut hits);
+                (directions.iter().zip(hits)).map(move |(&w, hit)| match hit {
+                    None => (self.outside(p, w), Source::Outside),
+                    Some(hit) => self.surface(p, w, p + w * hit.t),
+                })
+            })
             .collect();
         let mut stats = FusionStats::default();
         for (_, source) in &texels {
@@ -109,17 +122,6 @@ impl<'a> ProbeFusion<'a> {
             texels.into_iter().map(|(l, _)| l).collect(),
         );
         (map, stats)
-    }
-
-    /// The radiance arriving at `p` from direction `w`.
-    fn texel(&self, p: Vec3, w: Vec3) -> (Rgb, Source) {
-        match self
-            .proxies
-            .closest_hit(p, w, 0.0, f32::INFINITY, Skip::Nothing)
-        {
-            None => (self.outside(p, w), Source::Outside),
-            Some(hit) => self.surface(p, w, p + w * hit.t),
-        }
     }
 
     /// Light from beyond the room along `w`: what the probes that see out that way saw
@@ -144,36 +146,80 @@ impl<'a> ProbeFusion<'a> {
     /// from the probes that see `x`.
     fn surface(&self, p: Vec3, w: Vec3, x: Vec3) -> (Rgb, Source) {
         let (mut sum, mut total) = (Rgb::ZERO, 0.0);
-        // The fallback: (visible, cosine, direction, probe).
-        let mut best: Option<(bool, f32, Vec3, &Probe)> = None;
         for probe in self.probes {
-            let to_x = x - probe.position;
-            let distance = to_x.length();
-            if distance <= 0.0 {
+            let Some(seen) = self.sighting(probe, w, x) else {
+                continue;
+            };
+            let similarity = similarity(seen.cosine, self.settings.min_cosine);
+            // Only a probe close enough in direction is looked up (the lookup is the cost).
+            if similarity <= 0.0 {
                 continue;
             }
-            let seen_along = to_x / distance;
-            let cosine = w.dot(seen_along);
-            let stored = probe.distances.distance(seen_along);
-            let visible = distance <= stored * (1.0 + self.settings.depth_tolerance);
-            if best.is_none_or(|(v, c, _, _)| (visible, cosine) > (v, c)) {
-                best = Some((visible, cosine, seen_along, probe));
-            }
-            let similarity = similarity(cosine, self.settings.min_cosine);
-            if !visible || similarity <= 0.0 {
+            let (i, j) = seen.texel(probe);
+            if !seen.visible(probe, (i, j), self.settings.depth_tolerance) {
                 continue;
             }
             let weight = probe_weight(similarity, p.distance_squared(probe.position));
-            sum += probe.radiance.radiance(seen_along) * weight;
+            sum += probe.radiance.texel(i, j) * weight;
             total += weight;
         }
+        if total > 0.0 {
+            return (sum / total, Source::Blended);
+        }
+        // No probe blends here: the one that sees `x` best, visible first, then by cosine.
+        let tolerance = self.settings.depth_tolerance;
+        let best = (self.probes.iter())
+            .filter_map(|probe| Some((probe, self.sighting(probe, w, x)?)))
+            .map(|(probe, seen)| {
+                let texel = seen.texel(probe);
+                (
+                    (seen.visible(probe, texel, tolerance), seen.cosine),
+                    probe,
+                    texel,
+                )
+            })
+            .max_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
         match best {
-            _ if total > 0.0 => (sum / total, Source::Blended),
-            Some((_, _, seen_along, probe)) => {
-                (probe.radiance.radiance(seen_along), Source::Unseen)
-            }
+            Some((_, probe, (i, j))) => (probe.radiance.texel(i, j), Source::Unseen),
             None => (self.sky.radiance(w), Source::Unseen),
         }
+    }
+
+    /// How `probe` sees the proxy point `x` that `p` sees along `w` (`None` if `x` is the
+    /// probe's very position).
+    fn sighting(&self, probe: &Probe, w: Vec3, x: Vec3) -> Option<Sighting> {
+        let to_x = x - probe.position;
+        let distance = to_x.length();
+        (distance > 0.0).then(|| {
+            let along = to_x / distance;
+            Sighting {
+                cosine: w.dot(along),
+                distance,
+                along,
+            }
+        })
+    }
+}
+
+/// A probe's view of a proxy point.
+struct Sighting {
+    /// Between the probe's direction to the point and the local map's.
+    cosine: f32,
+    distance: f32,
+    /// The probe's direction to the point.
+    along: Vec3,
+}
+
+impl Sighting {
+    /// The probe's texel toward the point.
+    fn texel(&self, probe: &Probe) -> (usize, usize) {
+        probe.radiance.texel_of(self.along)
+    }
+
+    /// Whether nothing stands between the probe and the point (eq. 5.4), its `texel` toward
+    /// the point.
+    fn visible(&self, probe: &Probe, (i, j): (usize, usize), tolerance: f32) -> bool {
+        self.distance <= probe.distances.at(i, j) * (1.0 + tolerance)
     }
 }
 

@@ -3,6 +3,7 @@
 mod bake;
 mod capture;
 mod composite;
+mod probes;
 mod process;
 mod reference;
 mod reflections;
@@ -14,6 +15,7 @@ use bake::{BenchBakeArgs, bench_bake};
 use capture::{BenchCaptureArgs, bench_capture};
 use clap::Subcommand;
 use composite::{BenchCompositeArgs, bench_composite};
+use probes::{BenchProbesArgs, bench_probes};
 use reference::{BenchReferenceArgs, bench_reference};
 use reflections::{BenchReflectionsArgs, bench_reflections};
 use render::{BenchRenderArgs, bench_render};
@@ -45,6 +47,9 @@ pub enum BenchCommand {
     /// Capture: photographs a map as a camera would (24 shots of 12 megapixels by default),
     /// then times `hprt capture` on them and prints its peak memory.
     Capture(BenchCaptureArgs),
+    /// Light probes: the cost per update of moving a model through a room: the local map
+    /// fused from the probes, and its decomposition.
+    Probes(BenchProbesArgs),
 }
 
 pub fn run(command: BenchCommand) -> anyhow::Result<()> {
@@ -57,5 +62,6 @@ pub fn run(command: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Composite(args) => bench_composite(args),
         BenchCommand::Shards(args) => bench_shards(args),
         BenchCommand::Capture(args) => bench_capture(args),
+        BenchCommand::Probes(args) => bench_probes(args),
     }
 }
