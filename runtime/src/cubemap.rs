@@ -48,7 +48,7 @@ impl CubeGeometry {
         &self.directions
     }
 
-    pub(crate) fn solid_angles(&self) -> &[f32] {
+    pub fn solid_angles(&self) -> &[f32] {
         &self.solid_angles
     }
 

@@ -27,6 +27,14 @@ pub struct BenchProbesArgs {
     /// SH order of the lighting.
     #[arg(long, default_value_t = 5)]
     pub order: usize,
+    /// Also path-trace the true probe at this many points of the path and compare the local
+    /// map with it, beside one probe's map (the one nearest the room's centre: a single
+    /// capture) and the nearest probe's.
+    #[arg(long, default_value_t = 0)]
+    pub truth: usize,
+    /// Light paths per texel of the true probes.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub spp: u32,
     #[command(flatten)]
     pub environment: EnvironmentArgs,
 }
@@ -49,6 +57,13 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
         .collect::<Result<_, _>>()?;
     let env = args.environment.choose(&scene)?;
     let sky = env.loaded.map.rotated(env.rotation_deg);
+    let truth = |p: Vec3| {
+        let light = reference::EnvironmentLight::new(&env.loaded.map, env.rotation_deg);
+        let settings = reference::ReferenceSettings::new(args.spp, 3, 0);
+        let no_progress = &foundation::infra::progress::NoProgress;
+        let size = (256, 128);
+        reference::render_probe(&room, &proxies, &light, p, size, &settings, no_progress).0
+    };
     let fusion = runtime::ProbeFusion::new(&probes, &proxies, &sky, FusionSettings::default());
     let settings = DecomposeSettings {
         face_size: args.face,
@@ -92,7 +107,116 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
         median(totals),
         100.0 * unseen as f64 / (path.len() * geometry.directions().len()) as f64
     );
+    if args.truth > 0 {
+        let centre = room
+            .mesh
+            .bounds()
+            .map_or(Vec3::ZERO, |(lo, hi)| 0.5 * (lo + hi));
+        let points: Vec<Vec3> = (0..args.truth)
+            .map(|k| path[(2 * k + 1) * path.len() / (2 * args.truth)])
+            .collect();
+        let maps = |p: Vec3| MapsAt {
+            truth: truth(p),
+            fused: fusion.local_map(&geometry, p).0,
+        };
+        compare_with_truth(&probes, centre, &geometry, &points, maps);
+    }
     Ok(())
+}
+
+/// The true probe and the local map at a point.
+struct MapsAt {
+    truth: Probe,
+    fused: runtime::CubeMap,
+}
+
+/// Prints, at each of `points`, how far the local map, the nearest probe's map and the map
+/// of the probe nearest the room's `centre` are from the true probe there: the relative RMS
+/// of the irradiance they give over 26 normals, and their relative L1 luminance difference.
+fn compare_with_truth(
+    probes: &[Probe],
+    centre: Vec3,
+    geometry: &CubeGeometry,
+    points: &[Vec3],
+    maps_at: impl Fn(Vec3) -> MapsAt,
+) {
+    let nearest_to = |q: Vec3| {
+        (probes.iter())
+            .min_by(|a, b| q.distance(a.position).total_cmp(&q.distance(b.position)))
+            .expect("at least two probes")
+    };
+    let cube_of =
+        |probe: &Probe| runtime::CubeMap::from_fn(geometry, |w| probe.radiance.radiance(w));
+    let single = cube_of(nearest_to(centre));
+    println!(
+        "against the true probe (path-traced, 256×128): irradiance error (relative RMS over 26 \
+         normals) / map error (relative L1 of luminance)"
+    );
+    println!(
+        "{:<24} {:>17} {:>17} {:>17}",
+        "point", "fused", "nearest probe", "one probe"
+    );
+    let mut wins = 0;
+    for &p in points {
+        let maps = maps_at(p);
+        let truth = cube_of(&maps.truth);
+        let errors = [&maps.fused, &cube_of(nearest_to(p)), &single]
+            .map(|m| map_errors(geometry, m, &truth));
+        wins += usize::from(errors[0].0 < errors[1].0 && errors[0].0 < errors[2].0);
+        let cell = |(e, l): (f64, f64)| format!("{:.3} / {:.3}", e, l);
+        println!(
+            "{:<24} {:>17} {:>17} {:>17}",
+            format!("{p}"),
+            cell(errors[0]),
+            cell(errors[1]),
+            cell(errors[2])
+        );
+    }
+    println!(
+        "the fused map's irradiance is the closest at {wins} of {} points",
+        points.len()
+    );
+}
+
+/// (relative RMS irradiance error over 26 normals, relative L1 luminance error) of `map`
+/// against `truth`, both solid-angle weighted.
+fn map_errors(
+    geometry: &CubeGeometry,
+    map: &runtime::CubeMap,
+    truth: &runtime::CubeMap,
+) -> (f64, f64) {
+    let normals: Vec<Vec3> = (-1..=1)
+        .flat_map(|x| {
+            (-1..=1)
+                .flat_map(move |y| (-1..=1).map(move |z| Vec3::new(x as f32, y as f32, z as f32)))
+        })
+        .filter(|n| *n != Vec3::ZERO)
+        .map(Vec3::normalize)
+        .collect();
+    let weights = geometry.solid_angles();
+    let irradiance = |m: &runtime::CubeMap, n: Vec3| -> f64 {
+        (m.texels().iter().zip(geometry.directions()).zip(weights))
+            .map(|((l, w), dw)| (foundation::luminance(*l) * n.dot(*w).max(0.0) * dw) as f64)
+            .sum()
+    };
+    let (mut squared, mut mean) = (0.0, 0.0);
+    for &n in &normals {
+        let (e, t) = (irradiance(map, n), irradiance(truth, n));
+        squared += (e - t) * (e - t);
+        mean += t;
+    }
+    let count = normals.len() as f64;
+    let irradiance_error = (squared / count).sqrt() / (mean / count).max(f64::MIN_POSITIVE);
+    let (mut difference, mut total) = (0.0, 0.0);
+    for ((a, b), dw) in map.texels().iter().zip(truth.texels()).zip(weights) {
+        let (a, b) = (
+            foundation::luminance(*a) as f64,
+            foundation::luminance(*b) as f64,
+        );
+        difference += (a - b).abs() * *dw as f64;
+        total += b * *dw as f64;
+    }
+    (irradiance_error, difference / total.max(f64::MIN_POSITIVE))
 }
 
 /// `steps` positions along the polyline through the probes, in their order, evenly spaced
@@ -113,4 +237,30 @@ fn path_through(probes: &[Probe], steps: usize) -> Vec<Vec3> {
             points[points.len() - 1]
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use foundation::Rgb;
+
+    /// A map is no distance from itself; a uniform one 10% brighter is 10% off on both
+    /// measures; one brighter on one side only is off in irradiance by less than in L1.
+    #[test]
+    fn map_errors_measure_relative_differences() {
+        let geometry = CubeGeometry::new(8);
+        let sky = |w: Vec3| Rgb::splat(1.0 + w.y.max(0.0) * 3.0);
+        let truth = runtime::CubeMap::from_fn(&geometry, sky);
+        let (e, l) = map_errors(&geometry, &truth, &truth);
+        assert_eq!((e, l), (0.0, 0.0));
+        let uniform = runtime::CubeMap::uniform(8, Rgb::ONE);
+        let brighter = runtime::CubeMap::uniform(8, Rgb::splat(1.1));
+        let (e, l) = map_errors(&geometry, &brighter, &uniform);
+        assert!((e - 0.1).abs() < 1e-4 && (l - 0.1).abs() < 1e-4, "{e} {l}");
+        let noisy = runtime::CubeMap::from_fn(&geometry, |w| {
+            sky(w) * if (w.x * 40.0).sin() > 0.0 { 1.2 } else { 0.8 }
+        });
+        let (e, l) = map_errors(&geometry, &noisy, &truth);
+        assert!(e < 0.5 * l, "noise averages out of irradiance: {e} against {l}");
+    }
 }
