@@ -10,8 +10,8 @@
 //!   between the light and the SH part (as a delta function of the same power), so SH part plus
 //!   lights integrate to the same total in every frame, and in consistent mode to the map.
 
-use crate::decompose::Decomposition;
 use crate::decompose::weber::weber_elbow;
+use crate::decompose::{DecomposeSettings, Decomposition, MAX_CANDIDATES};
 use crate::light::DirectionalLight;
 use foundation::luminance;
 
@@ -24,6 +24,19 @@ pub struct TrackingSettings {
     pub fade_frames: u32,
     /// Largest angle between a light and its match in the next frame, degrees.
     pub match_deg: f32,
+}
+
+impl TrackingSettings {
+    /// What the decomposer extracts under tracking: lights down to the leaving threshold,
+    /// and up to twice as many, so that tracked lights stay found; the tracker decides which
+    /// enter and keeps at most `max_lights`.
+    pub(crate) fn decomposer_settings(&self, settings: &DecomposeSettings) -> DecomposeSettings {
+        DecomposeSettings {
+            threshold: settings.threshold * self.leave_fraction,
+            max_lights: (2 * settings.max_lights).min(MAX_CANDIDATES),
+            ..settings.clone()
+        }
+    }
 }
 
 impl Default for TrackingSettings {

@@ -11,9 +11,7 @@ use super::frame::{FrameLighting, LitFrame, RenderMode, lights_indirect_default}
 use super::rotation::{rotate_decomposition, rotate_sh};
 use crate::cubemap::{CubeGeometry, CubeMap, CubeSource};
 use crate::decompose::source_size::SourceMeter;
-use crate::decompose::{
-    DecomposeError, DecomposeSettings, Decomposer, Decomposition, MAX_CANDIDATES,
-};
+use crate::decompose::{DecomposeError, DecomposeSettings, Decomposer, Decomposition};
 use crate::light::DirectionalLight;
 use crate::peers::median_cut::{MedianCutError, analysis_map, median_cut_in_levels};
 use crate::peers::sh_sun;
@@ -193,16 +191,10 @@ impl EnvironmentLighting {
         self.tracker.as_ref().map_or(&[], |t| t.lights())
     }
 
-    /// The decomposer's settings: when tracking, lights are extracted down to the leaving
-    /// threshold, and up to twice as many, so that tracked lights stay found; the tracker
-    /// decides which enter and keeps at most `max_lights`.
+    /// The decomposer's settings: the tracker's when tracking.
     fn decomposer_settings(&self, settings: &DecomposeSettings) -> DecomposeSettings {
         match &self.tracker {
-            Some(tracker) => DecomposeSettings {
-                threshold: settings.threshold * tracker.settings().leave_fraction,
-                max_lights: (2 * settings.max_lights).min(MAX_CANDIDATES),
-                ..settings.clone()
-            },
+            Some(tracker) => tracker.settings().decomposer_settings(settings),
             None => settings.clone(),
         }
     }

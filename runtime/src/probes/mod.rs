@@ -4,7 +4,9 @@
 //! ([`ProbeFusion::local_map`]).
 
 mod fusion;
+mod lighting;
 #[cfg(test)]
 mod tests;
 
 pub use fusion::{FusionSettings, FusionStats, ProbeFusion};
+pub use lighting::{ProbeFrame, ProbeLighting};

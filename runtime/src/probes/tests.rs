@@ -3,6 +3,7 @@
 
 use super::fusion::{probe_weight, similarity};
 use super::*;
+use crate::ProbeLighting;
 use crate::cubemap::{CubeGeometry, CubeMap};
 use foundation::Rgb;
 use foundation::bvh::{SceneBvh, Skip};
@@ -226,5 +227,63 @@ fn maps_that_do_not_match_are_refused() {
     assert_eq!(
         DistanceMap::new(8, 4, &bad).unwrap_err(),
         ProbeError::BadDistance(5, 1)
+    );
+}
+
+/// Walking from where the sun is seen through the open side to where the ceiling hides it.
+/// The map loses the sun over a few steps as the ceiling's edge crosses its disc; the light
+/// follows. Decomposed afresh each step, the light vanishes at the last of them with the
+/// power it had left; followed from step to step, it fades out instead: no step where a
+/// light enters or leaves changes the lights' power by more than a fraction of that.
+#[test]
+fn walking_out_of_the_sun_never_pops() {
+    let proxies = open_room();
+    let sun = Vec3::new(0.85, 0.5, 0.15).normalize();
+    let sky = EnvMap::from_fn(256, 128, 2, |w| {
+        let disc = if w.dot(sun) > 0.998 { 2000.0 } else { 0.0 };
+        Rgb::new(0.4, 0.5, 0.7) + Rgb::splat(disc)
+    });
+    let probes: Vec<Probe> = [Vec3::new(1.5, 1.2, 0.0), Vec3::new(-1.5, 1.2, 0.0)]
+        .iter()
+        .map(|&p| probe(&proxies, &sky, p, 1.0))
+        .collect();
+    let settings = crate::DecomposeSettings {
+        face_size: 32,
+        ..crate::DecomposeSettings::for_mode(crate::DecomposeMode::Consistent, 3)
+    };
+    let mut untracked = crate::Decomposer::new(settings.clone()).unwrap();
+    let tracking = crate::TrackingSettings::default();
+    let mut lighting = ProbeLighting::new(probes, proxies, sky, settings, tracking).unwrap();
+    // (lights' luminance, number of lights) per step, followed and afresh.
+    let mut steps = Vec::new();
+    for k in 0..60 {
+        let p = Vec3::new(1.4 - 3.0 * k as f32 / 59.0, 1.2, 0.0);
+        let summary = |d: &crate::Decomposition| {
+            let power: f32 = (d.lights.iter())
+                .map(|l| foundation::luminance(l.power))
+                .sum();
+            (power, d.lights.len())
+        };
+        let followed = summary(&lighting.update(p).lighting);
+        let afresh = summary(&untracked.decompose(&lighting.local_map(p).0));
+        steps.push((followed, afresh));
+    }
+    // The largest change of the lights' power at a step where their number changes.
+    let pop = |pick: fn(&((f32, usize), (f32, usize))) -> (f32, usize)| {
+        (steps.windows(2))
+            .map(|w| (pick(&w[0]), pick(&w[1])))
+            .filter(|((_, a), (_, b))| a != b)
+            .map(|((a, _), (b, _))| (a - b).abs())
+            .fold(0.0f32, f32::max)
+    };
+    let (followed, afresh) = (pop(|s| s.0), pop(|s| s.1));
+    let start = steps[0].1.0;
+    assert!(
+        afresh > 0.2 * start,
+        "the sun never vanished at once: {afresh} of {start}"
+    );
+    assert!(
+        followed < 0.25 * afresh,
+        "followed {followed}, afresh {afresh}"
     );
 }

@@ -5,12 +5,12 @@ use crate::cli::EnvironmentArgs;
 use crate::support::{load_scene, median};
 use clap::Args;
 use foundation::bvh::SceneBvh;
+use foundation::luminance;
 use foundation::probe::Probe;
 use foundation::scene::ObjectRole;
 use glam::Vec3;
-use runtime::{CubeGeometry, DecomposeMode, DecomposeSettings, Decomposer, FusionSettings};
+use runtime::{CubeGeometry, DecomposeMode, DecomposeSettings, ProbeFrame, ProbeLighting};
 use std::path::PathBuf;
-use std::time::Instant;
 
 #[derive(Args)]
 pub struct BenchProbesArgs {
@@ -57,56 +57,34 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
         .collect::<Result<_, _>>()?;
     let env = args.environment.choose(&scene)?;
     let sky = env.loaded.map.rotated(env.rotation_deg);
+    let truth_bvh = SceneBvh::build(&room.mesh);
     let truth = |p: Vec3| {
         let light = reference::EnvironmentLight::new(&env.loaded.map, env.rotation_deg);
         let settings = reference::ReferenceSettings::new(args.spp, 3, 0);
         let no_progress = &foundation::infra::progress::NoProgress;
         let size = (256, 128);
-        reference::render_probe(&room, &proxies, &light, p, size, &settings, no_progress).0
+        reference::render_probe(&room, &truth_bvh, &light, p, size, &settings, no_progress).0
     };
-    let fusion = runtime::ProbeFusion::new(&probes, &proxies, &sky, FusionSettings::default());
     let settings = DecomposeSettings {
         face_size: args.face,
         ..DecomposeSettings::for_mode(args.mode, args.order)
     };
-    let mut decomposer = Decomposer::new(settings)?;
-    let geometry = CubeGeometry::new(args.face);
-    let path = path_through(&probes, args.steps);
-    let (mut fuse_ms, mut decompose_ms, mut unseen) = (Vec::new(), Vec::new(), 0);
-    for &p in &path {
-        let start = Instant::now();
-        let (map, stats) = fusion.local_map(&geometry, p);
-        let fused = Instant::now();
-        let decomposition = decomposer.decompose(&map);
-        fuse_ms.push((fused - start).as_secs_f64() * 1e3);
-        decompose_ms.push(fused.elapsed().as_secs_f64() * 1e3);
-        unseen += stats.unseen;
-        std::hint::black_box(decomposition);
-    }
-    let totals: Vec<f64> = fuse_ms
-        .iter()
-        .zip(&decompose_ms)
-        .map(|(a, b)| a + b)
-        .collect();
+    let mut lighting = ProbeLighting::new(probes, proxies, sky, settings, Default::default())?;
+    let path = path_through(lighting.probes(), args.steps);
+    let frames: Vec<ProbeFrame> = path.iter().map(|&p| lighting.update(p)).collect();
     println!(
         "{}: {} probes, {} positions through them, 6×{}² local maps, {} mode, order {}, {} \
          threads",
         scene.name,
-        probes.len(),
+        lighting.probes().len(),
         path.len(),
         args.face,
         args.mode.name(),
         args.order,
         rayon::current_num_threads()
     );
-    println!(
-        "median ms per update: local map {:.3}, decomposition {:.3}, together {:.3}; \
-         unseen texels {:.2}%",
-        median(fuse_ms),
-        median(decompose_ms),
-        median(totals),
-        100.0 * unseen as f64 / (path.len() * geometry.directions().len()) as f64
-    );
+    print_costs(&frames, lighting.geometry().directions().len());
+    print_steadiness(&frames);
     if args.truth > 0 {
         let centre = room
             .mesh
@@ -117,11 +95,53 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
             .collect();
         let maps = |p: Vec3| MapsAt {
             truth: truth(p),
-            fused: fusion.local_map(&geometry, p).0,
+            fused: lighting.local_map(p).0,
         };
-        compare_with_truth(&probes, centre, &geometry, &points, maps);
+        let (probes, geometry) = (lighting.probes(), lighting.geometry());
+        compare_with_truth(probes, centre, geometry, &points, maps);
     }
     Ok(())
+}
+
+/// Medians of each update's cost, and the share of texels no probe saw.
+fn print_costs(frames: &[ProbeFrame], texels: usize) {
+    let fuse: Vec<f64> = frames.iter().map(|f| f.fuse_ms).collect();
+    let decompose: Vec<f64> = frames.iter().map(|f| f.decompose_ms).collect();
+    let total: Vec<f64> = frames.iter().map(|f| f.fuse_ms + f.decompose_ms).collect();
+    let unseen: usize = frames.iter().map(|f| f.stats.unseen).sum();
+    println!(
+        "median ms per update: local map {:.3}, decomposition {:.3}, together {:.3}; \
+         unseen texels {:.2}%",
+        median(fuse),
+        median(decompose),
+        median(total),
+        100.0 * unseen as f64 / (frames.len() * texels) as f64
+    );
+}
+
+/// How steady the lights are along the path: changes in the number of lights drawn, and the
+/// largest change of the lights' power at such a change, relative to the most they carry
+/// along the path (a light popping in or out changes it by its whole power; followed from
+/// step to step, it fades).
+fn print_steadiness(frames: &[ProbeFrame]) {
+    let power =
+        |f: &ProbeFrame| -> f32 { (f.lighting.lights.iter()).map(|l| luminance(l.power)).sum() };
+    let most = frames.iter().map(power).fold(0.0f32, f32::max);
+    let (mut changes, mut largest) = (0, 0.0f32);
+    for pair in frames.windows(2) {
+        if pair[0].lighting.lights.len() != pair[1].lighting.lights.len() {
+            changes += 1;
+            largest = largest.max((power(&pair[1]) - power(&pair[0])).abs());
+        }
+    }
+    let counts = frames.iter().map(|f| f.lighting.lights.len());
+    println!(
+        "lights {}-{}, {changes} changes of their number; largest step of the lights' power \
+         at a change {:.3} of their most",
+        counts.clone().min().unwrap_or(0),
+        counts.max().unwrap_or(0),
+        largest / most.max(f32::MIN_POSITIVE)
+    );
 }
 
 /// The true probe and the local map at a point.
@@ -261,6 +281,9 @@ mod tests {
             sky(w) * if (w.x * 40.0).sin() > 0.0 { 1.2 } else { 0.8 }
         });
         let (e, l) = map_errors(&geometry, &noisy, &truth);
-        assert!(e < 0.5 * l, "noise averages out of irradiance: {e} against {l}");
+        assert!(
+            e < 0.5 * l,
+            "noise averages out of irradiance: {e} against {l}"
+        );
     }
 }
