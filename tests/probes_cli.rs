@@ -69,6 +69,25 @@ fn renders_probes_that_the_scene_then_loads() {
     );
 }
 
+/// The bundled room's shipped probes load, each of the size of its distances, and the room's
+/// benchmark runs on them.
+#[test]
+fn the_bundled_room_has_its_probes() {
+    let scene = foundation::scene::Scene::load(&scene("room.toml")).unwrap();
+    assert_eq!(scene.probes.len(), 3);
+    let room = scene
+        .geometry
+        .subset(|o| o.role == foundation::scene::ObjectRole::Proxy);
+    let proxies = foundation::bvh::SceneBvh::build(&room.mesh);
+    for source in &scene.probes {
+        let probe = source.load(&proxies).unwrap();
+        assert_eq!(probe.radiance.width(), 256, "{}", source.name);
+    }
+    let out = hprt(&repo(), &["bench", "probes", "--steps", "3"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).starts_with("room:"), "{}", stdout(&out));
+}
+
 #[test]
 fn refuses_what_cannot_be_captured() {
     let dir = tempfile::tempdir().unwrap();

@@ -15,6 +15,7 @@ use std::path::PathBuf;
 #[derive(Args)]
 pub struct BenchProbesArgs {
     /// Scene file (TOML) with the room's proxies and its probes (see `hprt probes`).
+    #[arg(default_value = "scenes/room.toml")]
     pub scene: PathBuf,
     /// Cube-map face size of the local map and of the decomposition.
     #[arg(long, default_value_t = 32)]
