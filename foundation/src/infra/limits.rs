@@ -40,6 +40,10 @@ pub const MAX_BACKPLATE_SIDE: u32 = 16_384;
 /// per vertex at order 5, so this many triangles is already tens of gigabytes of bake.
 pub const MAX_SCENE_TRIANGLES: usize = 50_000_000;
 
+/// Most frames a scene's `[path]` may have: ten minutes at 60 frames a second; every frame
+/// is a local map and a decomposition, and a report renders each.
+pub const MAX_PATH_FRAMES: u32 = 36_000;
+
 /// Most worker threads `--threads` may ask for: far above any machine's cores, low enough that
 /// spawning them cannot exhaust the process's resources.
 pub const MAX_THREADS: usize = 1024;

@@ -70,6 +70,9 @@ impl Scene {
             .map(|(index, probe)| probe.resolve(dir, index))
             .collect();
         check_probes(&geometry, &probes).map_err(invalid)?;
+        let model_path = (file.path.as_ref().map(|p| p.check()))
+            .transpose()
+            .map_err(invalid)?;
         let environment = file.environment.map(|env| EnvironmentSpec {
             map: dir.join(env.map),
             rotation_deg: env.rotation_deg,
@@ -98,6 +101,7 @@ impl Scene {
                 .collect(),
             backplate,
             probes,
+            model_path,
         })
     }
 }

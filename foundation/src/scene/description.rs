@@ -26,6 +26,9 @@ pub struct SceneFile {
     /// Light probes of the room the proxies model (CONVENTIONS.md, "Light probes").
     #[serde(rename = "probe", default, skip_serializing_if = "Vec::is_empty")]
     pub probes: Vec<ProbeSpec>,
+    /// Where the virtual objects are carried, frame by frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub path: Option<super::path::PathSpec>,
 }
 
 /// `[[probe]]`: a light probe of the room.

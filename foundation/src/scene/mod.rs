@@ -6,6 +6,7 @@ mod build;
 mod description;
 mod geometry;
 pub mod model;
+mod path;
 
 pub use backplate::{BackplateError, load_backplate_image};
 pub use build::MAX_MATERIAL_ALBEDO;
@@ -14,6 +15,7 @@ pub use description::{
     ProbeSpec, Scale, SceneFile, Transform,
 };
 pub use geometry::{NO_TEXTURE, SceneMesh, SceneObject};
+pub use path::{Crossing, ModelPath, PathSpec};
 
 use crate::bake_settings::BakeSettings;
 use crate::camera::Camera;
@@ -55,6 +57,8 @@ pub struct Scene {
     pub backplate: Option<Backplate>,
     /// The light probes of its room (the proxies), files resolved.
     pub probes: Vec<crate::probe::ProbeSource>,
+    /// Where its virtual objects are carried, frame by frame (the centre of their bounds).
+    pub model_path: Option<ModelPath>,
     /// Every file the scene was read from: the scene file (or model) and each object's mesh.
     pub sources: Vec<PathBuf>,
 }
@@ -140,6 +144,17 @@ mod tests {
         assert!(message.contains("named twice"), "{message}");
         let message = error(format!("{CAMERA}{object}{probes}"));
         assert!(message.contains("role = \"proxy\""), "{message}");
+
+        let path = "[path]\npoints = [[1, 0.5, 0], [-1, 0.5, 0]]\nframes = 3\n";
+        let scene = load(format!("{CAMERA}{object}{path}")).unwrap();
+        let positions = scene.model_path.unwrap().positions();
+        assert_eq!(positions[1], Vec3::new(0.0, 0.5, 0.0));
+        let still = "[path]\npoints = [[1, 0.5, 0]]\nframes = 3\n";
+        let message = error(format!("{CAMERA}{object}{still}"));
+        assert!(
+            message.contains("[path]") && message.contains("two"),
+            "{message}"
+        );
     }
 
     #[test]

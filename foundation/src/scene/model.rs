@@ -97,6 +97,7 @@ pub fn scene_file_for_model(
         objects,
         backplate: None,
         probes: Vec::new(),
+        path: None,
     })
 }
 

@@ -20,7 +20,8 @@ pub struct BenchProbesArgs {
     /// Cube-map face size of the local map and of the decomposition.
     #[arg(long, default_value_t = 32)]
     pub face: usize,
-    /// Positions along the path through the probes (first to last).
+    /// Positions along the path through the probes (first to last), when the scene has no
+    /// [path] of its own.
     #[arg(long, default_value_t = 200)]
     pub steps: usize,
     #[arg(long, default_value = "consistent")]
@@ -70,11 +71,25 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
         face_size: args.face,
         ..DecomposeSettings::for_mode(args.mode, args.order)
     };
+    if let Some(path) = &scene.model_path {
+        for crossing in path.crossings(&proxies) {
+            log::warn!(
+                "{}: [path] passes through a proxy at {} (between frames {} and {})",
+                scene.path.display(),
+                crossing.point,
+                crossing.frame,
+                crossing.frame + 1
+            );
+        }
+    }
+    let path = match &scene.model_path {
+        Some(path) => path.positions(),
+        None => path_through(&probes, args.steps),
+    };
     let mut lighting = ProbeLighting::new(probes, proxies, sky, settings, Default::default())?;
-    let path = path_through(lighting.probes(), args.steps);
     let frames: Vec<ProbeFrame> = path.iter().map(|&p| lighting.update(p)).collect();
     println!(
-        "{}: {} probes, {} positions through them, 6×{}² local maps, {} mode, order {}, {} \
+        "{}: {} probes, {} positions along the path, 6×{}² local maps, {} mode, order {}, {} \
          threads",
         scene.name,
         lighting.probes().len(),
