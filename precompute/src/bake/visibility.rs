@@ -73,7 +73,7 @@ fn base_samples(count: u32) -> Vec<Vec2> {
 
 /// Per-thread buffers reused across vertices.
 struct Scratch {
-    /// The SH basis at up to eight escaping directions, and those directions.
+    /// The SH basis at up to eight escaping directions; a fan's escaping directions.
     basis: Vec<f32x8>,
     escaped: Vec<Vec3>,
     /// A fan's directions and what each ray hit.
@@ -112,7 +112,7 @@ pub(crate) fn trace_vertices(
         .map_init(
             || Scratch {
                 basis: vec![f32x8::ZERO; n],
-                escaped: Vec::with_capacity(8),
+                escaped: Vec::with_capacity(tracer.fans.len()),
                 directions: Vec::with_capacity(tracer.fans.len()),
                 found: Vec::with_capacity(tracer.fans.len()),
                 hits: Vec::with_capacity(3 * tracer.fans.len()),
@@ -271,19 +271,7 @@ impl<'a> VertexTracer<'a> {
         let mut back_faces = 0u32;
         for (&direction, hit) in scratch.directions.iter().zip(&scratch.found) {
             match hit {
-                None => {
-                    // The escaping rays' basis values, eight at a time, summed in ray order.
-                    scratch.escaped.push(direction);
-                    if scratch.escaped.len() == 8 {
-                        accumulate_basis(
-                            &self.basis,
-                            &scratch.escaped,
-                            &mut scratch.basis,
-                            visibility,
-                        );
-                        scratch.escaped.clear();
-                    }
-                }
+                None => scratch.escaped.push(direction),
                 Some(hit) => {
                     if direction.dot(self.front_normals[hit.triangle as usize]) > 0.0 {
                         back_faces += 1;
@@ -299,13 +287,9 @@ impl<'a> VertexTracer<'a> {
                 }
             }
         }
-        if !scratch.escaped.is_empty() {
-            accumulate_basis(
-                &self.basis,
-                &scratch.escaped,
-                &mut scratch.basis,
-                visibility,
-            );
+        // The escaping rays' basis values, eight at a time, summed in ray order.
+        for directions in scratch.escaped.chunks(8) {
+            accumulate_basis(&self.basis, directions, &mut scratch.basis, visibility);
         }
         for y in visibility.iter_mut() {
             *y *= self.inv_samples;
