@@ -3,11 +3,11 @@
 
 use crate::Rgb;
 use crate::bvh::{SceneBvh, Skip};
-use crate::envmap::{self, EnvMap, EnvMapError, Layout};
+use crate::envmap::{self, EnvMap, EnvMapError, Layout, texel_centre_direction};
 use crate::image_io::{RgbImageF32, read_exr};
 use glam::Vec3;
 use rayon::prelude::*;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// What is wrong with a probe's maps.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -49,11 +49,10 @@ impl DistanceMap {
 
     /// The distances the room's `proxies` give from `position`, through each texel's centre.
     pub fn trace(proxies: &SceneBvh, position: Vec3, width: usize, height: usize) -> Self {
-        let blank = EnvMap::uniform(width, height, Rgb::ZERO);
         let texels = (0..width * height)
             .into_par_iter()
             .map(|k| {
-                let w = blank.texel_direction(k % width, k / width);
+                let w = texel_centre_direction(width, height, k % width, k / width);
                 let hit = proxies.closest_hit(position, w, 0.0, f32::INFINITY, Skip::Nothing);
                 Rgb::splat(hit.map_or(f32::INFINITY, |h| h.t))
             })
@@ -81,6 +80,27 @@ impl DistanceMap {
     #[inline]
     pub fn at(&self, i: usize, j: usize) -> f32 {
         self.map.texel(i, j)[0]
+    }
+
+    /// The distances of an image as [`Self::to_image`] writes them.
+    pub fn from_image(image: &RgbImageF32) -> Result<Self, ProbeError> {
+        let distances: Vec<f32> = image
+            .pixels
+            .iter()
+            .map(|p| if p.x == 0.0 { f32::INFINITY } else { p.x })
+            .collect();
+        Self::new(image.width, image.height, &distances)
+    }
+
+    /// The distances as an image: each in all three channels, `0` where the probe sees out
+    /// (no surface: a depth sensor's convention; a probe is never on a surface).
+    pub fn to_image(&self) -> RgbImageF32 {
+        let texels = self.map.texels();
+        let pixels = texels
+            .iter()
+            .map(|d| if d.x.is_finite() { *d } else { Rgb::ZERO })
+            .collect();
+        RgbImageF32::new(self.width(), self.height(), pixels)
     }
 }
 
@@ -113,6 +133,23 @@ impl Probe {
             distances,
         })
     }
+}
+
+/// Where a probe named `name` keeps its image unless its scene says otherwise, and where
+/// `hprt probes` writes it: `probes/NAME.exr` in the scene's folder `dir`.
+pub fn default_image(dir: &Path, name: &str) -> PathBuf {
+    dir.join("probes").join(format!("{name}.exr"))
+}
+
+/// Refuses a probe position outside the room, the bounds `(lo, hi)` of its proxies; `what`
+/// names the probe in the message.
+pub fn check_inside(what: &str, p: Vec3, (lo, hi): (Vec3, Vec3)) -> Result<(), String> {
+    if p.cmplt(lo).any() || p.cmpgt(hi).any() {
+        return Err(format!(
+            "{what} at {p} is outside every proxy: the room spans {lo} to {hi}"
+        ));
+    }
+    Ok(())
 }
 
 /// A probe as a scene names it (`[[probe]]`, resolved): where it is and where its maps are.
@@ -166,29 +203,6 @@ impl ProbeSource {
             path: self.distances.clone().unwrap_or_default(),
             cause: cause.to_string(),
         })
-    }
-}
-
-impl DistanceMap {
-    /// The distances of an image as [`Self::to_image`] writes them.
-    pub fn from_image(image: &RgbImageF32) -> Result<Self, ProbeError> {
-        let distances: Vec<f32> = image
-            .pixels
-            .iter()
-            .map(|p| if p.x == 0.0 { f32::INFINITY } else { p.x })
-            .collect();
-        Self::new(image.width, image.height, &distances)
-    }
-
-    /// The distances as an image: each in all three channels, `0` where the probe sees out
-    /// (no surface: a depth sensor's convention; a probe is never on a surface).
-    pub fn to_image(&self) -> RgbImageF32 {
-        let texels = self.map.texels();
-        let pixels = texels
-            .iter()
-            .map(|d| if d.x.is_finite() { *d } else { Rgb::ZERO })
-            .collect();
-        RgbImageF32::new(self.width(), self.height(), pixels)
     }
 }
 

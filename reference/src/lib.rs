@@ -23,7 +23,7 @@ pub use sampler::{MAX_SOBOL_SAMPLES, PathSampler, PixelSampler, SamplerKind, Sob
 use foundation::bvh::SceneBvh;
 use foundation::camera::Camera;
 use foundation::color::Rgb;
-use foundation::envmap::EnvMap;
+use foundation::envmap::{EnvMap, texel_centre_direction};
 use foundation::image_io::RgbImageF32;
 use foundation::infra::progress::Progress;
 use foundation::probe::{DistanceMap, Probe};
@@ -264,7 +264,6 @@ pub fn render_probe(
     progress: &dyn Progress,
 ) -> (Probe, RenderStats) {
     let start = Instant::now();
-    let blank = EnvMap::uniform(width, height, Rgb::ZERO);
     let integrator = Integrator::new(geometry, bvh, light, settings.bounces);
     progress.start(height as u64);
     let rows: Vec<(Vec<Rgb>, u64)> = (0..height)
@@ -273,7 +272,7 @@ pub fn render_probe(
             let mut rays = 0u64;
             let row = (0..width)
                 .map(|i| {
-                    let direction = blank.texel_direction(i, j);
+                    let direction = texel_centre_direction(width, height, i, j);
                     let index = (j * width + i) as u64;
                     render_pixel(&integrator, position, direction, index, settings, &mut rays)
                         .radiance

@@ -9,6 +9,7 @@ use anyhow::Context;
 use clap::Args;
 use foundation::bvh::SceneBvh;
 use foundation::image_io::{RgbImageF32, write_exr};
+use foundation::probe::{check_inside, default_image};
 use foundation::scene::ObjectRole;
 use glam::Vec3;
 use reference::{EnvironmentLight, ReferenceSettings};
@@ -51,19 +52,16 @@ pub fn run(args: ProbesArgs) -> anyhow::Result<()> {
             scene.path.display()
         );
     };
-    let folder = scene.path.parent().unwrap_or(Path::new(".")).join("probes");
+    let dir = scene.path.parent().unwrap_or(Path::new("."));
     let mut targets: Vec<Target> = (scene.probes.iter())
-        .filter(|p| p.image == folder.join(format!("{}.exr", p.name)))
+        .filter(|p| p.image == default_image(dir, &p.name))
         .map(|p| Target {
             name: p.name.clone(),
             position: p.position,
         })
         .collect();
     for (k, &position) in args.at.iter().enumerate() {
-        anyhow::ensure!(
-            position.cmpge(lo).all() && position.cmple(hi).all(),
-            "--at {position} is outside every proxy: the room spans {lo} to {hi}"
-        );
+        check_inside("--at point", position, (lo, hi)).map_err(anyhow::Error::msg)?;
         let name = format!("at-{}", k + 1);
         targets.push(Target { name, position });
     }
@@ -77,6 +75,7 @@ pub fn run(args: ProbesArgs) -> anyhow::Result<()> {
     let bvh = SceneBvh::build(&room.mesh);
     let settings = ReferenceSettings::new(args.spp, args.bounces, args.seed);
     let size = (args.width as usize, args.width as usize / 2);
+    let folder = dir.join("probes");
     std::fs::create_dir_all(&folder)
         .with_context(|| format!("cannot create {}", folder.display()))?;
     for target in &targets {
@@ -92,7 +91,7 @@ pub fn run(args: ProbesArgs) -> anyhow::Result<()> {
         );
         let map = &probe.radiance;
         let radiance = RgbImageF32::new(map.width(), map.height(), map.texels().to_vec());
-        let image = folder.join(format!("{}.exr", target.name));
+        let image = default_image(dir, &target.name);
         let distances = folder.join(format!("{}.distance.exr", target.name));
         write_exr(&image, &radiance)?;
         write_exr(&distances, &probe.distances.to_image())?;

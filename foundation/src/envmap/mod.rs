@@ -33,6 +33,15 @@ pub struct EnvMap {
     texels: Vec<Rgb>,
 }
 
+/// Direction through the centre of texel `(i, j)` of a `width × height` map (for a map of
+/// that size not yet made: a probe's distances, a rendered probe).
+pub fn texel_centre_direction(width: usize, height: usize, i: usize, j: usize) -> Vec3 {
+    direction_of_uv(
+        (i as f32 + 0.5) / width as f32,
+        (j as f32 + 0.5) / height as f32,
+    )
+}
+
 impl EnvMap {
     pub fn new(width: usize, height: usize, texels: Vec<Rgb>) -> Self {
         assert_eq!(texels.len(), width * height);
@@ -95,10 +104,7 @@ impl EnvMap {
 
     /// Direction through the centre of texel `(i, j)`.
     pub fn texel_direction(&self, i: usize, j: usize) -> Vec3 {
-        direction_of_uv(
-            (i as f32 + 0.5) / self.width as f32,
-            (j as f32 + 0.5) / self.height as f32,
-        )
+        texel_centre_direction(self.width, self.height, i, j)
     }
 
     /// Solid angle of a texel of row `j`: `(2π/W)(π/H) sin θ` at the row centre.

@@ -158,11 +158,7 @@ fn check_probes(geometry: &SceneMesh, probes: &[ProbeSource]) -> Result<(), Stri
         if !p.is_finite() {
             return Err(format!("probe \"{name}\": position {p} is not finite"));
         }
-        if p.cmplt(lo).any() || p.cmpgt(hi).any() {
-            return Err(format!(
-                "probe \"{name}\" at {p} is outside every proxy: the room spans {lo} to {hi}"
-            ));
-        }
+        crate::probe::check_inside(&format!("probe \"{name}\""), p, (lo, hi))?;
     }
     Ok(())
 }

@@ -61,11 +61,10 @@ impl ProbeSpec {
     pub fn resolve(&self, dir: &std::path::Path, index: usize) -> crate::probe::ProbeSource {
         let name = self.name(index);
         crate::probe::ProbeSource {
-            image: dir.join(
-                self.image
-                    .clone()
-                    .unwrap_or_else(|| PathBuf::from("probes").join(format!("{name}.exr"))),
-            ),
+            image: match &self.image {
+                Some(image) => dir.join(image),
+                None => crate::probe::default_image(dir, &name),
+            },
             distances: self.distances.as_ref().map(|d| dir.join(d)),
             position: Vec3::from(self.position),
             name,

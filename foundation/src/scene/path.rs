@@ -73,24 +73,26 @@ impl ModelPath {
 
     /// The centre's position at each frame: evenly spaced along the polyline by length.
     pub fn positions(&self) -> Vec<Vec3> {
+        (0..self.frames)
+            .map(|k| self.at(k as f32 / (self.frames - 1) as f32))
+            .collect()
+    }
+
+    /// The point `fraction` (0 to 1) of the way along the polyline, by length.
+    pub fn at(&self, fraction: f32) -> Vec3 {
         let lengths: Vec<f32> = self
             .points
             .windows(2)
             .map(|w| w[0].distance(w[1]))
             .collect();
-        let total: f32 = lengths.iter().sum();
-        (0..self.frames)
-            .map(|k| {
-                let mut s = total * k as f32 / (self.frames - 1) as f32;
-                for (w, &length) in self.points.windows(2).zip(&lengths) {
-                    if s <= length && length > 0.0 {
-                        return w[0].lerp(w[1], s / length);
-                    }
-                    s -= length;
-                }
-                self.points[self.points.len() - 1]
-            })
-            .collect()
+        let mut s = fraction * lengths.iter().sum::<f32>();
+        for (w, &length) in self.points.windows(2).zip(&lengths) {
+            if s <= length && length > 0.0 {
+                return w[0].lerp(w[1], s / length);
+            }
+            s -= length;
+        }
+        self.points[self.points.len() - 1]
     }
 
     /// Where the centre passes through a surface of `proxies` between two frames (the model

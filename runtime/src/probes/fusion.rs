@@ -129,9 +129,10 @@ impl<'a> ProbeFusion<'a> {
     fn outside(&self, p: Vec3, w: Vec3) -> Rgb {
         let (mut sum, mut total) = (Rgb::ZERO, 0.0);
         for probe in self.probes {
-            if probe.distances.distance(w).is_infinite() {
+            let (i, j) = probe.radiance.texel_of(w);
+            if probe.distances.at(i, j).is_infinite() {
                 let weight = 1.0 / p.distance_squared(probe.position);
-                sum += probe.radiance.radiance(w) * weight;
+                sum += probe.radiance.texel(i, j) * weight;
                 total += weight;
             }
         }
@@ -147,7 +148,7 @@ impl<'a> ProbeFusion<'a> {
     fn surface(&self, p: Vec3, w: Vec3, x: Vec3) -> (Rgb, Source) {
         let (mut sum, mut total) = (Rgb::ZERO, 0.0);
         for probe in self.probes {
-            let Some(seen) = self.sighting(probe, w, x) else {
+            let Some(seen) = Sighting::of(probe, w, x) else {
                 continue;
             };
             let similarity = similarity(seen.cosine, self.settings.min_cosine);
@@ -169,7 +170,7 @@ impl<'a> ProbeFusion<'a> {
         // No probe blends here: the one that sees `x` best, visible first, then by cosine.
         let tolerance = self.settings.depth_tolerance;
         let best = (self.probes.iter())
-            .filter_map(|probe| Some((probe, self.sighting(probe, w, x)?)))
+            .filter_map(|probe| Some((probe, Sighting::of(probe, w, x)?)))
             .map(|(probe, seen)| {
                 let texel = seen.texel(probe);
                 (
@@ -184,21 +185,6 @@ impl<'a> ProbeFusion<'a> {
             None => (self.sky.radiance(w), Source::Unseen),
         }
     }
-
-    /// How `probe` sees the proxy point `x` that `p` sees along `w` (`None` if `x` is the
-    /// probe's very position).
-    fn sighting(&self, probe: &Probe, w: Vec3, x: Vec3) -> Option<Sighting> {
-        let to_x = x - probe.position;
-        let distance = to_x.length();
-        (distance > 0.0).then(|| {
-            let along = to_x / distance;
-            Sighting {
-                cosine: w.dot(along),
-                distance,
-                along,
-            }
-        })
-    }
 }
 
 /// A probe's view of a proxy point.
@@ -211,6 +197,21 @@ struct Sighting {
 }
 
 impl Sighting {
+    /// How `probe` sees the proxy point `x` that the local map sees along `w` (`None` if `x`
+    /// is the probe's very position).
+    fn of(probe: &Probe, w: Vec3, x: Vec3) -> Option<Self> {
+        let to_x = x - probe.position;
+        let distance = to_x.length();
+        (distance > 0.0).then(|| {
+            let along = to_x / distance;
+            Self {
+                cosine: w.dot(along),
+                distance,
+                along,
+            }
+        })
+    }
+
     /// The probe's texel toward the point.
     fn texel(&self, probe: &Probe) -> (usize, usize) {
         probe.radiance.texel_of(self.along)

@@ -60,6 +60,11 @@ impl ProbeLighting {
         &self.probes
     }
 
+    /// The room's surfaces.
+    pub fn proxies(&self) -> &SceneBvh {
+        &self.proxies
+    }
+
     /// The cube map the decomposition works on: its face size and directions.
     pub fn geometry(&self) -> &CubeGeometry {
         &self.geometry

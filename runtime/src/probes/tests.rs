@@ -7,7 +7,7 @@ use crate::ProbeLighting;
 use crate::cubemap::{CubeGeometry, CubeMap};
 use foundation::Rgb;
 use foundation::bvh::{SceneBvh, Skip};
-use foundation::envmap::EnvMap;
+use foundation::envmap::{EnvMap, texel_centre_direction};
 use foundation::mesh::{TriangleMesh, box_mesh};
 use foundation::probe::{DistanceMap, Probe, ProbeError};
 use glam::Vec3;
@@ -57,10 +57,9 @@ fn truth(proxies: &SceneBvh, sky: &EnvMap, p: Vec3, w: Vec3) -> Rgb {
 /// their exposure).
 fn probe(proxies: &SceneBvh, sky: &EnvMap, position: Vec3, exposure: f32) -> Probe {
     let (width, height) = (256, 128);
-    let blank = EnvMap::uniform(width, height, Rgb::ZERO);
     let texels = (0..width * height)
         .map(|k| {
-            let w = blank.texel_direction(k % width, k / width);
+            let w = texel_centre_direction(width, height, k % width, k / width);
             truth(proxies, sky, position, w) * exposure
         })
         .collect();

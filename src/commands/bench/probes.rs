@@ -7,7 +7,7 @@ use clap::Args;
 use foundation::bvh::SceneBvh;
 use foundation::luminance;
 use foundation::probe::Probe;
-use foundation::scene::ObjectRole;
+use foundation::scene::{ObjectRole, PathSpec};
 use glam::Vec3;
 use runtime::{CubeGeometry, DecomposeMode, DecomposeSettings, ProbeFrame, ProbeLighting};
 use std::path::PathBuf;
@@ -59,14 +59,6 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
         .collect::<Result<_, _>>()?;
     let env = args.environment.choose(&scene)?;
     let sky = env.loaded.map.rotated(env.rotation_deg);
-    let truth_bvh = SceneBvh::build(&room.mesh);
-    let truth = |p: Vec3| {
-        let light = reference::EnvironmentLight::new(&env.loaded.map, env.rotation_deg);
-        let settings = reference::ReferenceSettings::new(args.spp, 3, 0);
-        let no_progress = &foundation::infra::progress::NoProgress;
-        let size = (256, 128);
-        reference::render_probe(&room, &truth_bvh, &light, p, size, &settings, no_progress).0
-    };
     let settings = DecomposeSettings {
         face_size: args.face,
         ..DecomposeSettings::for_mode(args.mode, args.order)
@@ -84,7 +76,7 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
     }
     let path = match &scene.model_path {
         Some(path) => path.positions(),
-        None => path_through(&probes, args.steps),
+        None => path_through(&probes, args.steps)?,
     };
     let mut lighting = ProbeLighting::new(probes, proxies, sky, settings, Default::default())?;
     let frames: Vec<ProbeFrame> = path.iter().map(|&p| lighting.update(p)).collect();
@@ -109,6 +101,13 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
         let points: Vec<Vec3> = (0..args.truth)
             .map(|k| path[(2 * k + 1) * path.len() / (2 * args.truth)])
             .collect();
+        let light = reference::EnvironmentLight::new(&env.loaded.map, env.rotation_deg);
+        let settings = reference::ReferenceSettings::new(args.spp, 3, 0);
+        let no_progress = &foundation::infra::progress::NoProgress;
+        let truth = |p: Vec3| {
+            let (proxies, size) = (lighting.proxies(), (256, 128));
+            reference::render_probe(&room, proxies, &light, p, size, &settings, no_progress).0
+        };
         let maps = |p: Vec3| MapsAt {
             truth: truth(p),
             fused: lighting.local_map(p).0,
@@ -257,22 +256,15 @@ fn map_errors(
 
 /// `steps` positions along the polyline through the probes, in their order, evenly spaced
 /// by length and off the probes themselves (where the local map is a copy).
-fn path_through(probes: &[Probe], steps: usize) -> Vec<Vec3> {
-    let points: Vec<Vec3> = probes.iter().map(|p| p.position).collect();
-    let lengths: Vec<f32> = points.windows(2).map(|w| w[0].distance(w[1])).collect();
-    let total: f32 = lengths.iter().sum();
-    (0..steps)
-        .map(|k| {
-            let mut s = total * (k as f32 + 0.5) / steps as f32;
-            for (w, length) in points.windows(2).zip(&lengths) {
-                if s <= *length || *length == total {
-                    return w[0].lerp(w[1], s / length.max(f32::MIN_POSITIVE));
-                }
-                s -= length;
-            }
-            points[points.len() - 1]
-        })
-        .collect()
+fn path_through(probes: &[Probe], steps: usize) -> anyhow::Result<Vec<Vec3>> {
+    let spec = PathSpec {
+        points: probes.iter().map(|p| p.position.to_array()).collect(),
+        frames: steps as u32,
+    };
+    let path = spec.check().map_err(anyhow::Error::msg)?;
+    Ok((0..steps)
+        .map(|k| path.at((k as f32 + 0.5) / steps as f32))
+        .collect())
 }
 
 #[cfg(test)]
