@@ -120,13 +120,13 @@ fn backplate_image(inputs: &CompositeInputs) -> anyhow::Result<RgbImageF32> {
 
 /// What each pixel's centre ray sees first in the whole scene: the point and the face normal
 /// turned toward the camera, with the triangle (as the reference's primary rays find them).
-struct PrimaryHits {
-    triangles: Vec<u32>,
+pub(crate) struct PrimaryHits {
+    pub(crate) triangles: Vec<u32>,
     points: Vec<Option<(Vec3, Vec3)>>,
 }
 
 impl PrimaryHits {
-    fn trace(scene: &Scene, camera: &Camera) -> Self {
+    pub(crate) fn trace(scene: &Scene, camera: &Camera) -> Self {
         let bvh = SceneBvh::build(&scene.geometry.mesh);
         let basis = camera.basis();
         let (triangles, points) = (0..camera.height)

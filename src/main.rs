@@ -9,6 +9,7 @@ mod gpu_composite;
 mod maps;
 mod outputs;
 mod report;
+mod room;
 mod support;
 mod view;
 

@@ -129,3 +129,123 @@ fn refuses_what_cannot_be_captured() {
         "{message}"
     );
 }
+
+/// `hprt report --path` on the bundled room: every method at both ends of the path, against
+/// the room path-traced with the teapot there. By the window the fused map is closer to the
+/// truth on the teapot than the one (central) probe, whose light comes from the middle of the
+/// room.
+#[test]
+fn reports_the_model_carried_through_the_bundled_room() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cache = d.join("cache");
+    let room = scene("room.toml");
+    let args = [
+        "report",
+        room.to_str().unwrap(),
+        "--path",
+        "--positions",
+        "2",
+        "--width",
+        "96",
+        "--height",
+        "72",
+        "--spp",
+        "64",
+        "--probe-spp",
+        "8",
+        "-o",
+        "out",
+    ];
+    let out = hprt_with_env(d, &args, &[("HPRT_CACHE", cache.as_path())]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for file in [
+        "report.html",
+        "path.json",
+        "path.csv",
+        "path.gif",
+        "model_error.svg",
+        "changed_error.svg",
+        "temporal.svg",
+    ] {
+        assert!(d.join("out").join(file).is_file(), "{file}");
+    }
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("out/path.json")).unwrap()).unwrap();
+    let positions = report["per_position"].as_array().unwrap();
+    assert_eq!(positions.len(), 2);
+    assert_eq!(positions[1]["frame"], 119);
+    let methods = |p: &serde_json::Value| p["methods"].as_array().unwrap().clone();
+    for p in positions {
+        assert_eq!(p["intersects_room"], false);
+        assert!(p["model_pixels"].as_u64().unwrap() > 20, "{p}");
+        assert_eq!(methods(p).len(), 5);
+        for m in methods(p) {
+            let e = m["model"].as_f64().unwrap();
+            assert!(e.is_finite() && e > 0.0, "{m}");
+        }
+    }
+    assert!(methods(&positions[0])[0]["temporal"].is_null());
+    assert!(methods(&positions[1])[2]["temporal"].as_f64().is_some());
+    let error = |method: &str| {
+        (methods(&positions[0]).iter())
+            .find(|m| m["method"] == method)
+            .map(|m| m["model"].as_f64().unwrap())
+            .unwrap()
+    };
+    assert!(
+        error("fused") < 0.8 * error("one probe"),
+        "by the window: fused {} against one probe {}",
+        error("fused"),
+        error("one probe")
+    );
+}
+
+/// A path that carries the model into a wall is reported, in the report and on the terminal,
+/// at the positions where it passes through.
+#[test]
+fn a_path_through_a_wall_is_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cache = d.join("cache");
+    write_room(
+        d,
+        &format!("{TWO_PROBES}[path]\npoints = [[0, 0.3, 0], [0, 0.3, -2.9]]\nframes = 2\n"),
+    );
+    let vars = [("HPRT_CACHE", cache.as_path())];
+    let out = hprt_with_env(
+        d,
+        &["probes", "room.toml", "--spp", "2", "--width", "64"],
+        &vars,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let args = [
+        "report",
+        "room.toml",
+        "--path",
+        "--spp",
+        "4",
+        "--probe-spp",
+        "2",
+        "-o",
+        "out",
+    ];
+    let out = hprt_with_env(d, &args, &vars);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("passes through the room's proxies"),
+        "{}",
+        stderr(&out)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("out/path.json")).unwrap()).unwrap();
+    let through: Vec<bool> = (report["per_position"].as_array().unwrap().iter())
+        .map(|p| p["intersects_room"].as_bool().unwrap())
+        .collect();
+    assert_eq!(through, [false, true]);
+    let html = std::fs::read_to_string(d.join("out/report.html")).unwrap();
+    assert!(
+        html.contains("passes through the room's proxies at frames 1"),
+        "{html}"
+    );
+}

@@ -461,3 +461,71 @@ fn composites_a_model_into_its_environment_under_xvfb() {
     let (_, _, whole) = image_rgb(&d.join("whole.png"));
     assert_ne!(whole, shown, "the whole scene draws the ground");
 }
+
+/// The bundled room: the teapot carried along its `[path]` (played back), then placed by a
+/// script, lit afresh by the probes at each place, composited into the empty room's picture;
+/// the panel shows the room and the update's costs.
+#[test]
+fn moves_a_model_through_a_room_under_xvfb() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cache = d.join("cache");
+    std::fs::write(
+        d.join("room.script"),
+        "wait-bake\nwait 4\nstate playing.json\nset play_path off\nplace 2.2 0.4 0\nwait 2\n\
+         screenshot window.png\nstate window.json\nplace -2.2 0.4 0.3\nwait 2\n\
+         screenshot back.png\nstate back.json\nquit\n",
+    )
+    .unwrap();
+    let out = view_under_xvfb_with(
+        d,
+        &repo().join("scenes/room.toml"),
+        &[
+            "--width",
+            "960",
+            "--height",
+            "400",
+            "--script",
+            "room.script",
+        ],
+        &[("HPRT_CACHE", cache.as_path())],
+    );
+    assert!(out.status.success(), "viewer failed: {}", stderr(&out));
+    let state = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(d.join(name)).unwrap()).unwrap()
+    };
+    let (playing, window, back) = (
+        state("playing.json"),
+        state("window.json"),
+        state("back.json"),
+    );
+    assert!(
+        playing["room"]["path_frame"].as_u64().unwrap() > 0,
+        "{playing}"
+    );
+    assert_eq!(playing["room"]["probes"], 3);
+    assert_eq!(window["compositing"], true);
+    assert!(
+        window["panels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|p| p == "Room")
+    );
+    for (s, x) in [(&window, 2.2), (&back, -2.2)] {
+        let centre = s["room"]["centre"].as_array().unwrap();
+        assert!((centre[0].as_f64().unwrap() - x).abs() < 1e-5, "{s}");
+        assert!(s["room"]["fuse_ms"].as_f64().unwrap() > 0.0, "{s}");
+    }
+    // The teapot moved, and is lit by another map: the pictures differ.
+    let ((_, _, a), (_, _, b)) = (
+        image_rgb(&d.join("window.png")),
+        image_rgb(&d.join("back.png")),
+    );
+    let differing = a
+        .iter()
+        .zip(&b)
+        .filter(|(x, y)| x.abs_diff(**y) > 8)
+        .count();
+    assert!(differing > 300, "{differing} values differ");
+}

@@ -29,6 +29,18 @@ pub struct ReportArgs {
     /// scenes/README.md): per-frame and temporal errors, popping frames, an animated GIF.
     #[arg(long, conflicts_with = "envs")]
     pub env_sequence: Option<PathBuf>,
+    /// Report on the model carried along the scene's [path] through its room, lit by its
+    /// [[probe]] entries: one probe, the nearest probe, the fused local map, the true probe
+    /// and median cut on the fused map, against the room path-traced with the model at each
+    /// position (see scenes/README.md).
+    #[arg(long, conflicts_with_all = ["envs", "env_sequence", "shard"])]
+    pub path: bool,
+    /// With --path: positions of the path reported, evenly spaced with its first and last.
+    #[arg(long, default_value_t = 24, requires = "path", value_parser = clap::value_parser!(u32).range(2..=36_000))]
+    pub positions: u32,
+    /// With --path: light paths per texel of the true probes.
+    #[arg(long, default_value_t = 64, requires = "path", value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub probe_spp: u32,
     #[command(flatten)]
     pub options: ReportOptions,
     /// Output folder: report.html, stats.json, stats.csv and one folder of images per map.
@@ -51,6 +63,9 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
     let Some(output) = &args.output else {
         anyhow::bail!("hprt report needs -o");
     };
+    if args.path {
+        return write_path_report(&scene, &args, output);
+    }
     if let Some(sequence) = &args.env_sequence {
         anyhow::ensure!(
             scene.backplate.is_none(),
@@ -200,6 +215,48 @@ fn write_sequence_report(
         &transfer,
         camera,
         &settings,
+        folder.path(),
+    )?;
+    folder
+        .commit()
+        .with_context(|| format!("cannot write {}", out.display()))?;
+    println!("\nwrote {}", out.join("report.html").display());
+    Ok(())
+}
+
+/// `--path`: the model carried along the scene's `[path]` through its room.
+fn write_path_report(scene: &Scene, args: &ReportArgs, out: &Path) -> anyhow::Result<()> {
+    let options = &args.options;
+    anyhow::ensure!(
+        options.bake.is_none(),
+        "--path bakes the model and the room apart (each cached); it takes no --bake"
+    );
+    check_folder_spares_inputs(&scene_inputs(scene, &[]), "-o", out)?;
+    let Some(environment) = &scene.environment else {
+        anyhow::bail!(
+            "{} names no [environment]: the sky the room's windows see",
+            scene.path.display()
+        );
+    };
+    let map = crate::maps::load_map(&environment.map, None)?.map;
+    let rotation = crate::maps::scene_rotation(scene, None);
+    let camera = options.size.camera(scene)?;
+    let settings = report::ReportSettings {
+        thresholds: Vec::new(),
+        ..options.report_settings(&camera, scene.bake.bounces)
+    };
+    let path_options = report::path::PathOptions {
+        positions: args.positions as usize,
+        probe_spp: args.probe_spp,
+    };
+    let folder =
+        AtomicFolder::create(out).with_context(|| format!("cannot write {}", out.display()))?;
+    report::path::write_path_report(
+        scene,
+        (&map, rotation),
+        camera,
+        &settings,
+        &path_options,
         folder.path(),
     )?;
     folder

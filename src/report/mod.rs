@@ -8,6 +8,7 @@ mod composite_truth;
 mod csv;
 pub mod figures;
 mod html;
+pub mod path;
 mod results;
 pub mod sequence;
 mod settings;

@@ -170,7 +170,35 @@ impl ApplicationHandler for App {
             {
                 self.reset_view();
             }
+            WindowEvent::KeyboardInput { event, .. }
+                if !consumed && event.state == ElementState::Pressed =>
+            {
+                if let Some(offset) = model_step(&event.logical_key) {
+                    self.settings.play_path = false;
+                    self.move_model(offset);
+                }
+            }
             _ => {}
         }
     }
 }
+
+/// How far a key moves a room's model: the arrows along the floor (x, z), Page Up and Down
+/// up and down, by `MODEL_STEP`.
+fn model_step(key: &winit::keyboard::Key) -> Option<glam::Vec3> {
+    use winit::keyboard::{Key, NamedKey};
+    let Key::Named(named) = key else { return None };
+    let direction = match named {
+        NamedKey::ArrowLeft => glam::Vec3::NEG_X,
+        NamedKey::ArrowRight => glam::Vec3::X,
+        NamedKey::ArrowUp => glam::Vec3::NEG_Z,
+        NamedKey::ArrowDown => glam::Vec3::Z,
+        NamedKey::PageUp => glam::Vec3::Y,
+        NamedKey::PageDown => glam::Vec3::NEG_Y,
+        _ => return None,
+    };
+    Some(direction * MODEL_STEP)
+}
+
+/// Metres a key press moves a room's model.
+const MODEL_STEP: f32 = 0.05;

@@ -129,6 +129,9 @@ impl App {
 
     /// The decomposition (and the renderer's lighting) when anything it depends on changed.
     pub(super) fn update_lighting(&mut self) -> anyhow::Result<()> {
+        if self.room.is_some() {
+            return self.update_room();
+        }
         let (Some(env), Some(renderer)) = (
             self.lighting.environment.as_mut(),
             self.window.renderer.as_mut(),
@@ -194,12 +197,24 @@ impl App {
     /// Turns the live composite on or off as the settings ask (a scene with a backplate only),
     /// baking the proxies alone the first time.
     pub(super) fn apply_composite(&mut self) -> anyhow::Result<()> {
+        let compositing = (self.window.renderer.as_ref()).is_some_and(|r| r.is_compositing());
+        // A room's picture is made for the view: wait for the panel's first frame, which
+        // sets the view's width.
+        if self.room.is_some() && self.settings.composite && !compositing && self.stats.frames == 0
+        {
+            return Ok(());
+        }
+        let room_backplate = match self.settings.composite && !compositing {
+            true => self.room_backplate()?,
+            false => None,
+        };
         let (Some(renderer), Some(transfer)) =
             (self.window.renderer.as_mut(), self.bake.transfer.as_ref())
         else {
             return Ok(());
         };
-        let wanted = self.settings.composite && self.scene.backplate.is_some();
+        let wanted =
+            self.settings.composite && (self.scene.backplate.is_some() || self.room.is_some());
         if wanted != renderer.is_compositing() {
             if wanted {
                 let proxies = match &self.bake.proxies {
@@ -211,7 +226,10 @@ impl App {
                         p
                     }
                 };
-                let backplate = crate::gpu_composite::live_backplate(&self.scene)?;
+                let backplate = match room_backplate {
+                    Some(photograph) => photograph,
+                    None => crate::gpu_composite::live_backplate(&self.scene)?,
+                };
                 if let Err(e) =
                     renderer.enable_composite(&self.scene.geometry, &proxies, &backplate)
                 {
@@ -251,6 +269,9 @@ impl App {
         gpu.renderer_changed();
         self.window.renderer = Some(renderer);
         self.lighting.lit_for = None;
+        if let Some(room) = self.room.as_mut() {
+            room.drawn_at = None;
+        }
         Ok(())
     }
 }

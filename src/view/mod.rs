@@ -9,6 +9,8 @@
 mod events;
 mod lighting;
 mod orbit;
+mod room;
+mod room_state;
 mod script;
 mod settings;
 mod state;
@@ -79,6 +81,8 @@ pub struct App {
     panel: PanelState,
     script: ScriptState,
     stats: Stats,
+    /// The room the model moves through, when the scene has probes.
+    room: Option<room_state::RoomState>,
     error: Option<anyhow::Error>,
 }
 
@@ -156,7 +160,8 @@ fn initial_settings(
         median_cut_lights: 8,
         exposure: 1.0,
         materials: scene.geometry.objects.iter().map(|o| o.material).collect(),
-        composite: scene.backplate.is_some(),
+        composite: scene.backplate.is_some() || !scene.probes.is_empty(),
+        play_path: !scene.probes.is_empty() && scene.model_path.is_some(),
         wireframe: false,
         backplate: backplate.map(Path::to_owned),
         object_offset: glam::Vec3::ZERO,
@@ -218,9 +223,13 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         },
         script: ScriptState { commands, wait: 0 },
         stats: Stats::default(),
+        room: None,
         error: None,
     };
     app.load_environment();
+    if let Some(map) = (app.lighting.environment.as_ref()).map(|e| e.map().clone()) {
+        app.open_room(&map);
+    }
     // A scene opened for the first time bakes at once, with its progress in the panel, into
     // the cache the next opening reads.
     if app.bake.transfer.is_none() {
@@ -282,7 +291,15 @@ impl App {
                         format!("{line}\n").as_bytes(),
                     )?;
                 }
+                C::Move(offset) if self.room.is_some() => self.move_model(offset),
                 C::Move(offset) => self.move_objects(offset),
+                C::Place(centre) => {
+                    anyhow::ensure!(
+                        self.room.is_some(),
+                        "place: the scene has no room (no [[probe]] entries); use move"
+                    );
+                    self.place_model(centre);
+                }
                 C::State(path) => {
                     let json = serde_json::to_string_pretty(&self.state_json())?;
                     foundation::infra::atomic_file::write_atomic(&path, json.as_bytes())?;
@@ -373,6 +390,7 @@ impl App {
                 .as_ref()
                 .is_some_and(|r| r.is_compositing()),
             "rotation_deg": self.settings.rotation_deg,
+            "room": self.room_json(),
             "window": [camera.width, camera.height],
             "command": self.command_line(Path::new("render.png")),
             "materials": self
@@ -398,7 +416,14 @@ impl App {
         };
         PanelInfo {
             bake,
-            has_backplate: self.scene.backplate.is_some(),
+            has_backplate: self.scene.backplate.is_some() || self.room.is_some(),
+            room: self.room.as_ref().map(|r| ui::RoomInfo {
+                probes: r.model.lighting.probes().len(),
+                centre: r.centre,
+                path: (r.path_frames() > 0).then(|| (r.path_frame, r.path_frames())),
+                last: r.last.as_ref(),
+                texels: r.model.lighting.geometry().directions().len(),
+            }),
             environment: self.lighting.environment.as_ref().map(|e| e.map()),
             env_choices: &self.env_choices,
             decomposition: self.lighting.decomposition.as_ref(),
@@ -434,6 +459,7 @@ impl App {
                 self.load_environment();
             }
             PanelAction::StartBake => self.start_bake(),
+            PanelAction::MoveObjects(offset) if self.room.is_some() => self.move_model(offset),
             PanelAction::MoveObjects(offset) => self.move_objects(offset),
             PanelAction::ResetView => self.reset_view(),
             PanelAction::SaveScreenshot => {

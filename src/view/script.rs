@@ -12,7 +12,9 @@
 //! screenshot scene.png      # the rendered image, tone-mapped
 //! window-screenshot ui.png  # the whole window, panels included
 //! command render.sh         # the equivalent `hprt render` command line
-//! move 1 0 -0.5             # move the virtual objects by (dx, dy, dz) (re-baked)
+//! move 1 0 -0.5             # move the virtual objects by (dx, dy, dz) (re-baked; live in a
+//!                           # room with probes)
+//! place 1 0.4 -0.5          # a room's model: put its centre there (live)
 //! state state.json          # lights, timings and visible panels, as JSON
 //! quit
 //! ```
@@ -34,6 +36,8 @@ pub enum Command {
     State(PathBuf),
     /// Move the virtual objects (not the proxies) by this offset.
     Move(glam::Vec3),
+    /// Put the centre of a room's model here.
+    Place(glam::Vec3),
     Quit,
 }
 
@@ -78,6 +82,7 @@ pub fn parse(path: &Path, text: &str) -> anyhow::Result<Vec<Command>> {
             "window-screenshot" => Command::WindowScreenshot(path_at(1)?),
             "command" => Command::SaveRenderLine(path_at(1)?),
             "move" => Command::Move(glam::Vec3::new(number_at(1)?, number_at(2)?, number_at(3)?)),
+            "place" => Command::Place(glam::Vec3::new(number_at(1)?, number_at(2)?, number_at(3)?)),
             "state" => Command::State(path_at(1)?),
             "quit" => Command::Quit,
             _ => return Err(error("unknown command")),
@@ -94,9 +99,14 @@ mod tests {
     #[test]
     fn parses_every_command_and_reports_bad_lines() {
         let text = "# smoke\nwait 3\norbit 10 -5\npan 1 2\nzoom -1.5\nreset\nset rotation 30\n\
-                    screenshot a.png\nwindow-screenshot b.png\ncommand c.sh\nstate d.json\nquit\n";
+                    screenshot a.png\nwindow-screenshot b.png\ncommand c.sh\nstate d.json\n\
+                    place 1 0.5 -2\nquit\n";
         let commands = parse(Path::new("s.txt"), text).unwrap();
-        assert_eq!(commands.len(), 11);
+        assert_eq!(commands.len(), 12);
+        assert_eq!(
+            commands[10],
+            Command::Place(glam::Vec3::new(1.0, 0.5, -2.0))
+        );
         assert_eq!(commands[1], Command::Orbit(10.0, -5.0));
         assert_eq!(commands[5], Command::Set("rotation".into(), "30".into()));
         let err = parse(Path::new("s.txt"), "wait\n").unwrap_err().to_string();

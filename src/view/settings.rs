@@ -30,6 +30,8 @@ pub struct ViewSettings {
     pub materials: Vec<Material>,
     /// Composite into the scene's backplate (only a scene with one).
     pub composite: bool,
+    /// Play a room's `[path]` back, one frame per drawn frame.
+    pub play_path: bool,
     /// Show the proxies' edges over the composite.
     pub wireframe: bool,
     /// The `--backplate` a model was opened with (repeated in the render command line).
@@ -101,6 +103,7 @@ impl ViewSettings {
             "env" => self.env = PathBuf::from(value),
             "composite" => self.composite = switch()?,
             "wireframe" => self.wireframe = switch()?,
+            "play_path" => self.play_path = switch()?,
             _ => {
                 // `specular:N r,g,b` (or one value for all three) and `shininess:N s`, for
                 // object N (from 0).
@@ -235,6 +238,7 @@ mod tests {
             wireframe: false,
             backplate: None,
             object_offset: glam::Vec3::ZERO,
+            play_path: false,
         }
     }
 

@@ -46,6 +46,21 @@ pub struct PanelInfo<'a> {
     pub command_line: String,
     /// Each object's name and diffuse albedo (the bound on its specular).
     pub objects: Vec<(&'a str, foundation::Rgb)>,
+    /// The room the model moves through, when the scene has probes.
+    pub room: Option<RoomInfo<'a>>,
+}
+
+/// What the panel shows of a room the model moves through.
+pub struct RoomInfo<'a> {
+    pub probes: usize,
+    /// Where the centre of the model is.
+    pub centre: glam::Vec3,
+    /// `(frame, frames)` of the `[path]`.
+    pub path: Option<(usize, usize)>,
+    /// The last update: its costs and how many texels no probe saw.
+    pub last: Option<&'a runtime::ProbeFrame>,
+    /// Texels of the local map.
+    pub texels: usize,
 }
 
 /// What the user asked for in the panel.
@@ -109,6 +124,9 @@ pub fn panel(
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
                 panel.bake_section(ui);
+                if info.room.is_some() {
+                    panel.room_section(ui);
+                }
                 panel.environment_section(ui);
                 panel.decomposition_section(ui);
                 panel.shadow_section(ui);
@@ -373,6 +391,44 @@ impl Panel<'_> {
         if ui.button("Reset view (R)").clicked() {
             self.actions.push(PanelAction::ResetView);
         }
+    }
+
+    /// The room: where the model is, the path, and what each update of its lighting costs.
+    fn room_section(&mut self, ui: &mut egui::Ui) {
+        let Some(room) = &self.info.room else { return };
+        self.heading(ui, "Room");
+        let c = room.centre;
+        ui.label(format!(
+            "{} probes; the model at ({:.2}, {:.2}, {:.2})",
+            room.probes, c.x, c.y, c.z
+        ));
+        if let Some((frame, frames)) = room.path {
+            ui.checkbox(&mut self.settings.play_path, "play the path")
+                .on_hover_text("The scene's [path], one frame per drawn frame, looping");
+            ui.label(format!("path frame {frame} of {frames}"));
+        }
+        if let Some(last) = room.last {
+            ui.label(format!(
+                "local map {:.2} ms + decomposition {:.2} ms = {:.2} ms per update",
+                last.fuse_ms,
+                last.decompose_ms,
+                last.fuse_ms + last.decompose_ms
+            ))
+            .on_hover_text(
+                "The local map fused from the probes at the model's centre, then decomposed \
+                 with its lights followed (CONVENTIONS.md, \"Light probes\")",
+            );
+            ui.label(format!(
+                "{} lights; {:.1}% of texels seen by no probe",
+                last.lighting.lights.len(),
+                100.0 * last.stats.unseen as f64 / room.texels.max(1) as f64
+            ));
+        }
+        ui.label("arrow keys move the model (Page Up/Down: up and down)");
+        ui.label(
+            "the empty room's picture is path-traced for the view as the composite turns on: \
+             turn it off and on after moving the camera",
+        );
     }
 
     fn composite_section(&mut self, ui: &mut egui::Ui) {

@@ -64,7 +64,8 @@ impl Scene {
                 env.rotation_deg
             )));
         }
-        let backplate = check_roles(&geometry, file.backplate.as_ref()).map_err(invalid)?;
+        let backplate = check_roles(&geometry, file.backplate.as_ref(), !file.probes.is_empty())
+            .map_err(invalid)?;
         let backplate = backplate.map(|b| b.resolve(dir));
         let probes: Vec<ProbeSource> = (file.probes.iter().enumerate())
             .map(|(index, probe)| probe.resolve(dir, index))
@@ -107,10 +108,12 @@ impl Scene {
 }
 
 /// Checks that a scene's proxies and backplate go together: proxies need a backplate to be
-/// composited into, and something virtual to composite. Returns the backplate.
+/// composited into, or probes (then they are the room the probes light, drawn as they are),
+/// and something virtual to composite. Returns the backplate.
 fn check_roles<'a>(
     geometry: &SceneMesh,
     backplate: Option<&'a BackplateSpec>,
+    has_probes: bool,
 ) -> Result<Option<&'a BackplateSpec>, String> {
     let proxies = geometry.has_proxies();
     if proxies && geometry.objects.iter().all(|o| o.role == ObjectRole::Proxy) {
@@ -121,10 +124,10 @@ fn check_roles<'a>(
         );
     }
     match backplate {
-        None if proxies => Err(
+        None if proxies && !has_probes => Err(
             "the scene has proxies (role = \"proxy\") but no [backplate] to \
-                                composite into: add [backplate] with image = \"environment\" or \
-                                a photograph"
+                                composite into (nor [[probe]] entries, which make them a room): \
+                                add [backplate] with image = \"environment\" or a photograph"
                 .into(),
         ),
         Some(b) if b.image.trim().is_empty() => {

@@ -15,7 +15,7 @@ pub use description::{
     ProbeSpec, Scale, SceneFile, Transform,
 };
 pub use geometry::{NO_TEXTURE, SceneMesh, SceneObject};
-pub use path::{Crossing, ModelPath, PathSpec};
+pub use path::{Crossing, ModelPath, PathSpec, mesh_crosses};
 
 use crate::bake_settings::BakeSettings;
 use crate::camera::Camera;
@@ -131,6 +131,9 @@ mod tests {
             },
         ];
         assert_eq!(scene.probes, expected);
+        // Probes make the proxies a room, drawn as it is: no backplate needed.
+        let room_only = load(format!("{CAMERA}{object}{room}{probes}")).unwrap();
+        assert_eq!((room_only.backplate, room_only.probes.len()), (None, 2));
 
         let error = |text: String| load(text).unwrap_err().to_string();
         let outside = "[[probe]]\nname = \"yard\"\nposition = [9, 1, 0]\n";

@@ -3,6 +3,7 @@
 
 use crate::bvh::{SceneBvh, Skip};
 use crate::infra::limits::MAX_PATH_FRAMES;
+use crate::mesh::TriangleMesh;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -115,6 +116,25 @@ impl ModelPath {
     }
 }
 
+/// Whether `mesh` passes through the proxies: one of its edges crosses a proxy's surface
+/// between its ends (a model carried through a wall, or sunk into the floor; one resting on
+/// the floor touches it only at its ends).
+pub fn mesh_crosses(mesh: &TriangleMesh, proxies: &SceneBvh) -> bool {
+    mesh.triangles.iter().any(|t| {
+        (0..3).any(|e| {
+            let a = mesh.positions[t[e] as usize];
+            let step = mesh.positions[t[(e + 1) % 3] as usize] - a;
+            let length = step.length();
+            let (near, far) = (TOUCH * length, (1.0 - TOUCH) * length);
+            step.try_normalize()
+                .is_some_and(|d| (proxies.closest_hit(a, d, near, far, Skip::Nothing)).is_some())
+        })
+    })
+}
+
+/// The share of an edge at each end where meeting a proxy is touching it, not crossing.
+const TOUCH: f32 = 1e-3;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -185,5 +205,35 @@ mod tests {
         );
         let beside = path(&[[-1.0, 1.0, 0.0], [-0.5, 1.0, 1.0]], 11).unwrap();
         assert!(beside.crossings(&proxies).is_empty());
+        // A model: a small box, clear of the wall, then through it.
+        let model = |x: f32| {
+            let lo = Vec3::new(x - 0.2, 0.5, -0.2);
+            box_mesh(lo, lo + Vec3::splat(0.4), [1; 3], [false; 6])
+        };
+        assert!(!mesh_crosses(&model(-0.5), &proxies));
+        // Resting on the floor is not passing through it.
+        let floor = box_mesh(
+            Vec3::new(-3.0, -0.2, -3.0),
+            Vec3::new(3.0, 0.0, 3.0),
+            [1; 3],
+            [false; 6],
+        );
+        let resting = box_mesh(
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(1.4, 0.4, 1.4),
+            [2; 3],
+            [false; 6],
+        );
+        let sunk = box_mesh(
+            Vec3::new(1.0, -0.1, 1.0),
+            Vec3::new(1.4, 0.3, 1.4),
+            [2; 3],
+            [false; 6],
+        );
+        let floor = SceneBvh::build(&floor);
+        assert!(!mesh_crosses(&resting, &floor));
+        assert!(mesh_crosses(&sunk, &floor));
+        assert!(mesh_crosses(&model(-0.2), &proxies));
+        assert!(mesh_crosses(&model(0.0), &proxies));
     }
 }

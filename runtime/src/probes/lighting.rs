@@ -56,6 +56,11 @@ impl ProbeLighting {
         })
     }
 
+    /// The decomposition's settings.
+    pub fn settings(&self) -> &DecomposeSettings {
+        &self.settings
+    }
+
     pub fn probes(&self) -> &[Probe] {
         &self.probes
     }

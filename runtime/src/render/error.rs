@@ -28,10 +28,11 @@ pub enum BakeMismatch {
     #[error("the transfer ({mb} MB) exceeds the adapter's storage buffer limit ({limit_mb} MB)")]
     TooLarge { mb: usize, limit_mb: usize },
     #[error(
-        "the proxies' bake has {bake} vertices and SH order {bake_order}; the scene's proxies \
+        "the {part}' bake has {bake} vertices and SH order {bake_order}; the scene's {part} \
          have {scene} vertices and its bake order {scene_order}"
     )]
-    Proxies {
+    Part {
+        part: &'static str,
         bake: usize,
         bake_order: usize,
         scene: usize,

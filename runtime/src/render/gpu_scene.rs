@@ -86,6 +86,18 @@ pub(crate) const PROXY_FLAG_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::Ve
     attributes: &wgpu::vertex_attr_array![9 => Float32],
 };
 
+fn vertices(geometry: &SceneMesh) -> Vec<Vertex> {
+    let mesh = &geometry.mesh;
+    (0..mesh.vertex_count())
+        .map(|v| Vertex {
+            position: mesh.positions[v].to_array(),
+            normal: mesh.normals[v].to_array(),
+            albedo: geometry.albedo[v].to_array(),
+            uv: mesh.uvs.get(v).map_or([0.0; 2], |uv| uv.to_array()),
+        })
+        .collect()
+}
+
 impl GpuScene {
     pub(crate) fn new(
         device: &wgpu::Device,
@@ -96,14 +108,7 @@ impl GpuScene {
         let mesh = &geometry.mesh;
         let order = transfer.settings.order;
         check_bake(device, mesh.vertex_count(), transfer)?;
-        let vertices: Vec<Vertex> = (0..mesh.vertex_count())
-            .map(|v| Vertex {
-                position: mesh.positions[v].to_array(),
-                normal: mesh.normals[v].to_array(),
-                albedo: geometry.albedo[v].to_array(),
-                uv: mesh.uvs.get(v).map_or([0.0; 2], |uv| uv.to_array()),
-            })
-            .collect();
+        let vertices = vertices(geometry);
         let init = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -114,7 +119,7 @@ impl GpuScene {
         let vertex_buffer = init(
             "vertices",
             bytemuck::cast_slice(&vertices),
-            wgpu::BufferUsages::VERTEX,
+            wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
         );
         let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
         let index_buffer = init(
@@ -168,6 +173,17 @@ impl GpuScene {
             bounds: mesh.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE)),
             transfer_pass,
         })
+    }
+
+    /// Uploads `geometry`'s vertices in place of the scene's (the same scene, its objects
+    /// moved), and its bounds.
+    pub(crate) fn write_vertices(&mut self, queue: &wgpu::Queue, geometry: &SceneMesh) {
+        queue.write_buffer(
+            &self.vertex_buffer,
+            0,
+            bytemuck::cast_slice(&vertices(geometry)),
+        );
+        self.bounds = geometry.mesh.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
     }
 
     /// Uploads `lighting` and records the pass that recomputes every vertex's radiance.

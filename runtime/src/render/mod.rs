@@ -37,8 +37,8 @@ mod transfer_pass;
 mod uniforms;
 
 use crate::lighting::ShTransfer;
-pub use composite::LiveBackplate;
 use composite::{Compositor, CompositorSource};
+pub use composite::{LiveBackplate, separate_transfer};
 pub use display_pass::{DisplayPass, capture_target};
 use environment_texture::EnvironmentTexture;
 use error::checked;
@@ -213,6 +213,28 @@ impl Renderer {
         })?;
         self.composite = Some(compositor);
         // The shadow-map array gains the proxies' own maps.
+        self.shadow_maps.invalidate();
+        Ok(())
+    }
+
+    /// Draws the same scene with `geometry`'s vertex positions: its objects moved rigidly (a
+    /// model carried through a room keeps its bake when it is a translation: its transfer
+    /// does not depend on where it is, see `separate_transfer`). The shadow maps are drawn
+    /// again; the triangles and the bake stay.
+    pub fn move_vertices(&mut self, geometry: &SceneMesh) -> Result<(), RenderError> {
+        let moved = geometry.mesh.vertex_count() as u32;
+        if moved != self.scene.vertex_count {
+            return Err(InvalidSettings::new(
+                "geometry",
+                format!(
+                    "the moved scene has {moved} vertices, the drawn one {}",
+                    self.scene.vertex_count
+                ),
+            )
+            .into());
+        }
+        self.scene.write_vertices(&self.queue, geometry);
+        self.bounds = BoundingSphere::of_box(self.scene.bounds.0, self.scene.bounds.1);
         self.shadow_maps.invalidate();
         Ok(())
     }

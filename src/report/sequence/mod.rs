@@ -5,9 +5,9 @@
 //! follows the sun. Writes `report.html` (plots and an animated GIF of hybrid | prt |
 //! reference), `sequence.json`, `sequence.csv`, the plots as SVG and the GIF.
 
-mod output;
+pub(in crate::report) mod output;
 mod results;
-mod temporal;
+pub(in crate::report) mod temporal;
 
 use super::stats::error_stats;
 use super::{ReferenceImages, ReferenceRequest, ReportSettings, reference_images};

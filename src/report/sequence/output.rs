@@ -10,7 +10,7 @@ use std::fmt::Write;
 use std::path::Path;
 
 /// Tone-mapped images next to each other, as 8-bit RGB rows.
-pub(super) fn side_by_side(images: &[&RgbImageF32], exposure: f32) -> Vec<u8> {
+pub(in crate::report) fn side_by_side(images: &[&RgbImageF32], exposure: f32) -> Vec<u8> {
     let parts: Vec<Vec<u8>> = images
         .iter()
         .map(|image| to_display_rgb8(image, exposure))

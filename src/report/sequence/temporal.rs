@@ -13,7 +13,7 @@ pub const POP_SPIKE: f64 = 2.0;
 pub const POP_FLOOR: f64 = 0.002;
 
 /// Tone-mapped luminance of every pixel.
-pub(super) fn tonemapped_luminance(image: &RgbImageF32, exposure: f32) -> Vec<f32> {
+pub(in crate::report) fn tonemapped_luminance(image: &RgbImageF32, exposure: f32) -> Vec<f32> {
     image
         .pixels
         .iter()
@@ -23,7 +23,7 @@ pub(super) fn tonemapped_luminance(image: &RgbImageF32, exposure: f32) -> Vec<f3
 
 /// Temporal error of a method's frame: the mean over covered pixels of how much its change
 /// differs from the reference's.
-pub(super) fn temporal(
+pub(in crate::report) fn temporal(
     now: &[f32],
     before: &[f32],
     reference_now: &[f32],
@@ -49,7 +49,7 @@ const POP_WINDOW: usize = 3;
 /// when its temporal error is a spike against its neighbours' (the median of up to
 /// `POP_WINDOW` frames on each side), so that a sequence whose motion speeds up or slows down
 /// pops nowhere, while a light appearing at once does.
-pub(super) fn mark_popping(temporal: &[Option<f64>]) -> Vec<bool> {
+pub(in crate::report) fn mark_popping(temporal: &[Option<f64>]) -> Vec<bool> {
     (0..temporal.len())
         .map(|t| {
             let Some(value) = temporal[t] else {

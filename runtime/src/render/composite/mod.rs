@@ -61,17 +61,53 @@ fn without_transfer(
     proxies: &Transfer,
     order: usize,
 ) -> Result<Transfer, BakeMismatch> {
+    spread_over(geometry, ObjectRole::Proxy, proxies, order)
+}
+
+/// The transfer of a model that moves through a room: the objects' own bake (the objects
+/// alone: they do not see the room, whose light reaches them through the local map, which
+/// already holds it) on their vertices, and the proxies' own bake (the room alone: the
+/// objects darken it only through the lights' shadow maps, which move with them) on theirs.
+/// Neither depends on where the objects are, so moving them keeps it.
+pub fn separate_transfer(
+    geometry: &SceneMesh,
+    objects: &Transfer,
+    proxies: &Transfer,
+) -> Result<Transfer, BakeMismatch> {
+    let order = objects.settings.order;
+    let on_objects = spread_over(geometry, ObjectRole::Object, objects, order)?;
+    let on_proxies = spread_over(geometry, ObjectRole::Proxy, proxies, order)?;
+    Ok(Transfer {
+        settings: objects.settings,
+        direct: on_objects.direct.sum(&on_proxies.direct),
+        indirect: on_objects.indirect.sum(&on_proxies.indirect),
+        textured_vertices: objects.textured_vertices + proxies.textured_vertices,
+    })
+}
+
+/// `part`'s bake (of [`SceneMesh::subset`] of the objects with `role`, whose vertices are
+/// theirs in scene order) on those vertices of the whole scene, zero elsewhere.
+fn spread_over(
+    geometry: &SceneMesh,
+    role: ObjectRole,
+    part: &Transfer,
+    order: usize,
+) -> Result<Transfer, BakeMismatch> {
     let parts: Vec<Range<usize>> = geometry
         .objects
         .iter()
-        .filter(|o| o.role == ObjectRole::Proxy)
+        .filter(|o| o.role == role)
         .map(|o| o.vertices.start as usize..o.vertices.end as usize)
         .collect();
     let count: usize = parts.iter().map(|r| r.len()).sum();
-    if proxies.direct.vertex_count() != count || proxies.settings.order != order {
-        return Err(BakeMismatch::Proxies {
-            bake: proxies.direct.vertex_count(),
-            bake_order: proxies.settings.order,
+    if part.direct.vertex_count() != count || part.settings.order != order {
+        return Err(BakeMismatch::Part {
+            part: match role {
+                ObjectRole::Object => "objects",
+                ObjectRole::Proxy => "proxies",
+            },
+            bake: part.direct.vertex_count(),
+            bake_order: part.settings.order,
             scene: count,
             scene_order: order,
         });
@@ -89,10 +125,10 @@ fn without_transfer(
         out
     };
     Ok(Transfer {
-        settings: proxies.settings,
-        direct: spread(&proxies.direct),
-        indirect: spread(&proxies.indirect),
-        textured_vertices: proxies.textured_vertices,
+        settings: part.settings,
+        direct: spread(&part.direct),
+        indirect: spread(&part.indirect),
+        textured_vertices: part.textured_vertices,
     })
 }
 

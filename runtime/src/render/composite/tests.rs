@@ -77,6 +77,32 @@ fn the_proxies_bake_lands_on_their_vertices_and_objects_get_none() {
 }
 
 #[test]
+fn separate_bakes_land_on_their_own_vertices() {
+    let geometry = scene();
+    let (objects, mut proxies) = (bake(8, 2), bake(8, 2));
+    for x in proxies.direct.as_mut_slice() {
+        *x = -*x;
+    }
+    let whole = separate_transfer(&geometry, &objects, &proxies).expect("matching bakes");
+    assert_eq!(whole.direct.vertex_count(), 16);
+    for v in 0..16 {
+        // Parts 0 and 2 are objects, 1 and 3 proxies; each part has four vertices.
+        let (part, k) = (v / 4, v % 4);
+        let (bake, at) = match part {
+            0 => (&objects, k),
+            1 => (&proxies, k),
+            2 => (&objects, 4 + k),
+            _ => (&proxies, 4 + k),
+        };
+        for c in 0..3 {
+            assert_eq!(whole.direct.vector(v, c), bake.direct.vector(at, c), "{v}");
+        }
+    }
+    assert!(separate_transfer(&geometry, &bake(7, 2), &proxies).is_err());
+    assert!(separate_transfer(&geometry, &objects, &bake(8, 3)).is_err());
+}
+
+#[test]
 fn a_proxies_bake_of_another_scene_is_refused() {
     let geometry = scene();
     assert!(without_transfer(&geometry, &bake(7, 2), 2).is_err());

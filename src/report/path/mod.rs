@@ -1,0 +1,427 @@
+//! Reports on a model carried along a room's `[path]` (`hprt report SCENE --path`): at each
+//! position, the room path-traced with the model there (the truth), and the hybrid lit by
+//! one probe, the nearest probe, the local map fused from every probe, the true probe at the
+//! model's centre, and median cut on the fused map; each composited into the empty room's
+//! truth the same way (the model drawn, the room changed by its shadows: `crate::room`).
+//! Errors over the model and over the region it changes, per position and along the path;
+//! temporal error, popping positions, an animated GIF, and where the model passes through a
+//! proxy.
+
+mod output;
+mod results;
+
+use super::sequence::output::side_by_side;
+use super::sequence::temporal::{temporal, tonemapped_luminance};
+use super::stats::error_image;
+use super::{ReferenceImages, ReferenceRequest, ReportSettings, reference_images};
+use crate::gpu_composite::PrimaryHits;
+use crate::maps::default_exposure;
+use crate::room::RoomModel;
+use anyhow::Context;
+use foundation::camera::Camera;
+use foundation::envmap::EnvMap;
+use foundation::image_io::{RgbImageF32, check_finite};
+use foundation::probe::Probe;
+use foundation::scene::{ObjectRole, Scene, SceneMesh, mesh_crosses};
+use glam::Vec3;
+use reference::composite::{PixelKind, composite, pixel_kinds};
+use results::{PathMethod, PathPosition, PositionResult, summarise};
+use runtime::render::{FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
+use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting, TrackingSettings};
+use std::path::Path;
+
+/// Median-cut lights of the fusion thesis' own method.
+const MEDIAN_CUT_LIGHTS: usize = 32;
+
+/// What a path report measures besides the report's own settings.
+pub struct PathOptions {
+    /// Positions of the path reported (evenly spaced, first and last included); all its
+    /// frames when it has fewer.
+    pub positions: usize,
+    /// Paths per texel of the true probes.
+    pub probe_spp: u32,
+}
+
+/// Writes the report on `scene`'s `[path]` into `out`: `map` is the scene's sky, turned by
+/// `rotation_deg`.
+pub fn write_path_report(
+    scene: &Scene,
+    (map, rotation_deg): (&EnvMap, f32),
+    camera: Camera,
+    settings: &ReportSettings,
+    options: &PathOptions,
+    out: &Path,
+) -> anyhow::Result<()> {
+    let sky = map.rotated(rotation_deg);
+    let decompose = DecomposeSettings::for_mode(DecomposeMode::Consistent, scene.bake.order);
+    let model = RoomModel::open(scene, sky, decompose.clone())?;
+    let Some(path) = model.path.clone() else {
+        anyhow::bail!(
+            "{}: the report on a model's path needs a [path] in the scene",
+            scene.path.display()
+        );
+    };
+    let gpu = GpuContext::headless(settings.backend)?;
+    println!("adapter: {}", gpu.description());
+    let mut run = PathRun::new(scene, model, &gpu, (map, rotation_deg), &camera, settings)?;
+    run.lightings = Some(MethodLightings::new(
+        run.model.lighting.probes(),
+        run.one_probe,
+        decompose,
+    )?);
+    let positions = path.positions();
+    let frames = pick_frames(positions.len(), options.positions);
+    let (mut per_position, mut gif) = (Vec::new(), Vec::new());
+    for (n, &frame) in frames.iter().enumerate() {
+        let (position, images) = run.position(frame, positions[frame], options.probe_spp)?;
+        println!(
+            "position {n}/{} (frame {frame}): {}",
+            frames.len() - 1,
+            position_line(&position)
+        );
+        if position.intersects_room {
+            eprintln!(
+                "warning: {}: at frame {frame} the model ({}) passes through the room's proxies",
+                scene.path.display(),
+                positions[frame]
+            );
+        }
+        gif.push(side_by_side(
+            &images.iter().collect::<Vec<_>>(),
+            run.exposure,
+        ));
+        per_position.push(position);
+    }
+    let report = summarise(
+        scene.path.display().to_string(),
+        settings,
+        options.probe_spp,
+        per_position,
+    );
+    let gif_size = (camera.width * 4, camera.height);
+    output::write_outputs(&report, &gif, gif_size, out)?;
+    output::print_summary(&report);
+    Ok(())
+}
+
+/// `count` frames of `frames`, evenly spaced with the first and the last (all of them when
+/// there are fewer).
+fn pick_frames(frames: usize, count: usize) -> Vec<usize> {
+    if count >= frames || frames < 2 {
+        return (0..frames).collect();
+    }
+    let count = count.max(2);
+    (0..count)
+        .map(|k| (k * (frames - 1) + (count - 1) / 2) / (count - 1))
+        .collect()
+}
+
+/// The renderers, the truth's fixed parts and each method's lighting, from position to
+/// position.
+struct PathRun {
+    scene: Scene,
+    model: RoomModel,
+    room_geometry: SceneMesh,
+    camera: Camera,
+    /// The model and the room, with separate bakes (`crate::room`); the room alone.
+    whole: Renderer,
+    room: Renderer,
+    map: EnvMap,
+    rotation_deg: f32,
+    /// The empty room's truth: what is composited into, and the truth without the model.
+    empty: ReferenceImages,
+    request: ReferenceRequest,
+    exposure: f32,
+    /// The probe nearest the room's centre.
+    one_probe: usize,
+    lightings: Option<MethodLightings>,
+    previous: Option<Previous>,
+}
+
+/// The last position's tone-mapped luminance, the truth's and each method's, and the pixels
+/// the model covered or changed there.
+struct Previous {
+    truth: Vec<f32>,
+    methods: Vec<Vec<f32>>,
+    covered: Vec<bool>,
+}
+
+impl PathRun {
+    fn new(
+        scene: &Scene,
+        model: RoomModel,
+        gpu: &GpuContext,
+        (map, rotation_deg): (&EnvMap, f32),
+        camera: &Camera,
+        settings: &ReportSettings,
+    ) -> anyhow::Result<Self> {
+        let shadow = ShadowSettings::default();
+        let room_geometry = scene.geometry.subset(|o| o.role == ObjectRole::Proxy);
+        let mut whole = Renderer::new(gpu, &model.geometry, &model.transfer, camera, shadow)?;
+        let mut room = Renderer::new(gpu, &room_geometry, &model.room_transfer, camera, shadow)?;
+        whole.set_environment(map, rotation_deg);
+        room.set_environment(map, rotation_deg);
+        let probes = model.lighting.probes();
+        let room_centre = (room_geometry.mesh.bounds()).map_or(Vec3::ZERO, |(a, b)| 0.5 * (a + b));
+        let one_probe = nearest(probes, room_centre);
+        // The room's own light sets the exposure, as the map's does for a model in the open.
+        let exposure = default_exposure(&probes[one_probe].radiance);
+        let request = ReferenceRequest {
+            target_noise: None,
+            ..settings.reference_request(exposure)
+        };
+        let room_scene = Scene {
+            geometry: room_geometry.clone(),
+            backplate: None,
+            ..scene.clone()
+        };
+        let no_limit = |_: &ReferenceImages| f64::INFINITY;
+        let empty = reference_images(&room_scene, camera, map, rotation_deg, &request, &no_limit)
+            .context("cannot render the empty room's truth")?;
+        Ok(Self {
+            scene: scene.clone(),
+            model,
+            room_geometry,
+            camera: *camera,
+            whole,
+            room,
+            map: map.clone(),
+            rotation_deg,
+            empty,
+            request,
+            exposure,
+            one_probe,
+            lightings: None,
+            previous: None,
+        })
+    }
+
+    /// Measures every method with the model's centre at `centre` (the path's `frame`);
+    /// returns the results and the images of the GIF.
+    fn position(
+        &mut self,
+        frame: usize,
+        centre: Vec3,
+        probe_spp: u32,
+    ) -> anyhow::Result<(PathPosition, [RgbImageF32; 4])> {
+        let geometry = self.model.placed(centre);
+        let truth = self.truth_at(&geometry)?;
+        let kinds = pixel_kinds(
+            &geometry,
+            &PrimaryHits::trace(&self.scene_with(&geometry), &self.camera).triangles,
+        );
+        let empty = &self.empty.radiance;
+        let changed = composite(&kinds, &truth.radiance, empty, empty).changed;
+        let on_model: Vec<bool> = kinds.iter().map(|k| *k == PixelKind::Object).collect();
+        let true_probe = self.true_probe(centre, probe_spp);
+        self.whole.move_vertices(&geometry)?;
+        let lightings = (self.lightings.as_mut())
+            .context("the methods' lighting is not set up")?
+            .at(&mut self.model, centre, &true_probe)?;
+        let mut covered: Vec<bool> = (on_model.iter().zip(&changed))
+            .map(|(a, b)| *a || *b)
+            .collect();
+        if let Some(before) = &self.previous {
+            (covered.iter_mut().zip(&before.covered)).for_each(|(c, b)| *c |= *b);
+        }
+        let truth_y = tonemapped_luminance(&truth.radiance, self.exposure);
+        let (mut results, mut ys, mut images) = (Vec::new(), Vec::new(), Vec::new());
+        for (m, lighting) in lightings.iter().enumerate() {
+            let image = self.composite_with(&kinds, lighting)?;
+            check_finite(&image, "frame").map_err(|e| {
+                anyhow::anyhow!("frame {frame}, {}: {e}", PathMethod::ALL[m].name())
+            })?;
+            let errors = error_image(&image, &truth.radiance, self.exposure);
+            let y = tonemapped_luminance(&image, self.exposure);
+            let temporal = (self.previous.as_ref())
+                .map(|before| temporal(&y, &before.methods[m], &truth_y, &before.truth, &covered));
+            results.push(PositionResult {
+                method: PathMethod::ALL[m].name().to_owned(),
+                model: masked_mean(&errors, &on_model),
+                changed: masked_mean(&errors, &changed),
+                temporal,
+                popping: false,
+                lights: lighting.lights.len(),
+            });
+            ys.push(y);
+            images.push(image);
+        }
+        let model_mesh = geometry.subset(|o| o.role == ObjectRole::Object).mesh;
+        let position = PathPosition {
+            frame,
+            centre: centre.to_array(),
+            intersects_room: mesh_crosses(&model_mesh, self.model.lighting.proxies()),
+            model_pixels: on_model.iter().filter(|c| **c).count(),
+            changed_pixels: changed.iter().filter(|c| **c).count(),
+            methods: results,
+        };
+        let here: Vec<bool> = (on_model.iter().zip(&changed))
+            .map(|(a, b)| *a || *b)
+            .collect();
+        self.previous = Some(Previous {
+            truth: truth_y,
+            methods: ys,
+            covered: here,
+        });
+        let mut images = images.into_iter();
+        let mut next = || images.next().unwrap_or_else(|| truth.radiance.clone());
+        let (one, nearest, fused) = (next(), next(), next());
+        Ok((position, [one, nearest, fused, truth.radiance.clone()]))
+    }
+
+    fn scene_with(&self, geometry: &SceneMesh) -> Scene {
+        Scene {
+            geometry: geometry.clone(),
+            backplate: None,
+            ..self.scene.clone()
+        }
+    }
+
+    /// The room path-traced with the model placed as in `geometry`.
+    fn truth_at(&self, geometry: &SceneMesh) -> anyhow::Result<ReferenceImages> {
+        let scene = self.scene_with(geometry);
+        let no_limit = |_: &ReferenceImages| f64::INFINITY;
+        let (map, rotation) = (&self.map, self.rotation_deg);
+        reference_images(
+            &scene,
+            &self.camera,
+            map,
+            rotation,
+            &self.request,
+            &no_limit,
+        )
+    }
+
+    /// The probe path-traced at `centre` in the empty room, at the scene's probes' size.
+    fn true_probe(&self, centre: Vec3, spp: u32) -> Probe {
+        let probes = self.model.lighting.probes();
+        let size = (probes[0].radiance.width(), probes[0].radiance.height());
+        let light = reference::EnvironmentLight::new(&self.map, self.rotation_deg);
+        let settings = reference::ReferenceSettings::new(spp, self.request.bounces, 0);
+        let proxies = self.model.lighting.proxies();
+        let no_progress = &foundation::infra::progress::NoProgress;
+        let room = &self.room_geometry;
+        reference::render_probe(room, proxies, &light, centre, size, &settings, no_progress).0
+    }
+
+    /// The model and the room drawn with `lighting`, the room alone too, composited into the
+    /// empty room's truth.
+    fn composite_with(
+        &mut self,
+        kinds: &[PixelKind],
+        lighting: &FrameLighting,
+    ) -> anyhow::Result<RgbImageF32> {
+        let draw = |renderer: &mut Renderer| -> anyhow::Result<RgbImageF32> {
+            renderer.set_lighting(lighting)?;
+            renderer.render()?;
+            Ok(renderer.read_back()?)
+        };
+        let with = draw(&mut self.whole)?;
+        let without = draw(&mut self.room)?;
+        Ok(composite(kinds, &with, &without, &self.empty.radiance).image)
+    }
+}
+
+/// The index of the probe nearest `p`.
+fn nearest(probes: &[Probe], p: Vec3) -> usize {
+    (0..probes.len())
+        .min_by(|a, b| {
+            let d = |i: &usize| probes[*i].position.distance(p);
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap_or(0)
+}
+
+/// The mean of `values` where `mask` holds (0 where it never does).
+fn masked_mean(values: &[f32], mask: &[bool]) -> f64 {
+    let (sum, count) = (values.iter().zip(mask))
+        .filter(|(_, m)| **m)
+        .fold((0.0f64, 0usize), |(s, c), (v, _)| (s + *v as f64, c + 1));
+    sum / count.max(1) as f64
+}
+
+/// The lighting of the methods other than the fused map's own (which `RoomModel` follows):
+/// each a map decomposed with the lights followed from position to position.
+struct MethodLightings {
+    one: EnvironmentLighting,
+    nearest: EnvironmentLighting,
+    nearest_index: usize,
+    truth: EnvironmentLighting,
+    median_cut: EnvironmentLighting,
+}
+
+impl MethodLightings {
+    fn new(probes: &[Probe], one: usize, settings: DecomposeSettings) -> anyhow::Result<Self> {
+        let tracked = |map: &EnvMap| -> anyhow::Result<EnvironmentLighting> {
+            let mut lighting = EnvironmentLighting::new(map, settings.clone())?;
+            lighting.enable_tracking(Some(TrackingSettings::default()))?;
+            Ok(lighting)
+        };
+        let mut median_cut = EnvironmentLighting::new(&probes[one].radiance, settings.clone())?;
+        median_cut.set_median_cut_lights(MEDIAN_CUT_LIGHTS)?;
+        Ok(Self {
+            one: tracked(&probes[one].radiance)?,
+            nearest: tracked(&probes[one].radiance)?,
+            nearest_index: one,
+            truth: tracked(&probes[one].radiance)?,
+            median_cut,
+        })
+    }
+
+    /// Every method's lighting at `centre`, in [`PathMethod::ALL`]'s order.
+    fn at(
+        &mut self,
+        model: &mut RoomModel,
+        centre: Vec3,
+        true_probe: &Probe,
+    ) -> anyhow::Result<Vec<FrameLighting>> {
+        let probes = model.lighting.probes();
+        let near = nearest(probes, centre);
+        if near != self.nearest_index {
+            self.nearest.set_map(probes[near].radiance.clone());
+            self.nearest_index = near;
+        }
+        let (cube, _) = model.lighting.local_map(centre);
+        let geometry = model.lighting.geometry();
+        let (w, h) = (true_probe.radiance.width(), true_probe.radiance.height());
+        let fused_map = EnvMap::from_fn(w, h, 1, |d| cube.texels()[geometry.texel_of(d)]);
+        self.median_cut.set_map(fused_map);
+        self.truth.set_map(true_probe.radiance.clone());
+        let (fused, _) = model.update(centre);
+        let hybrid = |l: &mut EnvironmentLighting| l.frame(RenderMode::Hybrid, None).lighting;
+        Ok(vec![
+            hybrid(&mut self.one),
+            hybrid(&mut self.nearest),
+            fused,
+            hybrid(&mut self.truth),
+            (self.median_cut.frame(RenderMode::MedianCut, None)).lighting,
+        ])
+    }
+}
+
+/// One position's model errors, for the terminal.
+fn position_line(position: &PathPosition) -> String {
+    (position.methods.iter())
+        .map(|r| format!("{} {:.4}", r.method, r.model))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_are_picked_evenly_with_both_ends() {
+        assert_eq!(pick_frames(120, 5), [0, 30, 60, 89, 119]);
+        assert_eq!(pick_frames(4, 10), [0, 1, 2, 3]);
+        assert_eq!(pick_frames(120, 2), [0, 119]);
+        assert_eq!(pick_frames(120, 1), [0, 119]);
+    }
+
+    #[test]
+    fn masked_means_count_only_the_mask() {
+        assert_eq!(masked_mean(&[1.0, 3.0, 100.0], &[true, true, false]), 2.0);
+        assert_eq!(masked_mean(&[1.0], &[false]), 0.0);
+    }
+}

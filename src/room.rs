@@ -1,0 +1,100 @@
+//! A model carried through a room lit by light probes: what the viewer and `hprt report
+//! --path` share. The model and the room are baked apart (`runtime::render::separate_transfer`),
+//! so moving the model keeps both bakes; at each position the local map at the model's centre
+//! is fused from the probes (`runtime::ProbeLighting`), decomposed with its lights followed
+//! from the previous position, and lights the frame: the model through its own transfer, the
+//! room's change (the model's shadows) through the lights' shadow maps.
+
+use crate::bake_cache::bake_for;
+use anyhow::Context;
+use foundation::bvh::SceneBvh;
+use foundation::envmap::EnvMap;
+use foundation::probe::Probe;
+use foundation::scene::{ModelPath, ObjectRole, Scene, SceneMesh};
+use glam::Vec3;
+use precompute::bake::Transfer;
+use runtime::render::{FrameLighting, RenderMode, separate_transfer};
+use runtime::{DecomposeSettings, ProbeFrame, ProbeLighting, TrackingSettings};
+
+/// A scene's room (its proxies and probes) and the model (its objects) that moves through it.
+pub struct RoomModel {
+    /// The scene's geometry, the objects where the scene places them.
+    pub geometry: SceneMesh,
+    /// Each part's own bake on its vertices of `geometry`.
+    pub transfer: Transfer,
+    /// The room alone (the composite's proxies without the objects).
+    pub room_transfer: Transfer,
+    pub lighting: ProbeLighting,
+    /// Centre of the objects' bounds where the scene places them.
+    pub centre: Vec3,
+    /// The scene's `[path]`, if any.
+    pub path: Option<ModelPath>,
+}
+
+impl RoomModel {
+    /// The room and model of `scene`, its probes loaded (their distances traced where not
+    /// given), lit under `sky` (the scene's map, turned by its rotation); both parts baked
+    /// with the scene's `[bake]` settings, or taken from the cache.
+    pub fn open(scene: &Scene, sky: EnvMap, settings: DecomposeSettings) -> anyhow::Result<Self> {
+        anyhow::ensure!(
+            !scene.probes.is_empty(),
+            "{}: a model moves through a room lit by its [[probe]] entries, and it has none",
+            scene.path.display()
+        );
+        let part = |role: ObjectRole, suffix: &str| Scene {
+            name: format!("{}-{suffix}", scene.name),
+            geometry: scene.geometry.subset(|o| o.role == role),
+            ..scene.clone()
+        };
+        let (model, room) = (
+            part(ObjectRole::Object, "model"),
+            part(ObjectRole::Proxy, "room"),
+        );
+        let centre = (model.geometry.mesh.bounds())
+            .map(|(lo, hi)| 0.5 * (lo + hi))
+            .context("the scene has no virtual objects to move")?;
+        let (_, model_transfer) = bake_for(&model, None).context("cannot bake the model alone")?;
+        let (_, room_transfer) = bake_for(&room, None).context("cannot bake the room alone")?;
+        let transfer = separate_transfer(&scene.geometry, &model_transfer, &room_transfer)?;
+        let proxies = SceneBvh::build(&room.geometry.mesh);
+        let probes: Vec<Probe> = (scene.probes.iter())
+            .map(|p| p.load(&proxies))
+            .collect::<Result<_, _>>()?;
+        let lighting = ProbeLighting::new(probes, proxies, sky, settings, tracking())?;
+        Ok(Self {
+            geometry: scene.geometry.clone(),
+            transfer,
+            room_transfer,
+            lighting,
+            centre,
+            path: scene.model_path.clone(),
+        })
+    }
+
+    /// The scene's geometry with the objects moved so that their centre is at `centre`.
+    pub fn placed(&self, centre: Vec3) -> SceneMesh {
+        let mut geometry = self.geometry.clone();
+        geometry.move_objects(centre - self.centre);
+        geometry
+    }
+
+    /// The lighting at `centre`, followed from the previous update's, and the renderer's
+    /// lighting from it: the hybrid's, the lights' bounce light included as the decomposition
+    /// mode says.
+    pub fn update(&mut self, centre: Vec3) -> (FrameLighting, ProbeFrame) {
+        let frame = self.lighting.update(centre);
+        let indirect = runtime::lights_indirect_default(self.lighting.settings().mode);
+        let lighting = FrameLighting::for_mode(
+            RenderMode::Hybrid,
+            &frame.lighting.sh,
+            &frame.lighting,
+            indirect,
+        );
+        (lighting, frame)
+    }
+}
+
+/// How the lights are followed as the model moves: the environment sequences' rules.
+fn tracking() -> TrackingSettings {
+    TrackingSettings::default()
+}

@@ -1,0 +1,101 @@
+//! A model carried through a room lit by its probes (a scene with `[[probe]]` entries): the
+//! model moves live (its `[path]` played back, the arrow keys, the panel, `move` and `place`
+//! in a script) and each new position fuses the local map at its centre, decomposes it and
+//! follows its lights (`crate::room`); the model and its shadows are composited into the
+//! empty room's path-traced picture, seen through the scene's camera.
+
+use super::App;
+use super::room_state::RoomState;
+use foundation::envmap::EnvMap;
+use glam::Vec3;
+use runtime::render::LiveBackplate;
+use std::sync::Arc;
+
+impl App {
+    /// Opens the scene's room when it has probes; the viewer then draws the room's bakes.
+    pub(super) fn open_room(&mut self, map: &EnvMap) {
+        if self.scene.probes.is_empty() || self.room.is_some() {
+            return;
+        }
+        let rotation = self.settings.rotation_deg;
+        match RoomState::open(
+            &self.scene,
+            map,
+            rotation,
+            self.settings.decompose_settings(),
+        ) {
+            Ok(room) => {
+                self.bake.transfer = Some(Arc::new(room.model.transfer.clone()));
+                self.bake.proxies = Some(Arc::new(room.model.room_transfer.clone()));
+                self.bake.job = None;
+                self.window.renderer = None;
+                self.room = Some(room);
+            }
+            Err(e) => self.stats.message = format!("cannot open the room: {e:#}"),
+        }
+    }
+
+    /// The room's backplate: the empty room's picture for the current view.
+    pub(super) fn room_backplate(&self) -> anyhow::Result<Option<LiveBackplate>> {
+        let Some(room) = &self.room else {
+            return Ok(None);
+        };
+        let picture = room.photograph(&self.current_camera())?;
+        Ok(Some(LiveBackplate::Photograph(picture)))
+    }
+
+    /// Moves the model by `offset`, live.
+    pub(super) fn move_model(&mut self, offset: Vec3) {
+        if let Some(room) = self.room.as_mut() {
+            room.centre += offset;
+        }
+    }
+
+    /// Puts the model's centre at `centre`, live.
+    pub(super) fn place_model(&mut self, centre: Vec3) {
+        if let Some(room) = self.room.as_mut() {
+            room.centre = centre;
+        }
+    }
+
+    /// The room's lighting for this frame: the path played on, and where the model moved,
+    /// the local map fused, decomposed and its lights followed; the model's vertices moved.
+    pub(super) fn update_room(&mut self) -> anyhow::Result<()> {
+        let (Some(room), Some(renderer)) = (self.room.as_mut(), self.window.renderer.as_mut())
+        else {
+            return Ok(());
+        };
+        renderer.set_shadow_settings(self.settings.shadow)?;
+        if self.settings.play_path {
+            room.advance_path();
+        }
+        if room.drawn_at == Some(room.centre) {
+            return Ok(());
+        }
+        let (lighting, frame) = room.model.update(room.centre);
+        renderer.move_vertices(&room.model.placed(room.centre))?;
+        renderer.set_lighting(&lighting)?;
+        self.lighting.decomposition_ms = frame.decompose_ms;
+        self.lighting.decomposition = Some(frame.lighting.clone());
+        room.last = Some(frame);
+        room.drawn_at = Some(room.centre);
+        Ok(())
+    }
+
+    /// The room's part of the scripted state.
+    pub(super) fn room_json(&self) -> serde_json::Value {
+        let Some(room) = &self.room else {
+            return serde_json::Value::Null;
+        };
+        let last = room.last.as_ref();
+        serde_json::json!({
+            "probes": room.model.lighting.probes().len(),
+            "centre": room.centre.to_array(),
+            "path_frame": room.path_frame,
+            "path_frames": room.path_frames(),
+            "fuse_ms": last.map_or(0.0, |f| f.fuse_ms),
+            "decompose_ms": last.map_or(0.0, |f| f.decompose_ms),
+            "lights": last.map_or(0, |f| f.lighting.lights.len()),
+        })
+    }
+}

@@ -1,0 +1,100 @@
+//! A room's state in the viewer: the room and the model's place in it (see `room.rs`).
+
+use crate::report::{ReferenceImages, ReferenceRequest, reference_images};
+use crate::room::RoomModel;
+use anyhow::Context;
+use foundation::camera::Camera;
+use foundation::envmap::EnvMap;
+use foundation::image_io::RgbImageF32;
+use foundation::scene::{ObjectRole, Scene};
+use glam::Vec3;
+use runtime::{DecomposeSettings, ProbeFrame};
+
+/// Paths per pixel of the empty room's picture (cached with the reports' references).
+const PHOTOGRAPH_SPP: u32 = 16;
+
+/// The room, the model's place in it and what its last update cost.
+pub(super) struct RoomState {
+    pub(super) model: RoomModel,
+    /// The room alone, and its sky: its picture is path-traced for the view.
+    room: Scene,
+    map: EnvMap,
+    rotation_deg: f32,
+    /// Where the centre of the model is.
+    pub(super) centre: Vec3,
+    /// The `[path]` frame shown (playing back, one per drawn frame).
+    pub(super) path_frame: usize,
+    /// The centre the renderer's lighting and vertices were last set for.
+    pub(super) drawn_at: Option<Vec3>,
+    pub(super) last: Option<ProbeFrame>,
+}
+
+impl RoomState {
+    /// The room of `scene` under `map` turned by `rotation_deg`: both parts baked (or taken
+    /// from the cache), the probes loaded, the empty room path-traced (or cached).
+    pub(super) fn open(
+        scene: &Scene,
+        map: &EnvMap,
+        rotation_deg: f32,
+        settings: DecomposeSettings,
+    ) -> anyhow::Result<Self> {
+        let model = RoomModel::open(scene, map.rotated(rotation_deg), settings)?;
+        let room = Scene {
+            geometry: scene.geometry.subset(|o| o.role == ObjectRole::Proxy),
+            backplate: None,
+            ..scene.clone()
+        };
+        let centre = (model.path.as_ref())
+            .and_then(|p| p.positions().first().copied())
+            .unwrap_or(model.centre);
+        Ok(Self {
+            model,
+            room,
+            map: map.clone(),
+            rotation_deg,
+            centre,
+            path_frame: 0,
+            drawn_at: None,
+            last: None,
+        })
+    }
+
+    /// The empty room path-traced through `camera` (or taken from the reports' cache): the
+    /// picture the model is composited into, as a photograph of the room would be.
+    pub(super) fn photograph(&self, camera: &Camera) -> anyhow::Result<RgbImageF32> {
+        let request = ReferenceRequest {
+            spp: PHOTOGRAPH_SPP,
+            bounces: self.room.bake.bounces,
+            seed: 0,
+            sampler: reference::SamplerKind::default(),
+            target_noise: None,
+            max_seconds: None,
+            exposure: 1.0,
+        };
+        println!("path-tracing the empty room for the view (cached)");
+        let no_limit = |_: &ReferenceImages| f64::INFINITY;
+        let (map, rotation) = (&self.map, self.rotation_deg);
+        Ok(
+            reference_images(&self.room, camera, map, rotation, &request, &no_limit)
+                .context("cannot path-trace the empty room")?
+                .radiance,
+        )
+    }
+
+    /// Frames of the `[path]` (0 without one).
+    pub(super) fn path_frames(&self) -> usize {
+        self.model.path.as_ref().map_or(0, |p| p.positions().len())
+    }
+
+    /// The next frame of the `[path]`, looping; a jump back to its start forgets the
+    /// followed lights.
+    pub(super) fn advance_path(&mut self) {
+        let Some(path) = &self.model.path else { return };
+        let positions = path.positions();
+        self.path_frame = (self.path_frame + 1) % positions.len();
+        if self.path_frame == 0 {
+            self.model.lighting.reset();
+        }
+        self.centre = positions[self.path_frame];
+    }
+}
