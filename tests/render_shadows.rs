@@ -367,3 +367,116 @@ fn a_source_with_a_halo_casts_its_wide_penumbra() {
         );
     }
 }
+
+/// A model moved in place (`Renderer::move_vertices`, as a model carried through a room is)
+/// draws exactly what a renderer built with it there draws: its shadow follows it, on both
+/// adapters. The frame before the move drew the shadow maps at the old place.
+#[test]
+fn a_moved_model_draws_as_one_built_there() {
+    let mut geometry = sphere_on_plane();
+    geometry.objects[1].role = foundation::scene::ObjectRole::Proxy;
+    let transfer = bake_of(&geometry, 3, 16, 0);
+    let mut moved = geometry.clone();
+    moved.move_objects(Vec3::new(1.5, 0.0, -0.5));
+    let light = DirectionalLight {
+        direction: Vec3::new(0.4, 1.0, 0.3).normalize(),
+        power: Rgb::splat(5.0),
+        cap_radius: 0.05,
+        angular_radius: 0.01,
+        halo_radius: 0.01,
+        core_fraction: 1.0,
+        share: 1.0,
+    };
+    let lighting = FrameLighting {
+        sh: uniform_sh(3, 0.3),
+        ..FrameLighting::lights_only(3, vec![light])
+    };
+    let view = camera(Vec3::new(0.0, 6.0, 9.0), Vec3::new(0.5, 0.5, 0.0), 96, 72);
+    for gpu in gpus() {
+        let mut renderer =
+            Renderer::new(&gpu, &geometry, &transfer, &view, ShadowSettings::default()).unwrap();
+        renderer.background = false;
+        renderer.set_lighting(&lighting).unwrap();
+        renderer.render().unwrap();
+        let before = renderer.read_back().unwrap();
+        renderer.move_vertices(&moved).unwrap();
+        renderer.render().unwrap();
+        let after = renderer.read_back().unwrap();
+        let built = render(&gpu, &moved, &transfer, &view, &lighting);
+        assert_eq!(after.pixels, built.pixels, "{}", gpu.description());
+        let changed = (before.pixels.iter().zip(&after.pixels))
+            .filter(|(a, b)| (luminance(**a) - luminance(**b)).abs() > 0.05)
+            .count();
+        assert!(changed > 200, "the model moved: {changed} pixels changed");
+        // Another scene's vertices are refused.
+        assert!(
+            renderer
+                .move_vertices(&sphere_on_plane().subset(|_| false))
+                .is_err()
+        );
+    }
+}
+
+/// With `ShadowCasters::Objects` the proxies (a room whose own shadowing is already in its
+/// light) cast no shadow, and still take the objects': a proxy roof over a sphere on a proxy
+/// floor shadows everything with every caster, nothing but the sphere's shadow without it.
+#[test]
+fn proxies_cast_no_shadow_when_only_objects_do() {
+    let mut geometry = sphere_on_plane();
+    geometry.objects[1].role = foundation::scene::ObjectRole::Proxy;
+    let roof = foundation::mesh::box_mesh(
+        Vec3::new(-3.0, 3.0, -3.0),
+        Vec3::new(3.0, 3.2, 3.0),
+        [4, 1, 4],
+        [false; 6],
+    );
+    geometry.push_object("roof".into(), &roof, Rgb::splat(0.5));
+    geometry.objects[2].role = foundation::scene::ObjectRole::Proxy;
+    let transfer = bake_of(&geometry, 3, 16, 0);
+    let light = DirectionalLight {
+        direction: Vec3::new(0.3, 1.0, 0.2).normalize(),
+        power: Rgb::splat(5.0),
+        cap_radius: 0.05,
+        angular_radius: 0.01,
+        halo_radius: 0.01,
+        core_fraction: 1.0,
+        share: 1.0,
+    };
+    let lighting = FrameLighting::lights_only(3, vec![light]);
+    let unshadowed = FrameLighting {
+        shadows: false,
+        ..lighting.clone()
+    };
+    // Under the roof, looking at the sphere and the floor around it.
+    let view = camera(Vec3::new(0.0, 2.6, 5.5), Vec3::new(0.0, 0.6, 0.0), 96, 72);
+    for gpu in gpus() {
+        let mut renderer =
+            Renderer::new(&gpu, &geometry, &transfer, &view, ShadowSettings::default()).unwrap();
+        renderer.background = false;
+        let mut draw = |renderer: &mut Renderer, lighting: &FrameLighting| {
+            renderer.set_lighting(lighting).unwrap();
+            renderer.render().unwrap();
+            renderer.read_back().unwrap()
+        };
+        let open = draw(&mut renderer, &unshadowed);
+        let every = draw(&mut renderer, &lighting);
+        renderer.set_shadow_casters(runtime::render::ShadowCasters::Objects);
+        let objects = draw(&mut renderer, &lighting);
+        let darker = |image: &foundation::image_io::RgbImageF32| {
+            (image.pixels.iter().zip(&open.pixels))
+                .filter(|(a, b)| luminance(**b) - luminance(**a) > 0.05)
+                .count()
+        };
+        let (every, objects) = (darker(&every), darker(&objects));
+        let pixels = open.pixels.len();
+        assert!(
+            every > pixels / 2,
+            "the roof shadows all: {every} of {pixels}"
+        );
+        assert!(objects > 50, "the sphere still casts: {objects}");
+        assert!(
+            objects < every / 3,
+            "the roof casts nothing: {objects} against {every}"
+        );
+    }
+}

@@ -3,7 +3,7 @@
 //! minutes on two CPU cores without a GPU; a second run reuses bake and references.
 
 use crate::cli::{ImageSizeArgs, ReportOptions};
-use crate::commands::report::write_report;
+use crate::commands::report::{write_path_report, write_report};
 use crate::maps::maps_beside;
 use crate::support::load_scene;
 use anyhow::Context;
@@ -78,6 +78,12 @@ const GLOSSY_DRAGON_SPP: u32 = 512;
 /// and the teapot's report under it.
 const CAPTURE: &str = "scenes/capture/capture.toml";
 const CAPTURE_TRUTH: &str = "scenes/env/interior.exr";
+/// Light probes: the teapot carried through a room lit by three probes, at positions of its
+/// path, each method's lighting against the room path-traced with the teapot there.
+const ROOM: &str = "scenes/room.toml";
+const ROOM_POSITIONS: usize = 12;
+const ROOM_SPP: u32 = 256;
+const ROOM_PROBE_SPP: u32 = 32;
 
 pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let bundled_scenes = args.scene.is_none();
@@ -157,6 +163,20 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
 
     if bundled_scenes {
         demo_capture(&args.output.join("capture"), &scene, &options)?;
+        println!("\nthe room {ROOM}, the teapot carried along its path:");
+        let room = load_scene(&bundled(ROOM))?;
+        let room_options = ReportOptions {
+            spp: ROOM_SPP,
+            target_noise: None,
+            thresholds: Vec::new(),
+            frames: 1,
+            ..options.clone()
+        };
+        let path = crate::report::path::PathOptions {
+            positions: ROOM_POSITIONS,
+            probe_spp: ROOM_PROBE_SPP,
+        };
+        write_path_report(&room, &room_options, &path, &args.output.join("room"))?;
     }
 
     // A model as users bring theirs: the textured glTF sample, placed on its own, through

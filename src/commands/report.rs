@@ -64,7 +64,11 @@ pub fn run(args: ReportArgs) -> anyhow::Result<()> {
         anyhow::bail!("hprt report needs -o");
     };
     if args.path {
-        return write_path_report(&scene, &args, output);
+        let path_options = report::path::PathOptions {
+            positions: args.positions as usize,
+            probe_spp: args.probe_spp,
+        };
+        return write_path_report(&scene, &args.options, &path_options, output);
     }
     if let Some(sequence) = &args.env_sequence {
         anyhow::ensure!(
@@ -225,8 +229,12 @@ fn write_sequence_report(
 }
 
 /// `--path`: the model carried along the scene's `[path]` through its room.
-fn write_path_report(scene: &Scene, args: &ReportArgs, out: &Path) -> anyhow::Result<()> {
-    let options = &args.options;
+pub(crate) fn write_path_report(
+    scene: &Scene,
+    options: &ReportOptions,
+    path_options: &report::path::PathOptions,
+    out: &Path,
+) -> anyhow::Result<()> {
     anyhow::ensure!(
         options.bake.is_none(),
         "--path bakes the model and the room apart (each cached); it takes no --bake"
@@ -245,10 +253,6 @@ fn write_path_report(scene: &Scene, args: &ReportArgs, out: &Path) -> anyhow::Re
         thresholds: Vec::new(),
         ..options.report_settings(&camera, scene.bake.bounces)
     };
-    let path_options = report::path::PathOptions {
-        positions: args.positions as usize,
-        probe_spp: args.probe_spp,
-    };
     let folder =
         AtomicFolder::create(out).with_context(|| format!("cannot write {}", out.display()))?;
     report::path::write_path_report(
@@ -256,7 +260,7 @@ fn write_path_report(scene: &Scene, args: &ReportArgs, out: &Path) -> anyhow::Re
         (&map, rotation),
         camera,
         &settings,
-        &path_options,
+        path_options,
         folder.path(),
     )?;
     folder

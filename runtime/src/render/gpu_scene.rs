@@ -46,6 +46,8 @@ pub(crate) struct GpuScene {
     texture_groups: Vec<wgpu::BindGroup>,
     /// Index ranges drawn with one texture group each, in scene order.
     draws: Vec<(std::ops::Range<u32>, usize)>,
+    /// The index ranges of the virtual objects (not the proxies).
+    pub objects: Vec<(std::ops::Range<u32>, usize)>,
     /// The glossy materials, with each vertex's index and specular occlusion.
     pub materials: GpuMaterials,
 }
@@ -163,6 +165,9 @@ impl GpuScene {
             texture_layout,
             texture_groups,
             draws: draws(geometry),
+            objects: draws_of(geometry, |o| {
+                o.role == foundation::scene::ObjectRole::Object
+            }),
             vertex_buffer,
             radiance_buffer,
             indirect_buffer: indirect_radiance_buffer,

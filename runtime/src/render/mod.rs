@@ -113,6 +113,19 @@ pub struct Renderer {
     composite: Option<Compositor>,
     /// Show the environment map where no geometry is.
     pub background: bool,
+    casters: ShadowCasters,
+}
+
+/// What casts the lights' shadows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ShadowCasters {
+    /// Every object and proxy.
+    #[default]
+    All,
+    /// The virtual objects alone: the proxies are a room whose own shadowing is already in
+    /// the light (a local map fused from probes at the model holds the room as it sees it),
+    /// so they take the objects' shadows but cast none.
+    Objects,
 }
 
 impl Renderer {
@@ -165,6 +178,7 @@ impl Renderer {
             },
             composite: None,
             background: true,
+            casters: ShadowCasters::All,
             queue: gpu.queue.clone(),
             device,
         })
@@ -237,6 +251,22 @@ impl Renderer {
         self.bounds = BoundingSphere::of_box(self.scene.bounds.0, self.scene.bounds.1);
         self.shadow_maps.invalidate();
         Ok(())
+    }
+
+    /// Which geometry casts the lights' shadows (all of it unless set).
+    pub fn set_shadow_casters(&mut self, casters: ShadowCasters) {
+        if casters != self.casters {
+            self.casters = casters;
+            self.shadow_maps.invalidate();
+            self.light_pass.inputs_changed();
+        }
+    }
+
+    /// Whether the shadow maps hold each light's map of the proxies alone too (compositing
+    /// proxies that can shadow themselves, and do).
+    fn proxy_layers(&self) -> bool {
+        self.casters == ShadowCasters::All
+            && self.composite.as_ref().is_some_and(|c| c.self_shadowing)
     }
 
     /// Back to drawing the whole scene.
@@ -401,9 +431,9 @@ impl Renderer {
             background: self.background && self.composite.is_none(),
             pcf_taps: shadow.pcf_taps,
             // 0: no maps of the proxies alone (they cannot shadow themselves).
-            proxy_layers: match &self.composite {
-                Some(c) if c.self_shadowing => lights.len() as u32,
-                _ => 0,
+            proxy_layers: match self.proxy_layers() {
+                true => lights.len() as u32,
+                false => 0,
             },
             sh_per_pixel: (lighting.sh_transfer == ShTransfer::Unshadowed).then_some(&lighting.sh),
             reflection_to_map: match &lighting.reflections {
@@ -462,9 +492,9 @@ impl Renderer {
     /// of the proxies alone, in the layers after the scene's.
     fn record_shadow_maps(&mut self, encoder: &mut wgpu::CommandEncoder, matrices: &[glam::Mat4]) {
         let lights = matrices.len();
-        let layers: Vec<glam::Mat4> = match &self.composite {
-            Some(c) if c.self_shadowing => matrices.iter().chain(matrices).copied().collect(),
-            _ => matrices.to_vec(),
+        let layers: Vec<glam::Mat4> = match self.proxy_layers() {
+            true => matrices.iter().chain(matrices).copied().collect(),
+            false => matrices.to_vec(),
         };
         if self.shadow_maps.reserve(&self.device, layers.len()) {
             self.light_pass.inputs_changed();
@@ -474,13 +504,14 @@ impl Renderer {
             self.shadow_maps.invalidate();
             self.frame.shadow_layers = Some(lights);
         }
-        let (scene, composite) = (&self.scene, &self.composite);
+        let (scene, composite, casters) = (&self.scene, &self.composite, self.casters);
         self.shadow_maps.render_stale(
             &self.queue,
             encoder,
-            |pass, layer| match composite {
-                Some(c) if layer >= lights => c.draw_proxies_depth_only(scene, pass),
-                _ => scene.draw_depth_only(pass),
+            |pass, layer| match (composite, casters) {
+                (Some(c), _) if layer >= lights => c.draw_proxies_depth_only(scene, pass),
+                (_, ShadowCasters::All) => scene.draw_depth_only(pass),
+                (_, ShadowCasters::Objects) => scene.draw_parts_depth_only(pass, &scene.objects),
             },
             &layers,
         );

@@ -26,7 +26,9 @@ use foundation::scene::{ObjectRole, Scene, SceneMesh, mesh_crosses};
 use glam::Vec3;
 use reference::composite::{PixelKind, composite, pixel_kinds};
 use results::{PathMethod, PathPosition, PositionResult, summarise};
-use runtime::render::{FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
+use runtime::render::{
+    FrameLighting, GpuContext, RenderMode, Renderer, ShadowCasters, ShadowSettings,
+};
 use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting, TrackingSettings};
 use std::path::Path;
 
@@ -161,6 +163,9 @@ impl PathRun {
         let mut room = Renderer::new(gpu, &room_geometry, &model.room_transfer, camera, shadow)?;
         whole.set_environment(map, rotation_deg);
         room.set_environment(map, rotation_deg);
+        // The room's own shadowing is in the local map already: only the model casts shadows.
+        whole.set_shadow_casters(ShadowCasters::Objects);
+        room.set_shadow_casters(ShadowCasters::Objects);
         let probes = model.lighting.probes();
         let room_centre = (room_geometry.mesh.bounds()).map_or(Vec3::ZERO, |(a, b)| 0.5 * (a + b));
         let one_probe = nearest(probes, room_centre);
