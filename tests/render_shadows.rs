@@ -453,7 +453,7 @@ fn proxies_cast_no_shadow_when_only_objects_do() {
         let mut renderer =
             Renderer::new(&gpu, &geometry, &transfer, &view, ShadowSettings::default()).unwrap();
         renderer.background = false;
-        let mut draw = |renderer: &mut Renderer, lighting: &FrameLighting| {
+        let draw = |renderer: &mut Renderer, lighting: &FrameLighting| {
             renderer.set_lighting(lighting).unwrap();
             renderer.render().unwrap();
             renderer.read_back().unwrap()

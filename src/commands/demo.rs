@@ -163,20 +163,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
 
     if bundled_scenes {
         demo_capture(&args.output.join("capture"), &scene, &options)?;
-        println!("\nthe room {ROOM}, the teapot carried along its path:");
-        let room = load_scene(&bundled(ROOM))?;
-        let room_options = ReportOptions {
-            spp: ROOM_SPP,
-            target_noise: None,
-            thresholds: Vec::new(),
-            frames: 1,
-            ..options.clone()
-        };
-        let path = crate::report::path::PathOptions {
-            positions: ROOM_POSITIONS,
-            probe_spp: ROOM_PROBE_SPP,
-        };
-        write_path_report(&room, &room_options, &path, &args.output.join("room"))?;
+        demo_room(&args.output.join("room"), &options)?;
     }
 
     // A model as users bring theirs: the textured glTF sample, placed on its own, through
@@ -196,6 +183,24 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         &sample_options,
         &args.output.join("crate"),
     )
+}
+
+/// The teapot carried along the bundled room's path, lit by its probes (`hprt report --path`).
+fn demo_room(output: &Path, options: &ReportOptions) -> anyhow::Result<()> {
+    println!("\nthe room {ROOM}, the teapot carried along its path:");
+    let room = load_scene(&bundled(ROOM))?;
+    let room_options = ReportOptions {
+        spp: ROOM_SPP,
+        target_noise: None,
+        thresholds: Vec::new(),
+        frames: 1,
+        ..options.clone()
+    };
+    let path = crate::report::path::PathOptions {
+        positions: ROOM_POSITIONS,
+        probe_spp: ROOM_PROBE_SPP,
+    };
+    write_path_report(&room, &room_options, &path, output)
 }
 
 /// The bundled capture through the whole chain: `hprt capture`, the decomposition of the
