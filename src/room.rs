@@ -60,6 +60,7 @@ impl RoomModel {
         let probes: Vec<Probe> = (scene.probes.iter())
             .map(|p| p.load(&proxies))
             .collect::<Result<_, _>>()?;
+        warn_of_mixed_sizes(scene, &probes);
         let lighting = ProbeLighting::new(probes, proxies, sky, settings, tracking())?;
         Ok(Self {
             geometry: scene.geometry.clone(),
@@ -91,6 +92,26 @@ impl RoomModel {
             indirect,
         );
         (lighting, frame)
+    }
+}
+
+/// Warns when the probes' images differ in size: each is still looked up at its own
+/// resolution, but the sharper ones' detail comes and goes as the point moves between them.
+pub fn warn_of_mixed_sizes(scene: &Scene, probes: &[Probe]) {
+    let size = |p: &Probe| (p.radiance.width(), p.radiance.height());
+    let name = |k: usize| scene.probes.get(k).map_or("?", |p| p.name.as_str());
+    if let Some(first) = probes.first()
+        && let Some(k) = (1..probes.len()).find(|k| size(&probes[*k]) != size(first))
+    {
+        let ((w0, h0), (w1, h1)) = (size(first), size(&probes[k]));
+        log::warn!(
+            "{}: the probes' images differ in size ({w0}×{h0} for {:?}, {w1}×{h1} for {:?}): \
+             each is looked up at its own resolution, so detail comes and goes as the model \
+             moves between them",
+            scene.path.display(),
+            name(0),
+            name(k)
+        );
     }
 }
 

@@ -249,3 +249,26 @@ fn a_path_through_a_wall_is_reported() {
         "{html}"
     );
 }
+
+/// Probes whose images differ in size still light the room, each at its own resolution, with
+/// a warning naming two of them.
+#[test]
+fn probes_of_different_sizes_are_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_room(d, TWO_PROBES);
+    let out = hprt(d, &["probes", "room.toml", "--spp", "1", "--width", "64"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    write_exr(&d.join("big.exr"), &RgbImageF32::filled(128, 64, Rgb::ONE)).unwrap();
+    let big = format!(
+        "{TWO_PROBES}[[probe]]\nname = \"big\"\nposition = [0, 1, 0]\nimage = \"big.exr\"\n"
+    );
+    write_room(d, &big);
+    let out = hprt(d, &["bench", "probes", "room.toml", "--steps", "2"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let message = stderr(&out);
+    assert!(
+        message.contains("differ in size") && message.contains("\"big\""),
+        "{message}"
+    );
+}
