@@ -38,7 +38,7 @@ mod uniforms;
 
 use crate::lighting::ShTransfer;
 use composite::{Compositor, CompositorSource};
-pub use composite::{LiveBackplate, separate_transfer};
+pub use composite::{LiveBackplate, separate_transfer, with_objects_alone};
 pub use display_pass::{DisplayPass, capture_target};
 use environment_texture::EnvironmentTexture;
 use error::checked;
@@ -250,6 +250,15 @@ impl Renderer {
         self.scene.write_vertices(&self.queue, geometry);
         self.bounds = BoundingSphere::of_box(self.scene.bounds.0, self.scene.bounds.1);
         self.shadow_maps.invalidate();
+        Ok(())
+    }
+
+    /// Draws with another bake of the same scene (the room baked again with the model where
+    /// it came to rest): same vertices, same order.
+    pub fn set_transfer(&mut self, transfer: &Transfer) -> Result<(), RenderError> {
+        self.scene
+            .write_transfer(&self.device, &self.queue, transfer)?;
+        self.frame.radiance_dirty = true;
         Ok(())
     }
 

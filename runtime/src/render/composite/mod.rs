@@ -85,6 +85,39 @@ pub fn separate_transfer(
     })
 }
 
+/// `whole` (a bake of the whole scene) with the objects' rows taken from `objects` (their bake
+/// alone): the room with the model where it rests, which takes the model's soft shadow and
+/// bounce light, and the model lit by a local map that already holds the room.
+pub fn with_objects_alone(
+    geometry: &SceneMesh,
+    whole: &Transfer,
+    objects: &Transfer,
+) -> Result<Transfer, BakeMismatch> {
+    let order = whole.settings.order;
+    let on_objects = spread_over(geometry, ObjectRole::Object, objects, order)?;
+    if whole.direct.vertex_count() != geometry.mesh.vertex_count() {
+        return Err(BakeMismatch::VertexCount {
+            bake: whole.direct.vertex_count(),
+            scene: geometry.mesh.vertex_count(),
+        });
+    }
+    let mut out = whole.clone();
+    let stride = out.direct.stride();
+    let copy = |to: &mut TransferVectors, from: &TransferVectors| {
+        for o in geometry
+            .objects
+            .iter()
+            .filter(|o| o.role == ObjectRole::Object)
+        {
+            let rows = o.vertices.start as usize * stride..o.vertices.end as usize * stride;
+            to.as_mut_slice()[rows.clone()].copy_from_slice(&from.as_slice()[rows]);
+        }
+    };
+    copy(&mut out.direct, &on_objects.direct);
+    copy(&mut out.indirect, &on_objects.indirect);
+    Ok(out)
+}
+
 /// `part`'s bake (of [`SceneMesh::subset`] of the objects with `role`, whose vertices are
 /// theirs in scene order) on those vertices of the whole scene, zero elsewhere.
 fn spread_over(

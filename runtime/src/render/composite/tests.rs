@@ -103,6 +103,27 @@ fn separate_bakes_land_on_their_own_vertices() {
 }
 
 #[test]
+fn a_whole_bake_takes_the_objects_rows_from_their_own() {
+    let geometry = scene();
+    let (whole, mut objects) = (bake(16, 2), bake(8, 2));
+    for x in objects.direct.as_mut_slice() {
+        *x = -*x;
+    }
+    let rested = with_objects_alone(&geometry, &whole, &objects).expect("matching bakes");
+    for v in 0..16 {
+        // Parts 0 and 2 are objects: their rows are the objects' bake's; 1 and 3 the whole's.
+        let expected = match v / 4 {
+            0 => objects.direct.vector(v, 1),
+            2 => objects.direct.vector(v - 4, 1),
+            _ => whole.direct.vector(v, 1),
+        };
+        assert_eq!(rested.direct.vector(v, 1), expected, "{v}");
+    }
+    assert!(with_objects_alone(&geometry, &bake(15, 2), &objects).is_err());
+    assert!(with_objects_alone(&geometry, &whole, &bake(9, 2)).is_err());
+}
+
+#[test]
 fn a_proxies_bake_of_another_scene_is_refused() {
     let geometry = scene();
     assert!(without_transfer(&geometry, &bake(7, 2), 2).is_err());
