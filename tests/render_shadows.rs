@@ -378,15 +378,7 @@ fn a_moved_model_draws_as_one_built_there() {
     let transfer = bake_of(&geometry, 3, 16, 0);
     let mut moved = geometry.clone();
     moved.move_objects(Vec3::new(1.5, 0.0, -0.5));
-    let light = DirectionalLight {
-        direction: Vec3::new(0.4, 1.0, 0.3).normalize(),
-        power: Rgb::splat(5.0),
-        cap_radius: 0.05,
-        angular_radius: 0.01,
-        halo_radius: 0.01,
-        core_fraction: 1.0,
-        share: 1.0,
-    };
+    let light = small_light(Vec3::new(0.4, 1.0, 0.3));
     let lighting = FrameLighting {
         sh: uniform_sh(3, 0.3),
         ..FrameLighting::lights_only(3, vec![light])
@@ -433,15 +425,7 @@ fn proxies_cast_no_shadow_when_only_objects_do() {
     geometry.push_object("roof".into(), &roof, Rgb::splat(0.5));
     geometry.objects[2].role = foundation::scene::ObjectRole::Proxy;
     let transfer = bake_of(&geometry, 3, 16, 0);
-    let light = DirectionalLight {
-        direction: Vec3::new(0.3, 1.0, 0.2).normalize(),
-        power: Rgb::splat(5.0),
-        cap_radius: 0.05,
-        angular_radius: 0.01,
-        halo_radius: 0.01,
-        core_fraction: 1.0,
-        share: 1.0,
-    };
+    let light = small_light(Vec3::new(0.3, 1.0, 0.2));
     let lighting = FrameLighting::lights_only(3, vec![light]);
     let unshadowed = FrameLighting {
         shadows: false,
@@ -478,5 +462,18 @@ fn proxies_cast_no_shadow_when_only_objects_do() {
             objects < every / 3,
             "the roof casts nothing: {objects} against {every}"
         );
+    }
+}
+
+/// A bright light of small source from `direction` (normalized here).
+fn small_light(direction: Vec3) -> DirectionalLight {
+    DirectionalLight {
+        direction: direction.normalize(),
+        power: Rgb::splat(5.0),
+        cap_radius: 0.05,
+        angular_radius: 0.01,
+        halo_radius: 0.01,
+        core_fraction: 1.0,
+        share: 1.0,
     }
 }

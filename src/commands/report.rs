@@ -179,16 +179,12 @@ fn write_composite_report(
     settings: &report::ReportSettings,
     output: &Path,
 ) -> anyhow::Result<()> {
-    let folder = AtomicFolder::create(output)
-        .with_context(|| format!("cannot write {}", output.display()))?;
-    let report =
-        report::composite::run_composite_report(scene, transfer, envs, settings, folder.path())?;
-    report::composite::print_composite_summary(&report);
-    folder
-        .commit()
-        .with_context(|| format!("cannot write {}", output.display()))?;
-    println!("\nwrote {}", output.join("report.html").display());
-    Ok(())
+    write_atomically(output, |folder| {
+        let report =
+            report::composite::run_composite_report(scene, transfer, envs, settings, folder)?;
+        report::composite::print_composite_summary(&report);
+        Ok(())
+    })
 }
 
 /// Loads the sequence, bakes (or reuses) the transfer and writes the sequence report.
@@ -210,17 +206,28 @@ fn write_sequence_report(
         thresholds: Vec::new(),
         ..options.report_settings(&camera, transfer.settings.bounces)
     };
+    write_atomically(out, |folder| {
+        report::sequence::write_sequence_report(
+            scene,
+            &sequence,
+            sequence_path,
+            &transfer,
+            camera,
+            &settings,
+            folder,
+        )
+    })
+}
+
+/// Runs `write` into a folder beside `out`, swapped in when it succeeds (nothing written
+/// otherwise), and says where the report is.
+fn write_atomically(
+    out: &Path,
+    write: impl FnOnce(&Path) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
     let folder =
         AtomicFolder::create(out).with_context(|| format!("cannot write {}", out.display()))?;
-    report::sequence::write_sequence_report(
-        scene,
-        &sequence,
-        sequence_path,
-        &transfer,
-        camera,
-        &settings,
-        folder.path(),
-    )?;
+    write(folder.path())?;
     folder
         .commit()
         .with_context(|| format!("cannot write {}", out.display()))?;
@@ -253,19 +260,14 @@ pub(crate) fn write_path_report(
         thresholds: Vec::new(),
         ..options.report_settings(&camera, scene.bake.bounces)
     };
-    let folder =
-        AtomicFolder::create(out).with_context(|| format!("cannot write {}", out.display()))?;
-    report::path::write_path_report(
-        scene,
-        (&map, rotation),
-        camera,
-        &settings,
-        path_options,
-        folder.path(),
-    )?;
-    folder
-        .commit()
-        .with_context(|| format!("cannot write {}", out.display()))?;
-    println!("\nwrote {}", out.join("report.html").display());
-    Ok(())
+    write_atomically(out, |folder| {
+        report::path::write_path_report(
+            scene,
+            (&map, rotation),
+            camera,
+            &settings,
+            path_options,
+            folder,
+        )
+    })
 }

@@ -108,14 +108,7 @@ fn csv_bytes(report: &PathReport) -> anyhow::Result<Vec<u8>> {
 }
 
 fn page(report: &PathReport, gif: &[u8], svgs: &[&str]) -> anyhow::Result<String> {
-    let mut html = String::new();
-    writeln!(
-        html,
-        "<!doctype html><html><head><meta charset=\"utf-8\"><title>hprt path report</title>\
-         <style>body{{font-family:sans-serif;max-width:1100px;margin:auto}}\
-         table{{border-collapse:collapse}}td,th{{border:1px solid #bbb;padding:3px 8px;\
-         text-align:right}}</style></head><body>"
-    )?;
+    let mut html = super::super::sequence::output::page_head("hprt path report");
     writeln!(
         html,
         "<h1>A model carried through a room</h1><p>Scene <code>{}</code>, {} positions of its \

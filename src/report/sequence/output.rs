@@ -9,6 +9,16 @@ use foundation::infra::atomic_file::write_atomic;
 use std::fmt::Write;
 use std::path::Path;
 
+/// The start of a report page of plots and tables, up to its body.
+pub(in crate::report) fn page_head(title: &str) -> String {
+    format!(
+        "<!doctype html><html><head><meta charset=\"utf-8\"><title>{title}</title>\
+         <style>body{{font-family:sans-serif;max-width:1100px;margin:auto}}\
+         table{{border-collapse:collapse}}td,th{{border:1px solid #bbb;padding:3px 8px;\
+         text-align:right}}</style></head><body>\n"
+    )
+}
+
 /// Tone-mapped images next to each other, as 8-bit RGB rows.
 pub(in crate::report) fn side_by_side(images: &[&RgbImageF32], exposure: f32) -> Vec<u8> {
     let parts: Vec<Vec<u8>> = images
@@ -105,14 +115,7 @@ fn page(
     error_svg: &str,
     temporal_svg: &str,
 ) -> anyhow::Result<String> {
-    let mut html = String::new();
-    writeln!(
-        html,
-        "<!doctype html><html><head><meta charset=\"utf-8\"><title>hprt sequence report</title>\
-         <style>body{{font-family:sans-serif;max-width:1100px;margin:auto}}\
-         table{{border-collapse:collapse}}td,th{{border:1px solid #bbb;padding:3px 8px;\
-         text-align:right}}</style></head><body>"
-    )?;
+    let mut html = page_head("hprt sequence report");
     writeln!(
         html,
         "<h1>Sequence report</h1><p>Scene <code>{}</code>, sequence <code>{}</code>, {} frames, \
