@@ -1,5 +1,5 @@
 //! A model carried through a room lit by light probes: what the viewer and `hprt report
-//! --path` share. The model and the room are baked apart (`runtime::render::separate_transfer`),
+//! --path` share. The model and the room are baked apart (`runtime::render::with_objects_alone`),
 //! so moving the model keeps both bakes; at each position the local map at the model's centre
 //! is fused from the probes (`runtime::ProbeLighting`), decomposed with its lights followed
 //! from the previous position, and lights the frame: the model through its own transfer, the
@@ -14,7 +14,7 @@ use foundation::probe::Probe;
 use foundation::scene::{ModelPath, ObjectRole, Scene, SceneMesh};
 use glam::Vec3;
 use precompute::bake::Transfer;
-use runtime::render::{FrameLighting, RenderMode, separate_transfer, with_objects_alone};
+use runtime::render::{FrameLighting, RenderMode, rows_of, with_objects_alone};
 use runtime::{DecomposeSettings, ProbeFrame, ProbeLighting, TrackingSettings};
 
 /// A scene's room (its proxies and probes) and the model (its objects) that moves through it.
@@ -57,8 +57,19 @@ impl RoomModel {
             .map(|(lo, hi)| 0.5 * (lo + hi))
             .context("the scene has no virtual objects to move")?;
         let (_, model_transfer) = bake_for(&model, None).context("cannot bake the model alone")?;
-        let (_, room_transfer) = bake_for(&room, None).context("cannot bake the room alone")?;
-        let transfer = separate_transfer(&scene.geometry, &model_transfer, &room_transfer)?;
+        // The room without the model, baked with the model's vertices kept (collapsed to a
+        // point no ray meets): each room vertex gets the samples it gets in a bake with the
+        // model, so the two bakes' noise cancels in the composite's ratio.
+        let mut collapsed = scene.geometry.clone();
+        collapsed.collapse_objects(centre);
+        let empty = Scene {
+            name: format!("{}-room", scene.name),
+            geometry: collapsed,
+            ..scene.clone()
+        };
+        let (_, empty) = bake_for(&empty, None).context("cannot bake the room alone")?;
+        let transfer = with_objects_alone(&scene.geometry, &empty, &model_transfer)?;
+        let room_transfer = rows_of(&scene.geometry, ObjectRole::Proxy, &empty)?;
         let proxies = SceneBvh::build(&room.geometry.mesh);
         let probes: Vec<Probe> = (scene.probes.iter())
             .map(|p| p.load(&proxies))
@@ -151,4 +162,58 @@ pub fn warn_of_mixed_sizes(scene: &Scene, probes: &[Probe]) {
 /// How the lights are followed as the model moves: the environment sequences' rules.
 fn tracking() -> TrackingSettings {
     TrackingSettings::default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use foundation::Rgb;
+    use foundation::mesh::{box_mesh, sphere_mesh};
+    use precompute::bake::BakeSettings;
+
+    /// The room baked with the model collapsed gives each room vertex the samples it gets in a
+    /// bake with the model: where no sample meets the model (a box face turned away from it)
+    /// the two bakes agree bit for bit, so the composite's ratio is exactly one there.
+    #[test]
+    fn a_collapsed_model_leaves_the_rooms_samples_as_they_were() {
+        let mut geometry = SceneMesh::default();
+        let sphere = sphere_mesh(Vec3::new(0.0, 1.0, 0.0), 1.0, 2);
+        geometry.push_object("model".into(), &sphere, Rgb::splat(0.7));
+        let block = box_mesh(
+            Vec3::new(5.0, 0.0, -1.0),
+            Vec3::new(6.0, 2.0, 1.0),
+            [2; 3],
+            [false; 6],
+        );
+        geometry.push_object("block".into(), &block, Rgb::splat(0.5));
+        geometry.objects[1].role = ObjectRole::Proxy;
+        let settings = BakeSettings {
+            order: 3,
+            samples: 64,
+            bounces: 0,
+            seed: 3,
+        };
+        let bake = |g: &SceneMesh| {
+            let bvh = SceneBvh::build(&g.mesh);
+            let no_progress = &foundation::infra::progress::NoProgress;
+            precompute::bake::bake(g, &bvh, &settings, no_progress)
+                .unwrap()
+                .0
+        };
+        let mut collapsed = geometry.clone();
+        collapsed.collapse_objects(Vec3::new(0.0, 1.0, 0.0));
+        let (with, without) = (bake(&geometry), bake(&collapsed));
+        let block = &geometry.objects[1];
+        let (mut away, mut facing_changed) = (0, 0);
+        for v in block.vertices.start as usize..block.vertices.end as usize {
+            let same = (0..3).all(|c| with.direct.vector(v, c) == without.direct.vector(v, c));
+            if geometry.mesh.normals[v].x > 0.5 {
+                assert!(same, "vertex {v}, turned away from the model, changed");
+                away += 1;
+            }
+            facing_changed += usize::from(geometry.mesh.normals[v].x < -0.5 && !same);
+        }
+        assert!(away > 4, "{away}");
+        assert!(facing_changed > 0, "the face toward the model sees it");
+    }
 }

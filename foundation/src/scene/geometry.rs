@@ -194,6 +194,17 @@ impl SceneMesh {
     }
 
     /// Moves the virtual objects (not the proxies) by `offset`.
+    /// Collapses the virtual objects (not the proxies) to `point`: their triangles lose their
+    /// area and no ray meets them, while every vertex keeps its index. A bake of the scene so
+    /// collapsed is the proxies' without the objects, with the same samples per vertex as a
+    /// bake with them.
+    pub fn collapse_objects(&mut self, point: glam::Vec3) {
+        for o in self.objects.iter().filter(|o| o.role == ObjectRole::Object) {
+            let range = o.vertices.start as usize..o.vertices.end as usize;
+            self.mesh.positions[range].fill(point);
+        }
+    }
+
     pub fn move_objects(&mut self, offset: glam::Vec3) {
         for o in self.objects.iter().filter(|o| o.role == ObjectRole::Object) {
             let range = o.vertices.start as usize..o.vertices.end as usize;

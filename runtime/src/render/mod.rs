@@ -38,7 +38,7 @@ mod uniforms;
 
 use crate::lighting::ShTransfer;
 use composite::{Compositor, CompositorSource};
-pub use composite::{LiveBackplate, separate_transfer, with_objects_alone};
+pub use composite::{LiveBackplate, rows_of, with_objects_alone};
 pub use display_pass::{DisplayPass, capture_target};
 use environment_texture::EnvironmentTexture;
 use error::checked;
@@ -233,7 +233,7 @@ impl Renderer {
 
     /// Draws the same scene with `geometry`'s vertex positions: its objects moved rigidly (a
     /// model carried through a room keeps its bake when it is a translation: its transfer
-    /// does not depend on where it is, see `separate_transfer`). The shadow maps are drawn
+    /// does not depend on where it is, see `with_objects_alone`). The shadow maps are drawn
     /// again; the triangles and the bake stay.
     pub fn move_vertices(&mut self, geometry: &SceneMesh) -> Result<(), RenderError> {
         let moved = geometry.mesh.vertex_count() as u32;

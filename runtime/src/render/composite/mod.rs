@@ -64,24 +64,39 @@ fn without_transfer(
     spread_over(geometry, ObjectRole::Proxy, proxies, order)
 }
 
-/// The transfer of a model that moves through a room: the objects' own bake (the objects
-/// alone: they do not see the room, whose light reaches them through the local map, which
-/// already holds it) on their vertices, and the proxies' own bake (the room alone: the
-/// objects darken it only through the lights' shadow maps, which move with them) on theirs.
-/// Neither depends on where the objects are, so moving them keeps it.
-pub fn separate_transfer(
+/// The rows of `whole` (a bake of the whole scene) on the vertices of the objects with
+/// `role`, in scene order: the bake of [`SceneMesh::subset`] of them, as [`spread_over`] takes.
+pub fn rows_of(
     geometry: &SceneMesh,
-    objects: &Transfer,
-    proxies: &Transfer,
+    role: ObjectRole,
+    whole: &Transfer,
 ) -> Result<Transfer, BakeMismatch> {
-    let order = objects.settings.order;
-    let on_objects = spread_over(geometry, ObjectRole::Object, objects, order)?;
-    let on_proxies = spread_over(geometry, ObjectRole::Proxy, proxies, order)?;
+    if whole.direct.vertex_count() != geometry.mesh.vertex_count() {
+        return Err(BakeMismatch::VertexCount {
+            bake: whole.direct.vertex_count(),
+            scene: geometry.mesh.vertex_count(),
+        });
+    }
+    let order = whole.settings.order;
+    let parts: Vec<Range<usize>> = (geometry.objects.iter())
+        .filter(|o| o.role == role)
+        .map(|o| o.vertices.start as usize..o.vertices.end as usize)
+        .collect();
+    let count: usize = parts.iter().map(|r| r.len()).sum();
+    let gather = |vectors: &TransferVectors| {
+        let stride = vectors.stride();
+        let data: Vec<f32> = (parts.iter())
+            .flat_map(|r| &vectors.as_slice()[r.start * stride..r.end * stride])
+            .copied()
+            .collect();
+        TransferVectors::from_raw(order, count, data)
+            .unwrap_or_else(|| TransferVectors::zeros(order, count))
+    };
     Ok(Transfer {
-        settings: objects.settings,
-        direct: on_objects.direct.sum(&on_proxies.direct),
-        indirect: on_objects.indirect.sum(&on_proxies.indirect),
-        textured_vertices: objects.textured_vertices + proxies.textured_vertices,
+        settings: whole.settings,
+        direct: gather(&whole.direct),
+        indirect: gather(&whole.indirect),
+        textured_vertices: whole.textured_vertices,
     })
 }
 

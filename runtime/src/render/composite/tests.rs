@@ -77,32 +77,6 @@ fn the_proxies_bake_lands_on_their_vertices_and_objects_get_none() {
 }
 
 #[test]
-fn separate_bakes_land_on_their_own_vertices() {
-    let geometry = scene();
-    let (objects, mut proxies) = (bake(8, 2), bake(8, 2));
-    for x in proxies.direct.as_mut_slice() {
-        *x = -*x;
-    }
-    let whole = separate_transfer(&geometry, &objects, &proxies).expect("matching bakes");
-    assert_eq!(whole.direct.vertex_count(), 16);
-    for v in 0..16 {
-        // Parts 0 and 2 are objects, 1 and 3 proxies; each part has four vertices.
-        let (part, k) = (v / 4, v % 4);
-        let (bake, at) = match part {
-            0 => (&objects, k),
-            1 => (&proxies, k),
-            2 => (&objects, 4 + k),
-            _ => (&proxies, 4 + k),
-        };
-        for c in 0..3 {
-            assert_eq!(whole.direct.vector(v, c), bake.direct.vector(at, c), "{v}");
-        }
-    }
-    assert!(separate_transfer(&geometry, &bake(7, 2), &proxies).is_err());
-    assert!(separate_transfer(&geometry, &objects, &bake(8, 3)).is_err());
-}
-
-#[test]
 fn a_whole_bake_takes_the_objects_rows_from_their_own() {
     let geometry = scene();
     let (whole, mut objects) = (bake(16, 2), bake(8, 2));
@@ -120,6 +94,13 @@ fn a_whole_bake_takes_the_objects_rows_from_their_own() {
         assert_eq!(rested.direct.vector(v, 1), expected, "{v}");
     }
     assert!(with_objects_alone(&geometry, &bake(15, 2), &objects).is_err());
+    // The proxies' rows gathered, then spread again, are the whole bake's on the proxies.
+    let proxies = rows_of(&geometry, ObjectRole::Proxy, &whole).expect("matching bake");
+    assert_eq!(proxies.direct.vertex_count(), 8);
+    let spread = without_transfer(&geometry, &proxies, 2).expect("matching bake");
+    for v in [4, 7, 12, 15] {
+        assert_eq!(spread.direct.vector(v, 2), whole.direct.vector(v, 2), "{v}");
+    }
     assert!(with_objects_alone(&geometry, &whole, &bake(9, 2)).is_err());
 }
 
