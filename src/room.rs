@@ -9,7 +9,6 @@ use crate::bake_cache::bake_for;
 use anyhow::Context;
 use foundation::bvh::SceneBvh;
 use foundation::envmap::EnvMap;
-use foundation::infra::progress::Progress;
 use foundation::probe::Probe;
 use foundation::scene::{ModelPath, ObjectRole, Scene, SceneMesh};
 use glam::Vec3;
@@ -25,8 +24,6 @@ pub struct RoomModel {
     pub transfer: Transfer,
     /// The room alone (the composite's proxies without the objects).
     pub room_transfer: Transfer,
-    /// The model alone.
-    model_transfer: Transfer,
     pub lighting: ProbeLighting,
     /// Centre of the objects' bounds where the scene places them.
     pub centre: Vec3,
@@ -80,7 +77,6 @@ impl RoomModel {
             geometry: scene.geometry.clone(),
             transfer,
             room_transfer,
-            model_transfer,
             lighting,
             centre,
             path: scene.model_path.clone(),
@@ -92,23 +88,6 @@ impl RoomModel {
         let mut geometry = self.geometry.clone();
         geometry.move_objects(centre - self.centre);
         geometry
-    }
-
-    /// The transfer with the model resting at `centre`: the whole scene baked with the model
-    /// there (the room takes its soft shadow and the light it bounces, as a composite's
-    /// proxies do), the model's own rows from its bake alone. Baked in memory (a bake per
-    /// place would fill the cache), with the model's bake settings.
-    pub fn resting_transfer(
-        &self,
-        centre: Vec3,
-        progress: &dyn Progress,
-    ) -> anyhow::Result<Transfer> {
-        resting_transfer(&self.placed(centre), &self.model_transfer, progress)
-    }
-
-    /// What [`Self::resting_transfer`] bakes from, to bake it on another thread.
-    pub fn resting_inputs(&self, centre: Vec3) -> (SceneMesh, Transfer) {
-        (self.placed(centre), self.model_transfer.clone())
     }
 
     /// The lighting at `centre`, followed from the previous update's, and the renderer's
@@ -125,18 +104,6 @@ impl RoomModel {
         );
         (lighting, frame)
     }
-}
-
-/// [`RoomModel::resting_transfer`] of the scene placed as `geometry`, whose model alone has
-/// the bake `model`.
-pub fn resting_transfer(
-    geometry: &SceneMesh,
-    model: &Transfer,
-    progress: &dyn Progress,
-) -> anyhow::Result<Transfer> {
-    let bvh = SceneBvh::build(&geometry.mesh);
-    let (whole, _) = precompute::bake::bake(geometry, &bvh, &model.settings, progress)?;
-    Ok(with_objects_alone(geometry, &whole, model)?)
 }
 
 /// Warns when the probes' images differ in size: each is still looked up at its own

@@ -271,7 +271,6 @@ impl App {
         self.lighting.lit_for = None;
         if let Some(room) = self.room.as_mut() {
             room.drawn_at = None;
-            room.resting = super::room_state::Resting::Moving;
             // The room's own shadowing is in the local map already: only the model casts.
             if let Some(renderer) = self.window.renderer.as_mut() {
                 renderer.set_shadow_casters(runtime::render::ShadowCasters::Objects);

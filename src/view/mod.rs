@@ -423,7 +423,6 @@ impl App {
                 path: (r.path_frames() > 0).then(|| (r.path_frame, r.path_frames())),
                 last: r.last.as_ref(),
                 texels: r.model.lighting.geometry().directions().len(),
-                resting: r.resting.describe(),
             }),
             environment: self.lighting.environment.as_ref().map(|e| e.map()),
             env_choices: &self.env_choices,

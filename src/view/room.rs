@@ -5,11 +5,10 @@
 //! empty room's path-traced picture, seen through the scene's camera.
 
 use super::App;
-use super::room_state::{REST_FRAMES, Resting, RoomState};
+use super::room_state::RoomState;
 use foundation::envmap::EnvMap;
 use glam::Vec3;
 use runtime::render::LiveBackplate;
-use runtime::render::Renderer;
 use std::sync::Arc;
 
 impl App {
@@ -71,13 +70,8 @@ impl App {
             room.advance_path();
         }
         if room.drawn_at == Some(room.centre) {
-            room.still_frames += 1;
-            return settle(room, renderer);
+            return Ok(());
         }
-        if matches!(room.resting, Resting::Rested) {
-            renderer.set_transfer(&room.model.transfer)?;
-        }
-        (room.resting, room.still_frames) = (Resting::Moving, 0);
         let (lighting, frame) = room.model.update(room.centre);
         renderer.move_vertices(&room.model.placed(room.centre))?;
         renderer.set_lighting(&lighting)?;
@@ -102,28 +96,6 @@ impl App {
             "fuse_ms": last.map_or(0.0, |f| f.fuse_ms),
             "decompose_ms": last.map_or(0.0, |f| f.decompose_ms),
             "lights": last.map_or(0, |f| f.lighting.lights.len()),
-            "rested": matches!(room.resting, Resting::Rested),
         })
     }
-}
-
-/// A model that stays put gets the room baked with it there (its soft shadow and bounce
-/// light on the room, as a composite's proxies take them); the bake lands if the model is
-/// still there.
-fn settle(room: &mut RoomState, renderer: &mut Renderer) -> anyhow::Result<()> {
-    match &room.resting {
-        Resting::Moving if room.still_frames >= REST_FRAMES => room.start_resting_bake(),
-        Resting::Baking(at, receiver) => match receiver.try_recv() {
-            Ok(Ok(transfer)) if *at == room.centre => {
-                renderer.set_transfer(&transfer)?;
-                room.resting = Resting::Rested;
-            }
-            Ok(Ok(_)) => room.resting = Resting::Moving,
-            Ok(Err(e)) => return Err(e.context("cannot bake the room with the model")),
-            Err(std::sync::mpsc::TryRecvError::Empty) => {}
-            Err(std::sync::mpsc::TryRecvError::Disconnected) => room.resting = Resting::Moving,
-        },
-        _ => {}
-    }
-    Ok(())
 }

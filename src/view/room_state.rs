@@ -8,9 +8,7 @@ use foundation::envmap::EnvMap;
 use foundation::image_io::RgbImageF32;
 use foundation::scene::{ObjectRole, Scene};
 use glam::Vec3;
-use precompute::bake::Transfer;
 use runtime::{DecomposeSettings, ProbeFrame};
-use std::sync::mpsc::Receiver;
 
 /// Paths per pixel of the empty room's picture (cached with the reports' references).
 const PHOTOGRAPH_SPP: u32 = 16;
@@ -29,35 +27,7 @@ pub(super) struct RoomState {
     /// The centre the renderer's lighting and vertices were last set for.
     pub(super) drawn_at: Option<Vec3>,
     pub(super) last: Option<ProbeFrame>,
-    /// Whether the room is drawn with the model where it rests (its soft shadow and bounce).
-    pub(super) resting: Resting,
-    /// Frames the model has not moved.
-    pub(super) still_frames: u32,
 }
-
-/// The room's bake as the model moves and rests.
-pub(super) enum Resting {
-    /// Moving: the room's own bake, the model's shadows from the lights alone.
-    Moving,
-    /// Baking the room with the model at this centre, on another thread.
-    Baking(Vec3, Receiver<anyhow::Result<Transfer>>),
-    /// Drawn with the room baked with the model where it is.
-    Rested,
-}
-
-impl Resting {
-    /// What the panel says of it.
-    pub(super) fn describe(&self) -> &'static str {
-        match self {
-            Resting::Moving => "moving: the room takes the model's shadows from the lights",
-            Resting::Baking(..) => "at rest: baking the room with the model here",
-            Resting::Rested => "at rest: the room baked with the model here (soft shadow, bounce)",
-        }
-    }
-}
-
-/// Frames the model stays put before the room is baked with it there.
-pub(super) const REST_FRAMES: u32 = 4;
 
 impl RoomState {
     /// The room of `scene` under `map` turned by `rotation_deg`: both parts baked (or taken
@@ -86,8 +56,6 @@ impl RoomState {
             path_frame: 0,
             drawn_at: None,
             last: None,
-            resting: Resting::Moving,
-            still_frames: 0,
         })
     }
 
@@ -111,21 +79,6 @@ impl RoomState {
                 .context("cannot path-trace the empty room")?
                 .radiance,
         )
-    }
-
-    /// Starts baking the room with the model at its centre, on another thread.
-    pub(super) fn start_resting_bake(&mut self) {
-        let (geometry, model) = self.model.resting_inputs(self.centre);
-        let (sender, receiver) = std::sync::mpsc::channel();
-        std::thread::spawn(move || {
-            let no_progress = &foundation::infra::progress::NoProgress;
-            let _ = sender.send(crate::room::resting_transfer(
-                &geometry,
-                &model,
-                no_progress,
-            ));
-        });
-        self.resting = Resting::Baking(self.centre, receiver);
     }
 
     /// Frames of the `[path]` (0 without one).

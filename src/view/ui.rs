@@ -61,8 +61,6 @@ pub struct RoomInfo<'a> {
     pub last: Option<&'a runtime::ProbeFrame>,
     /// Texels of the local map.
     pub texels: usize,
-    /// How the room takes the model: moving or at rest.
-    pub resting: &'static str,
 }
 
 /// What the user asked for in the panel.
@@ -426,7 +424,6 @@ impl Panel<'_> {
                 100.0 * last.stats.unseen as f64 / room.texels.max(1) as f64
             ));
         }
-        ui.label(room.resting);
         ui.label("arrow keys move the model (Page Up/Down: up and down)");
         ui.label(
             "the empty room's picture is path-traced for the view as the composite turns on: \

@@ -23,8 +23,6 @@ pub enum RenderError {
 pub enum BakeMismatch {
     #[error("the bake has {bake} vertices, the scene {scene}")]
     VertexCount { bake: usize, scene: usize },
-    #[error("the new bake's SH order {bake} is not the drawn one's, {drawn}")]
-    OrderChanged { bake: usize, drawn: usize },
     #[error("the bake's SH order {order} is above the renderer's maximum {max}")]
     OrderTooHigh { order: usize, max: usize },
     #[error("the transfer ({mb} MB) exceeds the adapter's storage buffer limit ({limit_mb} MB)")]

@@ -191,25 +191,6 @@ impl GpuScene {
         self.bounds = geometry.mesh.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
     }
 
-    /// Uploads another bake of the same vertices in place of the scene's.
-    pub(crate) fn write_transfer(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        transfer: &Transfer,
-    ) -> Result<(), RenderError> {
-        check_bake(device, self.vertex_count as usize, transfer)?;
-        if transfer.settings.order != self.order {
-            return Err(BakeMismatch::OrderChanged {
-                bake: transfer.settings.order,
-                drawn: self.order,
-            }
-            .into());
-        }
-        self.transfer_pass.write(queue, transfer);
-        Ok(())
-    }
-
     /// Uploads `lighting` and records the pass that recomputes every vertex's radiance.
     pub(crate) fn update_radiance(
         &self,

@@ -253,15 +253,6 @@ impl Renderer {
         Ok(())
     }
 
-    /// Draws with another bake of the same scene (the room baked again with the model where
-    /// it came to rest): same vertices, same order.
-    pub fn set_transfer(&mut self, transfer: &Transfer) -> Result<(), RenderError> {
-        self.scene
-            .write_transfer(&self.device, &self.queue, transfer)?;
-        self.frame.radiance_dirty = true;
-        Ok(())
-    }
-
     /// Which geometry casts the lights' shadows (all of it unless set).
     pub fn set_shadow_casters(&mut self, casters: ShadowCasters) {
         if casters != self.casters {

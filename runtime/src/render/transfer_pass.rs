@@ -22,8 +22,6 @@ pub(super) struct LightingUniform {
 
 pub(super) struct TransferPass {
     lighting_buffer: wgpu::Buffer,
-    full: wgpu::Buffer,
-    indirect: wgpu::Buffer,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
 }
@@ -41,7 +39,7 @@ impl TransferPass {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
                 contents: bytemuck::cast_slice(contents),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::STORAGE,
             })
         };
         let full = storage("full transfer", transfer.full().as_slice());
@@ -80,19 +78,9 @@ impl TransferPass {
         );
         Self {
             lighting_buffer,
-            full,
-            indirect,
             pipeline,
             bind_group,
         }
-    }
-
-    /// Uploads another bake of the same vertices at the same order in place of the first.
-    pub(super) fn write(&self, queue: &wgpu::Queue, transfer: &Transfer) {
-        let full = transfer.full();
-        queue.write_buffer(&self.full, 0, bytemuck::cast_slice(full.as_slice()));
-        let indirect = transfer.indirect.as_slice();
-        queue.write_buffer(&self.indirect, 0, bytemuck::cast_slice(indirect));
     }
 
     /// Uploads `lighting` (at the bake's `order`) and records the pass over `vertex_count`

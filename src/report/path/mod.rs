@@ -220,9 +220,6 @@ impl PathRun {
         let on_model: Vec<bool> = kinds.iter().map(|k| *k == PixelKind::Object).collect();
         let true_probe = self.true_probe(centre, probe_spp);
         self.whole.move_vertices(&geometry)?;
-        let no_progress = &foundation::infra::progress::NoProgress;
-        let rested = self.model.resting_transfer(centre, no_progress)?;
-        self.whole.set_transfer(&rested)?;
         let lightings = (self.lightings.as_mut())
             .context("the methods' lighting is not set up")?
             .at(&mut self.model, centre, &true_probe)?;
