@@ -55,8 +55,8 @@ impl RoomModel {
             .context("the scene has no virtual objects to move")?;
         let (_, model_transfer) = bake_for(&model, None).context("cannot bake the model alone")?;
         // The room without the model, baked with the model's vertices kept (collapsed to a
-        // point no ray meets): each room vertex gets the samples it gets in a bake with the
-        // model, so the two bakes' noise cancels in the composite's ratio.
+        // point no ray meets), so that its rows sit on the scene's vertices; the room renderer
+        // draws the same rows, so the composite's ratio is one but for the model's shadows.
         let mut collapsed = scene.geometry.clone();
         collapsed.collapse_objects(centre);
         let empty = Scene {

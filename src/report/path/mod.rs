@@ -65,12 +65,8 @@ pub fn write_path_report(
     };
     let gpu = GpuContext::headless(settings.backend)?;
     println!("adapter: {}", gpu.description());
-    let mut run = PathRun::new(scene, model, &gpu, (map, rotation_deg), &camera, settings)?;
-    run.lightings = Some(MethodLightings::new(
-        run.model.lighting.probes(),
-        run.one_probe,
-        decompose,
-    )?);
+    let sky = (map, rotation_deg);
+    let mut run = PathRun::new(scene, (model, decompose), &gpu, sky, &camera, settings)?;
     let positions = path.positions();
     let frames = pick_frames(positions.len(), options.positions);
     let (mut per_position, mut gif) = (Vec::new(), Vec::new());
@@ -134,9 +130,7 @@ struct PathRun {
     empty: ReferenceImages,
     request: ReferenceRequest,
     exposure: f32,
-    /// The probe nearest the room's centre.
-    one_probe: usize,
-    lightings: Option<MethodLightings>,
+    lightings: MethodLightings,
     previous: Option<Previous>,
 }
 
@@ -149,9 +143,10 @@ struct Previous {
 }
 
 impl PathRun {
+    /// `model` and the decomposition its methods' maps get.
     fn new(
         scene: &Scene,
-        model: RoomModel,
+        (model, decompose): (RoomModel, DecomposeSettings),
         gpu: &GpuContext,
         (map, rotation_deg): (&EnvMap, f32),
         camera: &Camera,
@@ -168,7 +163,9 @@ impl PathRun {
         room.set_shadow_casters(ShadowCasters::Objects);
         let probes = model.lighting.probes();
         let room_centre = (room_geometry.mesh.bounds()).map_or(Vec3::ZERO, |(a, b)| 0.5 * (a + b));
+        // The probe nearest the room's centre: method (a)'s.
         let one_probe = nearest(probes, room_centre);
+        let lightings = MethodLightings::new(probes, one_probe, decompose)?;
         // The room's own light sets the exposure, as the map's does for a model in the open.
         let exposure = default_exposure(&probes[one_probe].radiance);
         let request = ReferenceRequest {
@@ -195,8 +192,7 @@ impl PathRun {
             empty,
             request,
             exposure,
-            one_probe,
-            lightings: None,
+            lightings,
             previous: None,
         })
     }
@@ -220,9 +216,7 @@ impl PathRun {
         let on_model: Vec<bool> = kinds.iter().map(|k| *k == PixelKind::Object).collect();
         let true_probe = self.true_probe(centre, probe_spp);
         self.whole.move_vertices(&geometry)?;
-        let lightings = (self.lightings.as_mut())
-            .context("the methods' lighting is not set up")?
-            .at(&mut self.model, centre, &true_probe)?;
+        let lightings = (self.lightings).at(&mut self.model, centre, &true_probe)?;
         let mut covered: Vec<bool> = (on_model.iter().zip(&changed))
             .map(|(a, b)| *a || *b)
             .collect();
