@@ -3,17 +3,19 @@
 //! so moving the model keeps both bakes; at each position the local map at the model's centre
 //! is fused from the probes (`runtime::ProbeLighting`), decomposed with its lights followed
 //! from the previous position, and lights the frame: the model through its own transfer, the
-//! room's change (the model's shadows) through the lights' shadow maps.
+//! room's change (the model's shadows) through the lights' shadow maps. A turned model keeps
+//! its bake turned with it (it was baked alone, so nothing else's shadow turns with it).
 
 use crate::bake_cache::bake_for;
 use anyhow::Context;
 use foundation::bvh::SceneBvh;
 use foundation::envmap::EnvMap;
 use foundation::probe::Probe;
-use foundation::scene::{ModelPath, ObjectRole, Scene, SceneMesh};
-use glam::Vec3;
+use foundation::scene::{ModelPath, ObjectRole, Pose, Scene, SceneMesh};
+use foundation::sh::rotation::ShRotation;
+use glam::{Mat3, Quat, Vec3};
 use precompute::bake::Transfer;
-use runtime::render::{FrameLighting, RenderMode, rows_of, with_objects_alone};
+use runtime::render::{FrameLighting, RenderMode, Renderer, rows_of, with_objects_alone};
 use runtime::{DecomposeSettings, ProbeFrame, ProbeLighting, TrackingSettings};
 
 /// A scene's room (its proxies and probes) and the model (its objects) that moves through it.
@@ -83,11 +85,46 @@ impl RoomModel {
         })
     }
 
-    /// The scene's geometry with the objects moved so that their centre is at `centre`.
-    pub fn placed(&self, centre: Vec3) -> SceneMesh {
+    /// The scene's geometry with the objects at `pose`.
+    pub fn placed(&self, pose: Pose) -> SceneMesh {
         let mut geometry = self.geometry.clone();
-        geometry.move_objects(centre - self.centre);
+        geometry.pose_objects(self.centre, pose);
         geometry
+    }
+
+    /// [`Self::transfer`] with the model's rows turned by `rotation`.
+    pub fn turned_transfer(&self, rotation: Quat) -> anyhow::Result<Transfer> {
+        let mut transfer = self.transfer.clone();
+        let turn = ShRotation::new(
+            Mat3::from_quat(rotation.normalize()),
+            transfer.settings.order,
+        )?;
+        let objects = self.geometry.objects.iter();
+        for o in objects.filter(|o| o.role == ObjectRole::Object) {
+            let range = o.vertices.start as usize..o.vertices.end as usize;
+            transfer.direct.rotate_vertices(range.clone(), &turn);
+            transfer.indirect.rotate_vertices(range, &turn);
+        }
+        Ok(transfer)
+    }
+
+    /// Puts the model at `pose` in `renderer`, which draws [`Self::geometry`] with
+    /// [`Self::transfer`] and last had the model at `drawn` (`None`: where the scene places
+    /// it): its vertices moved, and its bake turned when its turn changed. Returns the
+    /// geometry drawn.
+    pub fn pose_in(
+        &self,
+        renderer: &mut Renderer,
+        pose: Pose,
+        drawn: Option<Pose>,
+    ) -> anyhow::Result<SceneMesh> {
+        let geometry = self.placed(pose);
+        renderer.move_vertices(&geometry)?;
+        if drawn.map_or(Quat::IDENTITY, |p| p.rotation) != pose.rotation {
+            let transfer = self.turned_transfer(pose.rotation)?;
+            renderer.set_transfer(&geometry, &transfer)?;
+        }
+        Ok(geometry)
     }
 
     /// The lighting at `centre`, followed from the previous update's, and the renderer's

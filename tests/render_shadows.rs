@@ -477,3 +477,100 @@ fn small_light(direction: Vec3) -> DirectionalLight {
         share: 1.0,
     }
 }
+
+/// A turned model keeps its bake turned (`rotate_vertices`, uploaded by
+/// `Renderer::set_transfer`): it draws as the same model baked where it is turned, within the
+/// two bakes' noise, on both adapters. An L of two boxes, lit from one side: the tower
+/// shadows the bar, and bounces light onto it, only from some directions, so a bake not
+/// turned with it (or turned the wrong way) draws the shadow in the wrong place.
+#[test]
+fn a_turned_model_draws_as_one_baked_turned() {
+    let mut geometry = SceneMesh::default();
+    let bar = foundation::mesh::box_mesh(
+        Vec3::new(-1.0, 0.0, -0.3),
+        Vec3::new(1.0, 0.4, 0.3),
+        [12, 3, 4],
+        [false; 6],
+    );
+    let tower = foundation::mesh::box_mesh(
+        Vec3::new(0.4, 0.4, -0.3),
+        Vec3::new(1.0, 1.6, 0.3),
+        [4, 8, 4],
+        [false; 6],
+    );
+    geometry.push_object("bar".into(), &bar, Rgb::splat(0.8));
+    geometry.push_object("tower".into(), &tower, Rgb::splat(0.8));
+    let (order, samples) = (5, 2048);
+    let rest_bake = bake_of(&geometry, order, samples, 1);
+    let centre = Vec3::new(0.0, 0.8, 0.0);
+    let pose = foundation::scene::Pose {
+        centre: Vec3::new(0.2, 0.9, -0.1),
+        rotation: foundation::scene::rotation_from_deg([25.0, 120.0, -15.0]),
+    };
+    let mut turned = geometry.clone();
+    turned.pose_objects(centre, pose);
+    let mut turned_bake = rest_bake.clone();
+    let turn =
+        foundation::sh::rotation::ShRotation::new(glam::Mat3::from_quat(pose.rotation), order)
+            .unwrap();
+    for t in [&mut turned_bake.direct, &mut turned_bake.indirect] {
+        t.rotate_vertices(0..geometry.mesh.vertex_count(), &turn);
+    }
+    let baked_turned = bake_of(&turned, order, samples, 1);
+    let mut sh = uniform_sh(order, 0.05);
+    sh.add_delta(Vec3::new(-0.9, 0.5, 0.4).normalize(), Rgb::splat(4.0));
+    let lighting = FrameLighting {
+        sh,
+        ..FrameLighting::lights_only(order, vec![])
+    };
+    let view = camera(
+        Vec3::new(-1.0, 2.2, 2.6),
+        Vec3::new(0.2, 0.9, -0.1),
+        128,
+        96,
+    );
+    let mean_difference = |a: &foundation::image_io::RgbImageF32,
+                           b: &foundation::image_io::RgbImageF32| {
+        let pairs = a.pixels.iter().zip(&b.pixels);
+        let covered = pairs.filter(|(x, y)| luminance(**x) > 0.0 || luminance(**y) > 0.0);
+        let (sum, mean, n) = covered.fold((0.0, 0.0, 0), |(s, m, n), (x, y)| {
+            let (x, y) = (luminance(*x) as f64, luminance(*y) as f64);
+            (s + (x - y).abs(), m + y, n + 1)
+        });
+        assert!(n > 1000, "the model covers {n} pixels");
+        sum / mean
+    };
+    for gpu in gpus() {
+        let mut renderer = Renderer::new(
+            &gpu,
+            &geometry,
+            &rest_bake,
+            &view,
+            ShadowSettings::default(),
+        )
+        .unwrap();
+        renderer.background = false;
+        renderer.set_lighting(&lighting).unwrap();
+        renderer.move_vertices(&turned).unwrap();
+        renderer.render().unwrap();
+        let unturned_bake = renderer.read_back().unwrap();
+        renderer.set_transfer(&turned, &turned_bake).unwrap();
+        renderer.render().unwrap();
+        let with_turned_bake = renderer.read_back().unwrap();
+        let truth = render(&gpu, &turned, &baked_turned, &view, &lighting);
+        let (right, wrong) = (
+            mean_difference(&with_turned_bake, &truth),
+            mean_difference(&unturned_bake, &truth),
+        );
+        println!(
+            "{}: turned bake {right:.4}, unturned {wrong:.4}",
+            gpu.description()
+        );
+        assert!(right < 0.01, "{}: {right}", gpu.description());
+        assert!(
+            wrong > 5.0 * right,
+            "{}: {wrong} against {right}",
+            gpu.description()
+        );
+    }
+}

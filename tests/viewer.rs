@@ -474,7 +474,8 @@ fn moves_a_model_through_a_room_under_xvfb() {
         d.join("room.script"),
         "wait-bake\nwait 4\nstate playing.json\nset play_path off\nplace 2.2 0.4 0\nwait 2\n\
          screenshot window.png\nstate window.json\nplace -2.2 0.4 0.3\nwait 2\n\
-         screenshot back.png\nstate back.json\nquit\n",
+         screenshot back.png\nstate back.json\nturn 90\nwait 2\nscreenshot turned.png\n\
+         state turned.json\nquit\n",
     )
     .unwrap();
     let out = view_under_xvfb_with(
@@ -528,4 +529,17 @@ fn moves_a_model_through_a_room_under_xvfb() {
         .filter(|(x, y)| x.abs_diff(**y) > 8)
         .count();
     assert!(differing > 300, "{differing} values differ");
+    // Turned where it stands: a quarter turn more, and another picture.
+    let turned = state("turned.json");
+    let turn = |s: &serde_json::Value| s["room"]["turn_deg"].as_f64().unwrap();
+    assert!(
+        (turn(&turned) - turn(&back) - 90.0).abs() < 1e-3,
+        "{turned}"
+    );
+    assert_eq!(turned["room"]["centre"], back["room"]["centre"]);
+    let (_, _, c) = image_rgb(&d.join("turned.png"));
+    let differing = (b.iter().zip(&c))
+        .filter(|(x, y)| x.abs_diff(**y) > 8)
+        .count();
+    assert!(differing > 300, "turning: {differing} values differ");
 }

@@ -177,6 +177,10 @@ impl ApplicationHandler for App {
                     self.settings.play_path = false;
                     self.move_model(offset);
                 }
+                if let Some(degrees) = model_turn(&event.logical_key) {
+                    self.settings.play_path = false;
+                    self.turn_model(degrees);
+                }
             }
             _ => {}
         }
@@ -198,6 +202,19 @@ fn model_step(key: &winit::keyboard::Key) -> Option<glam::Vec3> {
         _ => return None,
     };
     Some(direction * MODEL_STEP)
+}
+
+/// How far a key turns a room's model about the vertical: Q to the left (counter-clockwise
+/// seen from above), E to the right.
+fn model_turn(key: &winit::keyboard::Key) -> Option<f32> {
+    let winit::keyboard::Key::Character(c) = key else {
+        return None;
+    };
+    match c.to_lowercase().as_str() {
+        "q" => Some(super::ui::MODEL_TURN_DEG),
+        "e" => Some(-super::ui::MODEL_TURN_DEG),
+        _ => None,
+    }
 }
 
 /// Metres a key press moves a room's model.

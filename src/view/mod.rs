@@ -293,6 +293,13 @@ impl App {
                 }
                 C::Move(offset) if self.room.is_some() => self.move_model(offset),
                 C::Move(offset) => self.move_objects(offset),
+                C::Turn(degrees) => {
+                    anyhow::ensure!(
+                        self.room.is_some(),
+                        "turn: the scene has no room (no [[probe]] entries)"
+                    );
+                    self.turn_model(degrees);
+                }
                 C::Place(centre) => {
                     anyhow::ensure!(
                         self.room.is_some(),
@@ -419,7 +426,8 @@ impl App {
             has_backplate: self.scene.backplate.is_some() || self.room.is_some(),
             room: self.room.as_ref().map(|r| ui::RoomInfo {
                 probes: r.model.lighting.probes().len(),
-                centre: r.centre,
+                centre: r.pose.centre,
+                turn_deg: r.turn_deg(),
                 path: (r.path_frames() > 0).then(|| (r.path_frame, r.path_frames())),
                 last: r.last.as_ref(),
                 texels: r.model.lighting.geometry().directions().len(),
@@ -461,6 +469,7 @@ impl App {
             PanelAction::StartBake => self.start_bake(),
             PanelAction::MoveObjects(offset) if self.room.is_some() => self.move_model(offset),
             PanelAction::MoveObjects(offset) => self.move_objects(offset),
+            PanelAction::TurnModel(degrees) => self.turn_model(degrees),
             PanelAction::ResetView => self.reset_view(),
             PanelAction::SaveScreenshot => {
                 let name = format!("hprt-{}-{}.png", self.scene.name, self.stats.frames);

@@ -1,13 +1,13 @@
 //! A model carried through a room lit by its probes (a scene with `[[probe]]` entries): the
 //! model moves live (its `[path]` played back, the arrow keys, the panel, `move` and `place`
-//! in a script) and each new position fuses the local map at its centre, decomposes it and
+//! in a script), turns (Q and E, the panel, `turn` in a script), and each new position fuses the local map at its centre, decomposes it and
 //! follows its lights (`crate::room`); the model and its shadows are composited into the
 //! empty room's path-traced picture, seen through the scene's camera.
 
 use super::App;
 use super::room_state::RoomState;
 use foundation::envmap::EnvMap;
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use runtime::render::LiveBackplate;
 use std::sync::Arc;
 
@@ -47,14 +47,22 @@ impl App {
     /// Moves the model by `offset`, live.
     pub(super) fn move_model(&mut self, offset: Vec3) {
         if let Some(room) = self.room.as_mut() {
-            room.centre += offset;
+            room.pose.centre += offset;
         }
     }
 
     /// Puts the model's centre at `centre`, live.
     pub(super) fn place_model(&mut self, centre: Vec3) {
         if let Some(room) = self.room.as_mut() {
-            room.centre = centre;
+            room.pose.centre = centre;
+        }
+    }
+
+    /// Turns the model by `degrees` about the vertical through its centre, live.
+    pub(super) fn turn_model(&mut self, degrees: f32) {
+        if let Some(room) = self.room.as_mut() {
+            let turn = Quat::from_rotation_y(degrees.to_radians());
+            room.pose.rotation = (turn * room.pose.rotation).normalize();
         }
     }
 
@@ -69,16 +77,16 @@ impl App {
         if self.settings.play_path {
             room.advance_path();
         }
-        if room.drawn_at == Some(room.centre) {
+        if room.drawn_at == Some(room.pose) {
             return Ok(());
         }
-        let (lighting, frame) = room.model.update(room.centre);
-        renderer.move_vertices(&room.model.placed(room.centre))?;
+        let (lighting, frame) = room.model.update(room.pose.centre);
+        (room.model).pose_in(renderer, room.pose, room.drawn_at)?;
         renderer.set_lighting(&lighting)?;
         self.lighting.decomposition_ms = frame.decompose_ms;
         self.lighting.decomposition = Some(frame.lighting.clone());
         room.last = Some(frame);
-        room.drawn_at = Some(room.centre);
+        room.drawn_at = Some(room.pose);
         Ok(())
     }
 
@@ -90,7 +98,8 @@ impl App {
         let last = room.last.as_ref();
         serde_json::json!({
             "probes": room.model.lighting.probes().len(),
-            "centre": room.centre.to_array(),
+            "centre": room.pose.centre.to_array(),
+            "turn_deg": room.turn_deg(),
             "path_frame": room.path_frame,
             "path_frames": room.path_frames(),
             "fuse_ms": last.map_or(0.0, |f| f.fuse_ms),

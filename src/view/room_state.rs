@@ -6,8 +6,7 @@ use anyhow::Context;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::image_io::RgbImageF32;
-use foundation::scene::{ObjectRole, Scene};
-use glam::Vec3;
+use foundation::scene::{ObjectRole, Pose, Scene};
 use runtime::{DecomposeSettings, ProbeFrame};
 
 /// Paths per pixel of the empty room's picture (cached with the reports' references).
@@ -20,12 +19,12 @@ pub(super) struct RoomState {
     room: Scene,
     map: EnvMap,
     rotation_deg: f32,
-    /// Where the centre of the model is.
-    pub(super) centre: Vec3,
+    /// Where the model is and how it is turned.
+    pub(super) pose: Pose,
     /// The `[path]` frame shown (playing back, one per drawn frame).
     pub(super) path_frame: usize,
-    /// The centre the renderer's lighting and vertices were last set for.
-    pub(super) drawn_at: Option<Vec3>,
+    /// The pose the renderer's lighting, vertices and bake were last set for.
+    pub(super) drawn_at: Option<Pose>,
     pub(super) last: Option<ProbeFrame>,
 }
 
@@ -44,15 +43,15 @@ impl RoomState {
             backplate: None,
             ..scene.clone()
         };
-        let centre = (model.path.as_ref())
-            .and_then(|p| p.positions().first().copied())
-            .unwrap_or(model.centre);
+        let pose = (model.path.as_ref())
+            .and_then(|p| p.poses().first().copied())
+            .unwrap_or(Pose::at(model.centre));
         Ok(Self {
             model,
             room,
             map: map.clone(),
             rotation_deg,
-            centre,
+            pose,
             path_frame: 0,
             drawn_at: None,
             last: None,
@@ -81,6 +80,13 @@ impl RoomState {
         )
     }
 
+    /// How far the model is turned from where the scene places it, in degrees (0 to 180),
+    /// about whichever axis.
+    pub(super) fn turn_deg(&self) -> f32 {
+        let turn = self.pose.rotation.normalize();
+        turn.angle_between(glam::Quat::IDENTITY).to_degrees()
+    }
+
     /// Frames of the `[path]` (0 without one).
     pub(super) fn path_frames(&self) -> usize {
         self.model.path.as_ref().map_or(0, |p| p.positions().len())
@@ -90,11 +96,11 @@ impl RoomState {
     /// followed lights.
     pub(super) fn advance_path(&mut self) {
         let Some(path) = &self.model.path else { return };
-        let positions = path.positions();
-        self.path_frame = (self.path_frame + 1) % positions.len();
+        let poses = path.poses();
+        self.path_frame = (self.path_frame + 1) % poses.len();
         if self.path_frame == 0 {
             self.model.lighting.reset();
         }
-        self.centre = positions[self.path_frame];
+        self.pose = poses[self.path_frame];
     }
 }

@@ -15,6 +15,7 @@
 //! move 1 0 -0.5             # move the virtual objects by (dx, dy, dz) (re-baked; live in a
 //!                           # room with probes)
 //! place 1 0.4 -0.5          # a room's model: put its centre there (live)
+//! turn 30                   # a room's model: turn it 30° about the vertical (live)
 //! state state.json          # lights, timings and visible panels, as JSON
 //! quit
 //! ```
@@ -38,6 +39,8 @@ pub enum Command {
     Move(glam::Vec3),
     /// Put the centre of a room's model here.
     Place(glam::Vec3),
+    /// Turn a room's model by this many degrees about the vertical.
+    Turn(f32),
     Quit,
 }
 
@@ -82,6 +85,7 @@ pub fn parse(path: &Path, text: &str) -> anyhow::Result<Vec<Command>> {
             "window-screenshot" => Command::WindowScreenshot(path_at(1)?),
             "command" => Command::SaveRenderLine(path_at(1)?),
             "move" => Command::Move(glam::Vec3::new(number_at(1)?, number_at(2)?, number_at(3)?)),
+            "turn" => Command::Turn(number_at(1)?),
             "place" => Command::Place(glam::Vec3::new(number_at(1)?, number_at(2)?, number_at(3)?)),
             "state" => Command::State(path_at(1)?),
             "quit" => Command::Quit,
@@ -100,9 +104,10 @@ mod tests {
     fn parses_every_command_and_reports_bad_lines() {
         let text = "# smoke\nwait 3\norbit 10 -5\npan 1 2\nzoom -1.5\nreset\nset rotation 30\n\
                     screenshot a.png\nwindow-screenshot b.png\ncommand c.sh\nstate d.json\n\
-                    place 1 0.5 -2\nquit\n";
+                    place 1 0.5 -2\nturn -45\nquit\n";
         let commands = parse(Path::new("s.txt"), text).unwrap();
-        assert_eq!(commands.len(), 12);
+        assert_eq!(commands.len(), 13);
+        assert_eq!(commands[11], Command::Turn(-45.0));
         assert_eq!(
             commands[10],
             Command::Place(glam::Vec3::new(1.0, 0.5, -2.0))

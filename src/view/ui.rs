@@ -12,6 +12,9 @@ use std::path::{Path, PathBuf};
 
 const THUMBNAIL: [usize; 2] = [256, 128];
 
+/// Degrees a press of Q or E, or of the panel's buttons, turns a room's model.
+pub const MODEL_TURN_DEG: f32 = 15.0;
+
 /// Where the scene's bake stands.
 pub enum BakeStatus<'a> {
     /// Loaded, of this SH order.
@@ -55,6 +58,8 @@ pub struct RoomInfo<'a> {
     pub probes: usize,
     /// Where the centre of the model is.
     pub centre: glam::Vec3,
+    /// How far it is turned from where the scene places it.
+    pub turn_deg: f32,
     /// `(frame, frames)` of the `[path]`.
     pub path: Option<(usize, usize)>,
     /// The last update: its costs and how many texels no probe saw.
@@ -72,6 +77,8 @@ pub enum PanelAction {
     SaveScreenshot,
     /// Move the virtual objects by this offset (then re-bake).
     MoveObjects(glam::Vec3),
+    /// Turn a room's model by this many degrees about the vertical.
+    TurnModel(f32),
 }
 
 /// The panel's own state between frames.
@@ -399,9 +406,20 @@ impl Panel<'_> {
         self.heading(ui, "Room");
         let c = room.centre;
         ui.label(format!(
-            "{} probes; the model at ({:.2}, {:.2}, {:.2})",
-            room.probes, c.x, c.y, c.z
+            "{} probes; the model at ({:.2}, {:.2}, {:.2}), turned {:.0}°",
+            room.probes, c.x, c.y, c.z, room.turn_deg
         ));
+        ui.horizontal(|ui| {
+            ui.label("turn the model");
+            for degrees in [-MODEL_TURN_DEG, MODEL_TURN_DEG] {
+                if (ui.button(format!("{degrees:+.0}°")))
+                    .on_hover_text("About the vertical through its centre; its bake turns with it")
+                    .clicked()
+                {
+                    self.actions.push(PanelAction::TurnModel(degrees));
+                }
+            }
+        });
         if let Some((frame, frames)) = room.path {
             ui.checkbox(&mut self.settings.play_path, "play the path")
                 .on_hover_text("The scene's [path], one frame per drawn frame, looping");
@@ -424,7 +442,7 @@ impl Panel<'_> {
                 100.0 * last.stats.unseen as f64 / room.texels.max(1) as f64
             ));
         }
-        ui.label("arrow keys move the model (Page Up/Down: up and down)");
+        ui.label("arrow keys move the model (Page Up/Down: up and down), Q and E turn it");
         ui.label(
             "the empty room's picture is path-traced for the view as the composite turns on: \
              turn it off and on after moving the camera",

@@ -1,9 +1,10 @@
 //! The scene file as written (TOML, `scenes/README.md`): what the user describes, before
 //! anything is loaded.
 
+use super::rotation::rotation_from_deg;
 use crate::bake_settings::BakeSettings;
 use crate::camera::Camera;
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -249,9 +250,7 @@ impl Transform {
             Scale::Uniform(s) => Vec3::splat(s),
             Scale::PerAxis(s) => Vec3::from(s),
         };
-        let [rx, ry, rz] = self.rotate_deg.map(f32::to_radians);
-        let rotation =
-            Quat::from_rotation_z(rz) * Quat::from_rotation_y(ry) * Quat::from_rotation_x(rx);
+        let rotation = rotation_from_deg(self.rotate_deg);
         Mat4::from_scale_rotation_translation(scale, rotation, Vec3::from(self.translate))
     }
 }

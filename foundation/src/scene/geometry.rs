@@ -214,6 +214,21 @@ impl SceneMesh {
         }
     }
 
+    /// Puts the objects, placed by the scene with their centre at `rest_centre`, at `pose`:
+    /// turned about that centre, then moved so that it is at the pose's.
+    pub fn pose_objects(&mut self, rest_centre: glam::Vec3, pose: super::Pose) {
+        let rotation = pose.rotation.normalize();
+        for o in self.objects.iter().filter(|o| o.role == ObjectRole::Object) {
+            let range = o.vertices.start as usize..o.vertices.end as usize;
+            for p in &mut self.mesh.positions[range.clone()] {
+                *p = pose.centre + rotation * (*p - rest_centre);
+            }
+            for n in &mut self.mesh.normals[range] {
+                *n = (rotation * *n).normalize_or_zero();
+            }
+        }
+    }
+
     /// Whether any object has a specular lobe.
     pub fn is_glossy(&self) -> bool {
         self.objects.iter().any(|o| o.material.is_glossy())
@@ -289,5 +304,59 @@ impl SceneMesh {
             }
         }
         albedo
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::box_mesh;
+    use crate::scene::Pose;
+    use glam::{Quat, Vec3};
+
+    /// A posed object is turned about its rest centre and moved there, normals turned with
+    /// it; the proxies stay.
+    #[test]
+    fn posing_turns_the_objects_about_their_centre() {
+        let mut geometry = SceneMesh::default();
+        let model = box_mesh(
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(3.0, 1.0, 1.0),
+            [1; 3],
+            [false; 6],
+        );
+        geometry.push_object("model".into(), &model, Rgb::splat(0.5));
+        let floor = box_mesh(
+            Vec3::splat(-5.0),
+            Vec3::new(5.0, -4.0, 5.0),
+            [1; 3],
+            [false; 6],
+        );
+        geometry.push_object("floor".into(), &floor, Rgb::splat(0.5));
+        geometry.objects[1].role = ObjectRole::Proxy;
+        let rest = geometry.clone();
+        let centre = Vec3::new(2.0, 0.5, 0.5);
+        let pose = Pose {
+            centre: Vec3::new(0.0, 0.5, 0.0),
+            rotation: Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+        };
+        geometry.pose_objects(centre, pose);
+        let (lo, hi) = geometry
+            .subset(|o| o.role == ObjectRole::Object)
+            .mesh
+            .bounds()
+            .unwrap();
+        // 2 × 1 × 1 along x turns into 1 × 1 × 2 along z, about the new centre.
+        assert!(lo.distance(Vec3::new(-0.5, 0.0, -1.0)) < 1e-5, "{lo}");
+        assert!(hi.distance(Vec3::new(0.5, 1.0, 1.0)) < 1e-5, "{hi}");
+        for v in 0..model.vertex_count() {
+            let turned = pose.rotation * rest.mesh.normals[v];
+            assert!(geometry.mesh.normals[v].distance(turned) < 1e-6);
+        }
+        let proxies = model.vertex_count()..geometry.mesh.vertex_count();
+        assert_eq!(
+            geometry.mesh.positions[proxies.clone()],
+            rest.mesh.positions[proxies]
+        );
     }
 }

@@ -7,6 +7,7 @@ mod description;
 mod geometry;
 pub mod model;
 mod path;
+mod rotation;
 
 pub use backplate::{BackplateError, load_backplate_image};
 pub use build::MAX_MATERIAL_ALBEDO;
@@ -15,7 +16,8 @@ pub use description::{
     ProbeSpec, Scale, SceneFile, Transform,
 };
 pub use geometry::{NO_TEXTURE, SceneMesh, SceneObject};
-pub use path::{Crossing, ModelPath, PathSpec, mesh_crosses};
+pub use path::{Crossing, ModelPath, PathSpec, Pose, mesh_crosses};
+pub use rotation::rotation_from_deg;
 
 use crate::bake_settings::BakeSettings;
 use crate::camera::Camera;

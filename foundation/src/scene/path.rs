@@ -1,13 +1,15 @@
 //! `[path]`: the virtual objects carried through the scene, frame by frame (a model moved
 //! through a room lit by its probes).
 
+use super::rotation::rotation_from_deg;
 use crate::bvh::{SceneBvh, Skip};
 use crate::infra::limits::MAX_PATH_FRAMES;
 use crate::mesh::TriangleMesh;
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
-/// `[path]` as written: where the centre of the virtual objects' bounds goes.
+/// `[path]` as written: where the centre of the virtual objects' bounds goes, and optionally
+/// how they are turned there.
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PathSpec {
@@ -15,13 +17,44 @@ pub struct PathSpec {
     pub points: Vec<[f32; 3]>,
     /// Frames along it, the first at the first point and the last at the last.
     pub frames: u32,
+    /// One turn per point, as an object's `rotate_deg` (about x, then y, then z, in degrees),
+    /// of the objects about their centre from where the scene places them; each angle goes
+    /// linearly from point to point, so `[0, 0, 0]` to `[0, 360, 0]` is a whole turn.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotate_deg: Option<Vec<[f32; 3]>>,
 }
 
 /// A checked path.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelPath {
     points: Vec<Vec3>,
+    /// Per point, its `rotate_deg` (zero when the path gives none).
+    turns: Vec<Vec3>,
     frames: u32,
+}
+
+/// Where the virtual objects are: their centre, and their turn about it from where the scene
+/// places them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    pub centre: Vec3,
+    pub rotation: Quat,
+}
+
+impl Pose {
+    /// At `centre`, unturned.
+    pub fn at(centre: Vec3) -> Self {
+        Self {
+            centre,
+            rotation: Quat::IDENTITY,
+        }
+    }
+
+    /// Whether the objects are turned at all.
+    pub fn is_turned(&self) -> bool {
+        !self.rotation.abs_diff_eq(Quat::IDENTITY, 1e-7)
+            && !self.rotation.abs_diff_eq(-Quat::IDENTITY, 1e-7)
+    }
 }
 
 /// Where a path's centre passes through a proxy's surface.
@@ -61,9 +94,27 @@ impl PathSpec {
             return Err("[path]: every point is the same: the path does not move".into());
         }
         Ok(ModelPath {
+            turns: self.turns(points.len())?,
             points,
             frames: self.frames,
         })
+    }
+
+    /// `rotate_deg` checked against `points` points.
+    fn turns(&self, points: usize) -> Result<Vec<Vec3>, String> {
+        let Some(turns) = &self.rotate_deg else {
+            return Ok(vec![Vec3::ZERO; points]);
+        };
+        if turns.len() != points {
+            return Err(format!(
+                "[path]: {} rotate_deg for {points} points; give one per point",
+                turns.len()
+            ));
+        }
+        if let Some(t) = turns.iter().find(|t| !t.iter().all(|x| x.is_finite())) {
+            return Err(format!("[path]: the rotation {t:?} is not finite"));
+        }
+        Ok(turns.iter().map(|&t| Vec3::from(t)).collect())
     }
 }
 
@@ -74,26 +125,48 @@ impl ModelPath {
 
     /// The centre's position at each frame: evenly spaced along the polyline by length.
     pub fn positions(&self) -> Vec<Vec3> {
+        self.poses().iter().map(|p| p.centre).collect()
+    }
+
+    /// The objects' pose at each frame: the centre evenly spaced along the polyline by
+    /// length, the turn interpolated with it.
+    pub fn poses(&self) -> Vec<Pose> {
         (0..self.frames)
             .map(|k| self.at(k as f32 / (self.frames - 1) as f32))
             .collect()
     }
 
-    /// The point `fraction` (0 to 1) of the way along the polyline, by length.
-    pub fn at(&self, fraction: f32) -> Vec3 {
+    /// Whether any point turns the objects.
+    pub fn turns(&self) -> bool {
+        self.turns.iter().any(|t| *t != Vec3::ZERO)
+    }
+
+    /// The pose `fraction` (0 to 1) of the way along the polyline, by length.
+    pub fn at(&self, fraction: f32) -> Pose {
+        let (segment, t) = self.segment_at(fraction);
+        let next = (segment + 1).min(self.points.len() - 1);
+        let lerp = |v: &[Vec3]| v[segment].lerp(v[next], t);
+        Pose {
+            centre: lerp(&self.points),
+            rotation: rotation_from_deg(lerp(&self.turns).to_array()),
+        }
+    }
+
+    /// The segment `fraction` of the way along the polyline falls in, and how far along it.
+    fn segment_at(&self, fraction: f32) -> (usize, f32) {
         let lengths: Vec<f32> = self
             .points
             .windows(2)
             .map(|w| w[0].distance(w[1]))
             .collect();
         let mut s = fraction * lengths.iter().sum::<f32>();
-        for (w, &length) in self.points.windows(2).zip(&lengths) {
+        for (k, &length) in lengths.iter().enumerate() {
             if s <= length && length > 0.0 {
-                return w[0].lerp(w[1], s / length);
+                return (k, s / length);
             }
             s -= length;
         }
-        self.points[self.points.len() - 1]
+        (self.points.len() - 1, 0.0)
     }
 
     /// Where the centre passes through a surface of `proxies` between two frames (the model
@@ -144,8 +217,54 @@ mod tests {
         PathSpec {
             points: points.to_vec(),
             frames,
+            rotate_deg: None,
         }
         .check()
+    }
+
+    /// The turn goes with the centre: half way along the path (by length) is half way
+    /// between the points' turns, and a turn past 180° keeps its direction.
+    #[test]
+    fn turns_are_interpolated_with_the_centre() {
+        let spec = PathSpec {
+            points: vec![[0.0; 3], [2.0, 0.0, 0.0], [2.0, 0.0, 2.0]],
+            frames: 5,
+            rotate_deg: Some(vec![[0.0; 3], [0.0, 90.0, 0.0], [0.0, 270.0, 0.0]]),
+        };
+        let path = spec.check().unwrap();
+        assert!(path.turns());
+        let poses = path.poses();
+        let yaw = |p: &Pose| {
+            let (axis, angle) = p.rotation.to_axis_angle();
+            angle.to_degrees() * axis.y.signum()
+        };
+        let expected = [0.0, 45.0, 90.0, 180.0, -90.0];
+        for (pose, want) in poses.iter().zip(expected) {
+            let got = yaw(pose);
+            let diff = (got - want).rem_euclid(360.0);
+            assert!(diff.min(360.0 - diff) < 1e-3, "{got} against {want}");
+        }
+        // The turn is the scene's object rotation: +90° about y takes +x to −z.
+        let x = poses[2].rotation * Vec3::X;
+        assert!(x.distance(-Vec3::Z) < 1e-6, "{x}");
+        assert!(!Pose::at(Vec3::ONE).is_turned() && poses[1].is_turned());
+    }
+
+    #[test]
+    fn bad_turns_are_refused() {
+        let spec = |turns: Vec<[f32; 3]>| PathSpec {
+            points: vec![[0.0; 3], [1.0, 0.0, 0.0]],
+            frames: 3,
+            rotate_deg: Some(turns),
+        };
+        assert!(
+            spec(vec![[0.0; 3]])
+                .check()
+                .unwrap_err()
+                .contains("one per point")
+        );
+        let nan = spec(vec![[0.0; 3], [0.0, f32::INFINITY, 0.0]]).check();
+        assert!(nan.unwrap_err().contains("finite"));
     }
 
     #[test]

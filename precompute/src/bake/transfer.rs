@@ -1,6 +1,7 @@
 //! Per-vertex transfer vectors: what a bake produces.
 
 use foundation::color::Rgb;
+use foundation::sh::rotation::ShRotation;
 use foundation::sh::{ShCoeffs, num_coeffs};
 
 /// For each vertex and colour channel, `order²` SH coefficients `t_c` such that the vertex's
@@ -121,6 +122,21 @@ impl TransferVectors {
             .collect()
     }
 
+    /// Turns the vectors of `vertices` by `rotation`: the transfer of those vertices' object
+    /// turned rigidly with them. An object baked alone (nothing else to shadow or light it)
+    /// turns exactly so: its transfer in the turned frame is the old one of `R⁻¹ ω`.
+    pub fn rotate_vertices(&mut self, vertices: std::ops::Range<usize>, rotation: &ShRotation) {
+        let n = num_coeffs(self.order);
+        let start = vertices.start * self.stride();
+        let end = vertices.end.min(self.vertex_count) * self.stride();
+        for vector in self.data[start..end.max(start)].chunks_exact_mut(n) {
+            let Some(coeffs) = ShCoeffs::from_vec(vector.to_vec()) else {
+                continue;
+            };
+            vector.copy_from_slice(rotation.rotate(&coeffs).with_order(self.order).as_slice());
+        }
+    }
+
     /// Element-wise sum (direct + indirect = full transfer).
     /// Each vertex's vectors times its albedo, channel by channel.
     pub(crate) fn scaled_per_vertex(&self, albedo: &[Rgb]) -> TransferVectors {
@@ -191,6 +207,31 @@ impl TransferVectors {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use foundation::sh::ShBasis;
+    use glam::{Quat, Vec3};
+
+    /// A vertex whose transfer is a single direction `d` (the SH of a delta there) turned by
+    /// `R` becomes the delta at `R d`, the turned object's direction: the convention a turned
+    /// model's lighting depends on. The vertices outside the range keep theirs.
+    #[test]
+    fn rotated_transfer_follows_the_turned_direction() {
+        let order = 5;
+        let basis = ShBasis::new(order).unwrap();
+        let d = Vec3::new(0.3, 0.8, -0.52).normalize();
+        let delta = basis.eval_vec(d);
+        let data: Vec<f32> = (0..2 * 3).flat_map(|_| delta.clone()).collect();
+        let mut t = TransferVectors::from_raw(order, 2, data).unwrap();
+        let turn = Quat::from_euler(glam::EulerRot::YXZ, 1.9, -0.7, 0.4);
+        let rotation = ShRotation::new(glam::Mat3::from_quat(turn), order).unwrap();
+        t.rotate_vertices(1..2, &rotation);
+        let turned = basis.eval_vec(turn * d);
+        for c in 0..3 {
+            for (k, (a, b)) in t.vector(1, c).iter().zip(&turned).enumerate() {
+                assert!((a - b).abs() < 1e-4, "coefficient {k}: {a} against {b}");
+            }
+            assert_eq!(t.vector(0, c), delta.as_slice());
+        }
+    }
 
     #[test]
     fn radiance_is_a_per_channel_dot_product() {

@@ -191,6 +191,24 @@ impl GpuScene {
         self.bounds = geometry.mesh.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
     }
 
+    /// Uploads `transfer` in place of the bake (the same scene, its objects turned: `geometry`
+    /// posed as the transfer is), and the glossy materials' visibility read from it.
+    pub(crate) fn write_transfer(
+        &mut self,
+        queue: &wgpu::Queue,
+        geometry: &SceneMesh,
+        transfer: &Transfer,
+    ) -> Result<(), BakeMismatch> {
+        let (bake, scene) = (transfer.direct.vertex_count(), self.vertex_count as usize);
+        if bake != scene || transfer.settings.order != self.order {
+            return Err(BakeMismatch::VertexCount { bake, scene });
+        }
+        self.transfer_pass.write(queue, transfer);
+        self.materials
+            .set_visibility(queue, visibility(geometry, transfer));
+        Ok(())
+    }
+
     /// Uploads `lighting` and records the pass that recomputes every vertex's radiance.
     pub(crate) fn update_radiance(
         &self,
@@ -295,18 +313,21 @@ fn materials(
     geometry: &SceneMesh,
     transfer: &Transfer,
 ) -> Result<GpuMaterials, RenderError> {
+    let materials = GpuMaterials::new(device, geometry, visibility(geometry, transfer))?;
+    materials.write(queue);
+    Ok(materials)
+}
+
+/// Per vertex, its bent normal and unoccluded fraction read from the bake.
+fn visibility(geometry: &SceneMesh, transfer: &Transfer) -> Vec<[f32; 4]> {
     let unoccluded = transfer.direct.unoccluded_fraction(&geometry.albedo);
     let bent = transfer
         .direct
         .bent_normals(&geometry.albedo, &geometry.mesh.normals);
-    let visibility = bent
-        .iter()
+    bent.iter()
         .zip(&unoccluded)
         .map(|(b, v)| b.extend(*v).to_array())
-        .collect();
-    let materials = GpuMaterials::new(device, geometry, visibility)?;
-    materials.write(queue);
-    Ok(materials)
+        .collect()
 }
 
 /// Index ranges of consecutive objects sharing a texture group (0: untextured, `i + 1`:

@@ -153,6 +153,13 @@ impl GpuMaterials {
         );
     }
 
+    /// Takes each vertex's new bent normal and unoccluded fraction (a turned object's).
+    pub(crate) fn set_visibility(&mut self, queue: &wgpu::Queue, visibility: Vec<[f32; 4]>) {
+        self.visibility = visibility;
+        let data = vertices(&self.table, &self.vertex_objects, &self.visibility);
+        queue.write_buffer(&self.vertex_buffer, 0, bytemuck::cast_slice(&data));
+    }
+
     /// Gives the objects new materials (one per object); returns whether the shininess
     /// slots changed (the reflection maps must be prefiltered again).
     pub(crate) fn set(

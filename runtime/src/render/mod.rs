@@ -253,6 +253,19 @@ impl Renderer {
         Ok(())
     }
 
+    /// Draws the same scene with a new bake of it, `geometry` as the bake's (a turned model
+    /// keeps its bake turned: `precompute::bake::TransferVectors::rotate_vertices`; move its
+    /// vertices with [`Self::move_vertices`]).
+    pub fn set_transfer(
+        &mut self,
+        geometry: &SceneMesh,
+        transfer: &Transfer,
+    ) -> Result<(), RenderError> {
+        self.scene.write_transfer(&self.queue, geometry, transfer)?;
+        self.frame.radiance_dirty = true;
+        Ok(())
+    }
+
     /// Which geometry casts the lights' shadows (all of it unless set).
     pub fn set_shadow_casters(&mut self, casters: ShadowCasters) {
         if casters != self.casters {

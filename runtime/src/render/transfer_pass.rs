@@ -21,6 +21,8 @@ pub(super) struct LightingUniform {
 }
 
 pub(super) struct TransferPass {
+    full: wgpu::Buffer,
+    indirect: wgpu::Buffer,
     lighting_buffer: wgpu::Buffer,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
@@ -39,7 +41,7 @@ impl TransferPass {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
                 contents: bytemuck::cast_slice(contents),
-                usage: wgpu::BufferUsages::STORAGE,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             })
         };
         let full = storage("full transfer", transfer.full().as_slice());
@@ -77,10 +79,20 @@ impl TransferPass {
             ],
         );
         Self {
+            full,
+            indirect,
             lighting_buffer,
             pipeline,
             bind_group,
         }
+    }
+
+    /// Uploads a new bake of the same size (a turned object's).
+    pub(super) fn write(&self, queue: &wgpu::Queue, transfer: &Transfer) {
+        let full = transfer.full();
+        queue.write_buffer(&self.full, 0, bytemuck::cast_slice(full.as_slice()));
+        let indirect = transfer.indirect.as_slice();
+        queue.write_buffer(&self.indirect, 0, bytemuck::cast_slice(indirect));
     }
 
     /// Uploads `lighting` (at the bake's `order`) and records the pass over `vertex_count`

@@ -261,10 +261,11 @@ fn path_through(probes: &[Probe], steps: usize) -> anyhow::Result<Vec<Vec3>> {
     let spec = PathSpec {
         points: probes.iter().map(|p| p.position.to_array()).collect(),
         frames: steps as u32,
+        rotate_deg: None,
     };
     let path = spec.check().map_err(anyhow::Error::msg)?;
     Ok((0..steps)
-        .map(|k| path.at((k as f32 + 0.5) / steps as f32))
+        .map(|k| path.at((k as f32 + 0.5) / steps as f32).centre)
         .collect())
 }
 

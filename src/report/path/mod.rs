@@ -22,7 +22,7 @@ use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::image_io::{RgbImageF32, check_finite};
 use foundation::probe::Probe;
-use foundation::scene::{ObjectRole, Scene, SceneMesh, mesh_crosses};
+use foundation::scene::{ObjectRole, Pose, Scene, SceneMesh, mesh_crosses};
 use glam::Vec3;
 use reference::composite::{PixelKind, composite, pixel_kinds};
 use results::{PathMethod, PathPosition, PositionResult, summarise};
@@ -67,11 +67,11 @@ pub fn write_path_report(
     println!("adapter: {}", gpu.description());
     let sky = (map, rotation_deg);
     let mut run = PathRun::new(scene, (model, decompose), &gpu, sky, &camera, settings)?;
-    let positions = path.positions();
-    let frames = pick_frames(positions.len(), options.positions);
+    let poses = path.poses();
+    let frames = pick_frames(poses.len(), options.positions);
     let (mut per_position, mut gif) = (Vec::new(), Vec::new());
     for (n, &frame) in frames.iter().enumerate() {
-        let (position, images) = run.position(frame, positions[frame], options.probe_spp)?;
+        let (position, images) = run.position(frame, poses[frame], options.probe_spp)?;
         println!(
             "position {n}/{} (frame {frame}): {}",
             frames.len() - 1,
@@ -81,7 +81,7 @@ pub fn write_path_report(
             eprintln!(
                 "warning: {}: at frame {frame} the model ({}) passes through the room's proxies",
                 scene.path.display(),
-                positions[frame]
+                poses[frame].centre
             );
         }
         gif.push(side_by_side(
@@ -132,6 +132,8 @@ struct PathRun {
     exposure: f32,
     lightings: MethodLightings,
     previous: Option<Previous>,
+    /// Where `whole` last drew the model.
+    drawn: Option<Pose>,
 }
 
 /// The last position's tone-mapped luminance, the truth's and each method's, and the pixels
@@ -194,18 +196,21 @@ impl PathRun {
             exposure,
             lightings,
             previous: None,
+            drawn: None,
         })
     }
 
-    /// Measures every method with the model's centre at `centre` (the path's `frame`);
-    /// returns the results and the images of the GIF.
+    /// Measures every method with the model at `pose` (the path's `frame`); returns the
+    /// results and the images of the GIF.
     fn position(
         &mut self,
         frame: usize,
-        centre: Vec3,
+        pose: Pose,
         probe_spp: u32,
     ) -> anyhow::Result<(PathPosition, [RgbImageF32; 4])> {
-        let geometry = self.model.placed(centre);
+        let centre = pose.centre;
+        let geometry = self.model.pose_in(&mut self.whole, pose, self.drawn)?;
+        self.drawn = Some(pose);
         let truth = self.truth_at(&geometry)?;
         let kinds = pixel_kinds(
             &geometry,
@@ -215,7 +220,6 @@ impl PathRun {
         let changed = composite(&kinds, &truth.radiance, empty, empty).changed;
         let on_model: Vec<bool> = kinds.iter().map(|k| *k == PixelKind::Object).collect();
         let true_probe = self.true_probe(centre, probe_spp);
-        self.whole.move_vertices(&geometry)?;
         let lightings = (self.lightings).at(&mut self.model, centre, &true_probe)?;
         let mut covered: Vec<bool> = (on_model.iter().zip(&changed))
             .map(|(a, b)| *a || *b)
