@@ -3,8 +3,10 @@
 //! so moving the model keeps both bakes; at each position the local map at the model's centre
 //! is fused from the probes (`runtime::ProbeLighting`), decomposed with its lights followed
 //! from the previous position, and lights the frame: the model through its own transfer, the
-//! room's change (the model's shadows) through the lights' shadow maps. A turned model keeps
-//! its bake turned with it (it was baked alone, so nothing else's shadow turns with it).
+//! room's change through the lights' shadow maps and through the model's soft shadow and
+//! bounce on the room's SH light (`runtime::RoomShadow`, traced at each position). A turned
+//! model keeps its bake turned with it (it was baked alone, so nothing else's shadow turns
+//! with it).
 
 use crate::bake_cache::bake_for;
 use anyhow::Context;
@@ -16,7 +18,7 @@ use foundation::sh::rotation::ShRotation;
 use glam::{Mat3, Quat, Vec3};
 use precompute::bake::Transfer;
 use runtime::render::{FrameLighting, RenderMode, Renderer, rows_of, with_objects_alone};
-use runtime::{DecomposeSettings, ProbeFrame, ProbeLighting, TrackingSettings};
+use runtime::{DecomposeSettings, ProbeFrame, ProbeLighting, RoomShadow, TrackingSettings};
 
 /// A scene's room (its proxies and probes) and the model (its objects) that moves through it.
 pub struct RoomModel {
@@ -31,6 +33,17 @@ pub struct RoomModel {
     pub centre: Vec3,
     /// The scene's `[path]`, if any.
     pub path: Option<ModelPath>,
+    /// The room's vertices that take the model's soft shadow and bounce.
+    shadow: RoomShadow,
+    /// Whether the room takes them (the lights' shadows it always takes).
+    pub soft_shadow: bool,
+}
+
+/// The model at a pose: the scene's geometry with it there, and the bake turned with it.
+pub struct PosedModel {
+    pub pose: Pose,
+    pub geometry: SceneMesh,
+    transfer: Transfer,
 }
 
 impl RoomModel {
@@ -76,6 +89,13 @@ impl RoomModel {
         warn_of_mixed_sizes(scene, &probes);
         let lighting = ProbeLighting::new(probes, proxies, sky, settings, tracking())?;
         Ok(Self {
+            shadow: RoomShadow::new(
+                &scene.geometry,
+                centre,
+                runtime::ROOM_SHADOW_RAYS,
+                scene.bake.order,
+            ),
+            soft_shadow: true,
             geometry: scene.geometry.clone(),
             transfer,
             room_transfer,
@@ -85,15 +105,23 @@ impl RoomModel {
         })
     }
 
-    /// The scene's geometry with the objects at `pose`.
-    pub fn placed(&self, pose: Pose) -> SceneMesh {
+    /// The scene's geometry with the objects at `pose`, and the bake turned with them.
+    pub fn posed(&self, pose: Pose) -> anyhow::Result<PosedModel> {
         let mut geometry = self.geometry.clone();
         geometry.pose_objects(self.centre, pose);
-        geometry
+        let transfer = match pose.is_turned() {
+            true => self.turned_transfer(pose.rotation)?,
+            false => self.transfer.clone(),
+        };
+        Ok(PosedModel {
+            pose,
+            geometry,
+            transfer,
+        })
     }
 
     /// [`Self::transfer`] with the model's rows turned by `rotation`.
-    pub fn turned_transfer(&self, rotation: Quat) -> anyhow::Result<Transfer> {
+    fn turned_transfer(&self, rotation: Quat) -> anyhow::Result<Transfer> {
         let mut transfer = self.transfer.clone();
         let turn = ShRotation::new(
             Mat3::from_quat(rotation.normalize()),
@@ -108,23 +136,30 @@ impl RoomModel {
         Ok(transfer)
     }
 
-    /// Puts the model at `pose` in `renderer`, which draws [`Self::geometry`] with
-    /// [`Self::transfer`] and last had the model at `drawn` (`None`: where the scene places
-    /// it): its vertices moved, and its bake turned when its turn changed. Returns the
-    /// geometry drawn.
-    pub fn pose_in(
+    /// Draws `posed` in `renderer` (made with [`Self::geometry`] and [`Self::transfer`]) under
+    /// `lighting`: the model's vertices where it is, its bake turned, and the room's rows
+    /// scaled by the model's soft shadow and bounce under this lighting. Returns what the
+    /// soft shadow cost, in milliseconds.
+    pub fn draw(
         &self,
         renderer: &mut Renderer,
-        pose: Pose,
-        drawn: Option<Pose>,
-    ) -> anyhow::Result<SceneMesh> {
-        let geometry = self.placed(pose);
-        renderer.move_vertices(&geometry)?;
-        if drawn.map_or(Quat::IDENTITY, |p| p.rotation) != pose.rotation {
-            let transfer = self.turned_transfer(pose.rotation)?;
-            renderer.set_transfer(&geometry, &transfer)?;
+        posed: &PosedModel,
+        lighting: &FrameLighting,
+    ) -> anyhow::Result<f64> {
+        renderer.move_vertices(&posed.geometry)?;
+        let mut transfer = posed.transfer.clone();
+        let start = std::time::Instant::now();
+        if self.soft_shadow {
+            let radiance = runtime::model_radiance(&posed.geometry, &transfer, lighting);
+            for (v, factor) in self.shadow.factors(posed.pose, &lighting.sh, &radiance) {
+                transfer.direct.scale_vertex(v, factor);
+                transfer.indirect.scale_vertex(v, factor);
+            }
         }
-        Ok(geometry)
+        let shadow_ms = start.elapsed().as_secs_f64() * 1e3;
+        renderer.set_transfer(&posed.geometry, &transfer)?;
+        renderer.set_lighting(lighting)?;
+        Ok(shadow_ms)
     }
 
     /// The lighting at `centre`, followed from the previous update's, and the renderer's

@@ -517,6 +517,8 @@ fn moves_a_model_through_a_room_under_xvfb() {
         let centre = s["room"]["centre"].as_array().unwrap();
         assert!((centre[0].as_f64().unwrap() - x).abs() < 1e-5, "{s}");
         assert!(s["room"]["fuse_ms"].as_f64().unwrap() > 0.0, "{s}");
+        assert_eq!(s["room"]["soft_shadow"], true);
+        assert!(s["room"]["soft_shadow_ms"].as_f64().unwrap() > 0.0, "{s}");
     }
     // The teapot moved, and is lit by another map: the pictures differ.
     let ((_, _, a), (_, _, b)) = (

@@ -26,6 +26,9 @@ pub use lighting::{
     lights_indirect_default, map_rotation,
 };
 pub use peers::median_cut::{MedianCutError, analysis_map, median_cut};
-pub use probes::{FusionSettings, FusionStats, ProbeFrame, ProbeFusion, ProbeLighting};
+pub use probes::{
+    FusionSettings, FusionStats, ProbeFrame, ProbeFusion, ProbeLighting, ROOM_SHADOW_RAYS,
+    RoomShadow, model_radiance,
+};
 pub use reflection::{ReflectedEnvironment, SharedCube, convolve_exact};
 pub use tracking::{LightTracker, TrackedLight, TrackingSettings};

@@ -77,12 +77,13 @@ impl App {
         if self.settings.play_path {
             room.advance_path();
         }
-        if room.drawn_at == Some(room.pose) {
+        if room.drawn_at == Some(room.pose) && room.model.soft_shadow == self.settings.soft_shadow {
             return Ok(());
         }
+        room.model.soft_shadow = self.settings.soft_shadow;
         let (lighting, frame) = room.model.update(room.pose.centre);
-        (room.model).pose_in(renderer, room.pose, room.drawn_at)?;
-        renderer.set_lighting(&lighting)?;
+        let posed = room.model.posed(room.pose)?;
+        room.shadow_ms = room.model.draw(renderer, &posed, &lighting)?;
         self.lighting.decomposition_ms = frame.decompose_ms;
         self.lighting.decomposition = Some(frame.lighting.clone());
         room.last = Some(frame);
@@ -104,6 +105,8 @@ impl App {
             "path_frames": room.path_frames(),
             "fuse_ms": last.map_or(0.0, |f| f.fuse_ms),
             "decompose_ms": last.map_or(0.0, |f| f.decompose_ms),
+            "soft_shadow": room.model.soft_shadow,
+            "soft_shadow_ms": room.shadow_ms,
             "lights": last.map_or(0, |f| f.lighting.lights.len()),
         })
     }

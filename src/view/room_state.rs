@@ -26,6 +26,8 @@ pub(super) struct RoomState {
     /// The pose the renderer's lighting, vertices and bake were last set for.
     pub(super) drawn_at: Option<Pose>,
     pub(super) last: Option<ProbeFrame>,
+    /// What the model's soft shadow on the room cost at the last update, in milliseconds.
+    pub(super) shadow_ms: f64,
 }
 
 impl RoomState {
@@ -55,6 +57,7 @@ impl RoomState {
             path_frame: 0,
             drawn_at: None,
             last: None,
+            shadow_ms: 0.0,
         })
     }
 

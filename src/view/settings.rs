@@ -32,6 +32,9 @@ pub struct ViewSettings {
     pub composite: bool,
     /// Play a room's `[path]` back, one frame per drawn frame.
     pub play_path: bool,
+    /// A room takes the model's soft shadow and bounce on its SH light (the lights' shadows
+    /// it always takes).
+    pub soft_shadow: bool,
     /// Show the proxies' edges over the composite.
     pub wireframe: bool,
     /// The `--backplate` a model was opened with (repeated in the render command line).
@@ -104,6 +107,7 @@ impl ViewSettings {
             "composite" => self.composite = switch()?,
             "wireframe" => self.wireframe = switch()?,
             "play_path" => self.play_path = switch()?,
+            "soft_shadow" => self.soft_shadow = switch()?,
             _ => {
                 // `specular:N r,g,b` (or one value for all three) and `shininess:N s`, for
                 // object N (from 0).
@@ -239,6 +243,7 @@ mod tests {
             backplate: None,
             object_offset: glam::Vec3::ZERO,
             play_path: false,
+            soft_shadow: true,
         }
     }
 

@@ -60,6 +60,8 @@ pub struct RoomInfo<'a> {
     pub centre: glam::Vec3,
     /// How far it is turned from where the scene places it.
     pub turn_deg: f32,
+    /// What its soft shadow on the room cost at the last update, in milliseconds.
+    pub shadow_ms: f64,
     /// `(frame, frames)` of the `[path]`.
     pub path: Option<(usize, usize)>,
     /// The last update: its costs and how many texels no probe saw.
@@ -409,6 +411,16 @@ impl Panel<'_> {
             "{} probes; the model at ({:.2}, {:.2}, {:.2}), turned {:.0}°",
             room.probes, c.x, c.y, c.z, room.turn_deg
         ));
+        let soft = format!(
+            "its soft shadow and bounce on the room ({:.2} ms)",
+            room.shadow_ms
+        );
+        ui.checkbox(&mut self.settings.soft_shadow, soft)
+            .on_hover_text(
+                "The model's occlusion of the room's SH light and the light it bounces onto \
+                 the room, traced from the room's vertices at each position (the lights' \
+                 shadows come from their shadow maps)",
+            );
         ui.horizontal(|ui| {
             ui.label("turn the model");
             for degrees in [-MODEL_TURN_DEG, MODEL_TURN_DEG] {

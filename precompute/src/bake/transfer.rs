@@ -122,6 +122,17 @@ impl TransferVectors {
             .collect()
     }
 
+    /// Scales the vectors of `vertex`, channel by channel.
+    pub fn scale_vertex(&mut self, vertex: usize, factor: Rgb) {
+        let n = num_coeffs(self.order);
+        let (start, stride) = (vertex * self.stride(), self.stride());
+        if let Some(vector) = self.data.get_mut(start..start + stride) {
+            for (c, channel) in vector.chunks_exact_mut(n).enumerate() {
+                channel.iter_mut().for_each(|x| *x *= factor[c]);
+            }
+        }
+    }
+
     /// Turns the vectors of `vertices` by `rotation`: the transfer of those vertices' object
     /// turned rigidly with them. An object baked alone (nothing else to shadow or light it)
     /// turns exactly so: its transfer in the turned frame is the old one of `R⁻¹ ω`.

@@ -5,8 +5,10 @@
 
 mod fusion;
 mod lighting;
+mod room_shadow;
 #[cfg(test)]
 mod tests;
 
 pub use fusion::{FusionSettings, FusionStats, ProbeFusion};
 pub use lighting::{ProbeFrame, ProbeLighting};
+pub use room_shadow::{ROOM_SHADOW_RAYS, RoomShadow, model_radiance};

@@ -1,5 +1,6 @@
 //! `hprt bench probes`: what moving a model through a room costs per update: the local map
-//! fused from the room's probes, then its decomposition.
+//! fused from the room's probes, then its decomposition; and the model's soft shadow on the
+//! room along the scene's `[path]`.
 
 use crate::cli::EnvironmentArgs;
 use crate::support::{load_scene, median};
@@ -7,9 +8,10 @@ use clap::Args;
 use foundation::bvh::SceneBvh;
 use foundation::luminance;
 use foundation::probe::Probe;
-use foundation::scene::{ObjectRole, PathSpec};
+use foundation::scene::{ObjectRole, PathSpec, Scene};
 use glam::Vec3;
 use runtime::{CubeGeometry, DecomposeMode, DecomposeSettings, ProbeFrame, ProbeLighting};
+use runtime::{ROOM_SHADOW_RAYS, RoomShadow};
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -94,6 +96,7 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
     );
     print_costs(&frames, lighting.geometry().directions().len());
     print_steadiness(&frames);
+    print_soft_shadow(&scene, &frames);
     if args.truth > 0 {
         let centre = room
             .mesh
@@ -253,6 +256,36 @@ fn map_errors(
         total += b * *dw as f64;
     }
     (irradiance_error, difference / total.max(f64::MIN_POSITIVE))
+}
+
+/// What the model's soft shadow and bounce on the room cost per update along the scene's
+/// `[path]` (`runtime::RoomShadow`; the rays traced, not the model's radiance at its
+/// vertices, a dot product per vertex).
+fn print_soft_shadow(scene: &Scene, frames: &[ProbeFrame]) {
+    let Some(path) = &scene.model_path else {
+        return;
+    };
+    let model = scene.geometry.subset(|o| o.role == ObjectRole::Object);
+    let Some((lo, hi)) = model.mesh.bounds() else {
+        return;
+    };
+    let order = scene.bake.order;
+    let shadow = RoomShadow::new(&scene.geometry, 0.5 * (lo + hi), ROOM_SHADOW_RAYS, order);
+    let dark = vec![foundation::Rgb::ZERO; scene.geometry.mesh.vertex_count()];
+    let ms: Vec<f64> = (path.poses().iter().zip(frames))
+        .map(|(pose, frame)| {
+            let start = std::time::Instant::now();
+            std::hint::black_box(shadow.factors(*pose, &frame.lighting.sh, &dark));
+            start.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    println!(
+        "the model's soft shadow on the room: {:.3} ms per update (median of {}), {} rays per \
+         room vertex",
+        median(ms.clone()),
+        ms.len(),
+        shadow.rays()
+    );
 }
 
 /// `steps` positions along the polyline through the probes, in their order, evenly spaced

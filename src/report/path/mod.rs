@@ -16,7 +16,7 @@ use super::stats::error_image;
 use super::{ReferenceImages, ReferenceRequest, ReportSettings, reference_images};
 use crate::gpu_composite::PrimaryHits;
 use crate::maps::default_exposure;
-use crate::room::RoomModel;
+use crate::room::{PosedModel, RoomModel};
 use anyhow::Context;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
@@ -132,8 +132,6 @@ struct PathRun {
     exposure: f32,
     lightings: MethodLightings,
     previous: Option<Previous>,
-    /// Where `whole` last drew the model.
-    drawn: Option<Pose>,
 }
 
 /// The last position's tone-mapped luminance, the truth's and each method's, and the pixels
@@ -196,7 +194,6 @@ impl PathRun {
             exposure,
             lightings,
             previous: None,
-            drawn: None,
         })
     }
 
@@ -209,12 +206,12 @@ impl PathRun {
         probe_spp: u32,
     ) -> anyhow::Result<(PathPosition, [RgbImageF32; 4])> {
         let centre = pose.centre;
-        let geometry = self.model.pose_in(&mut self.whole, pose, self.drawn)?;
-        self.drawn = Some(pose);
-        let truth = self.truth_at(&geometry)?;
+        let posed = self.model.posed(pose)?;
+        let geometry = &posed.geometry;
+        let truth = self.truth_at(geometry)?;
         let kinds = pixel_kinds(
-            &geometry,
-            &PrimaryHits::trace(&self.scene_with(&geometry), &self.camera).triangles,
+            geometry,
+            &PrimaryHits::trace(&self.scene_with(geometry), &self.camera).triangles,
         );
         let empty = &self.empty.radiance;
         let changed = composite(&kinds, &truth.radiance, empty, empty).changed;
@@ -230,7 +227,7 @@ impl PathRun {
         let truth_y = tonemapped_luminance(&truth.radiance, self.exposure);
         let (mut results, mut ys, mut images) = (Vec::new(), Vec::new(), Vec::new());
         for (m, lighting) in lightings.iter().enumerate() {
-            let image = self.composite_with(&kinds, lighting)?;
+            let image = self.composite_with(&kinds, &posed, lighting)?;
             check_finite(&image, "frame").map_err(|e| {
                 anyhow::anyhow!("frame {frame}, {}: {e}", PathMethod::ALL[m].name())
             })?;
@@ -307,20 +304,20 @@ impl PathRun {
         reference::render_probe(room, proxies, &light, centre, size, &settings, no_progress).0
     }
 
-    /// The model and the room drawn with `lighting`, the room alone too, composited into the
-    /// empty room's truth.
+    /// The model at `posed` and the room drawn with `lighting`, the room alone too,
+    /// composited into the empty room's truth.
     fn composite_with(
         &mut self,
         kinds: &[PixelKind],
+        posed: &PosedModel,
         lighting: &FrameLighting,
     ) -> anyhow::Result<RgbImageF32> {
-        let draw = |renderer: &mut Renderer| -> anyhow::Result<RgbImageF32> {
-            renderer.set_lighting(lighting)?;
-            renderer.render()?;
-            Ok(renderer.read_back()?)
-        };
-        let with = draw(&mut self.whole)?;
-        let without = draw(&mut self.room)?;
+        self.model.draw(&mut self.whole, posed, lighting)?;
+        self.whole.render()?;
+        let with = self.whole.read_back()?;
+        self.room.set_lighting(lighting)?;
+        self.room.render()?;
+        let without = self.room.read_back()?;
         Ok(composite(kinds, &with, &without, &self.empty.radiance).image)
     }
 }
