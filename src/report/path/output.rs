@@ -168,7 +168,8 @@ fn page(report: &PathReport, gif: &[u8], svgs: &[&str]) -> anyhow::Result<String
         html,
         "<p>Errors: mean absolute difference of tone-mapped luminance. Temporal error and \
          popping as in the sequence reports: a popping position's temporal error is more than \
-         {} times its neighbours' median and above {}. Per position: <code>path.csv</code>, \
+         {} times its neighbours' median (at the ends, their trend if larger) and above {}. \
+         Per position: <code>path.csv</code>, \
          <code>path.json</code>.</p></body></html>",
         report.pop_spike, report.pop_floor
     )?;

@@ -145,8 +145,9 @@ fn page(
         html,
         "<p>Temporal error: the mean over covered pixels of |(M(t) − M(t−1)) − (R(t) − \
          R(t−1))| of tone-mapped luminance. A popping frame: its temporal error is more than {} \
-         times the median of its neighbours' (3 frames on each side) and above {} (CONVENTIONS.md, \
-         \"Temporal statistics\").</p>",
+         times the median of its neighbours' (3 frames on each side; at the first and last \
+         frame, their trend if larger) and above {} (CONVENTIONS.md, \"Temporal \
+         statistics\").</p>",
         report.pop_spike, report.pop_floor
     )?;
     if let Some(sun) = report.sun_worst {

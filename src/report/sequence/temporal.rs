@@ -48,24 +48,49 @@ const POP_WINDOW: usize = 3;
 /// Marks the popping frames of one method's temporal errors (frame 0 has none): a frame pops
 /// when its temporal error is a spike against its neighbours' (the median of up to
 /// `POP_WINDOW` frames on each side), so that a sequence whose motion speeds up or slows down
-/// pops nowhere, while a light appearing at once does.
+/// pops nowhere, while a light appearing at once does. A frame with neighbours on one side
+/// only (a sequence's first or last) is compared with the larger of their median and their
+/// trend carried on to it, so that the end of a motion that keeps speeding up is not a spike.
 pub(in crate::report) fn mark_popping(temporal: &[Option<f64>]) -> Vec<bool> {
     (0..temporal.len())
         .map(|t| {
             let Some(value) = temporal[t] else {
                 return false;
             };
-            let neighbours: Vec<f64> = (t.saturating_sub(POP_WINDOW)..=t + POP_WINDOW)
-                .filter(|&u| u != t)
-                .filter_map(|u| temporal.get(u).copied().flatten())
-                .collect();
+            let side = |range: &mut dyn Iterator<Item = usize>| -> Vec<(f64, f64)> {
+                (range.filter_map(|u| Some((u as f64, temporal.get(u).copied().flatten()?))))
+                    .collect()
+            };
+            let before = side(&mut (t.saturating_sub(POP_WINDOW)..t));
+            let after = side(&mut (t + 1..=t + POP_WINDOW));
+            let neighbours: Vec<f64> = before.iter().chain(&after).map(|(_, v)| *v).collect();
             if neighbours.is_empty() {
                 return false;
             }
-            let local = crate::support::median(neighbours);
+            let mut local = crate::support::median(neighbours);
+            if before.is_empty() || after.is_empty() {
+                let one_side = if before.is_empty() { &after } else { &before };
+                local = local.max(trend_at(one_side, t as f64).unwrap_or(0.0));
+            }
             value > POP_SPIKE * local && value > POP_FLOOR
         })
         .collect()
+}
+
+/// The least-squares line through `points` `(frame, value)`, at `frame` (`None` for fewer than
+/// two frames).
+fn trend_at(points: &[(f64, f64)], frame: f64) -> Option<f64> {
+    if points.len() < 2 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), (x, y)| {
+        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
+    });
+    (sxx > 0.0).then(|| my + sxy / sxx * (frame - mx))
 }
 
 #[cfg(test)]
@@ -101,5 +126,26 @@ mod tests {
         // Tiny errors never pop.
         let still = [None, Some(1e-5), Some(1e-3), Some(1e-5)];
         assert!(mark_popping(&still).iter().all(|p| !p));
+    }
+
+    /// The last frame has neighbours on one side only: a motion that keeps speeding up to the
+    /// end (each change larger than the last, as a model nearing the camera) is not a spike
+    /// there, and a light appearing at the last frame still is; the same at the start.
+    #[test]
+    fn the_ends_of_a_speeding_motion_do_not_pop() {
+        let speeding: Vec<Option<f64>> = std::iter::once(None)
+            .chain((1..12).map(|t| Some(0.0005 * 1.6f64.powi(t))))
+            .collect();
+        assert!(mark_popping(&speeding).iter().all(|p| !p), "{speeding:?}");
+        let mut popping = speeding.clone();
+        popping[11] = Some(0.5);
+        assert!(mark_popping(&popping)[11]);
+        let mut slowing = speeding.clone();
+        slowing[1..].reverse();
+        assert!(mark_popping(&slowing).iter().all(|p| !p));
+        slowing[1] = Some(0.5);
+        assert!(mark_popping(&slowing)[1]);
+        assert_eq!(trend_at(&[(1.0, 1.0), (2.0, 3.0)], 3.0), Some(5.0));
+        assert_eq!(trend_at(&[(1.0, 1.0)], 3.0), None);
     }
 }
