@@ -43,7 +43,8 @@ pub struct RoomModel {
 pub struct PosedModel {
     pub pose: Pose,
     pub geometry: SceneMesh,
-    transfer: Transfer,
+    /// The bake turned with the model; `None` when it is not turned.
+    turned: Option<Transfer>,
 }
 
 impl RoomModel {
@@ -109,14 +110,14 @@ impl RoomModel {
     pub fn posed(&self, pose: Pose) -> anyhow::Result<PosedModel> {
         let mut geometry = self.geometry.clone();
         geometry.pose_objects(self.centre, pose);
-        let transfer = match pose.is_turned() {
-            true => self.turned_transfer(pose.rotation)?,
-            false => self.transfer.clone(),
+        let turned = match pose.is_turned() {
+            true => Some(self.turned_transfer(pose.rotation)?),
+            false => None,
         };
         Ok(PosedModel {
             pose,
             geometry,
-            transfer,
+            turned,
         })
     }
 
@@ -147,7 +148,7 @@ impl RoomModel {
         lighting: &FrameLighting,
     ) -> anyhow::Result<f64> {
         renderer.move_vertices(&posed.geometry)?;
-        let mut transfer = posed.transfer.clone();
+        let mut transfer = posed.turned.as_ref().unwrap_or(&self.transfer).clone();
         let start = std::time::Instant::now();
         if self.soft_shadow {
             let radiance = runtime::model_radiance(&posed.geometry, &transfer, lighting);
