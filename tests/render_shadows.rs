@@ -478,6 +478,13 @@ fn small_light(direction: Vec3) -> DirectionalLight {
     }
 }
 
+/// The tower of [`a_turned_model_draws_as_one_baked_turned`] alone.
+fn tower_only(tower: &foundation::mesh::TriangleMesh) -> SceneMesh {
+    let mut geometry = SceneMesh::default();
+    geometry.push_object("tower".into(), tower, Rgb::splat(0.8));
+    geometry
+}
+
 /// A turned model keeps its bake turned (`rotate_vertices`, uploaded by
 /// `Renderer::set_transfer`): it draws as the same model baked where it is turned, within the
 /// two bakes' noise, on both adapters. An L of two boxes, lit from one side: the tower
@@ -517,6 +524,9 @@ fn a_turned_model_draws_as_one_baked_turned() {
         t.rotate_vertices(0..geometry.mesh.vertex_count(), &turn);
     }
     let baked_turned = bake_of(&turned, order, samples, 1);
+    // A bake of another order or another mesh is refused, saying which.
+    let lower_order = bake_of(&turned, 3, 64, 0);
+    let other_mesh = bake_of(&tower_only(&tower), order, 64, 0);
     let mut sh = uniform_sh(order, 0.05);
     sh.add_delta(Vec3::new(-0.9, 0.5, 0.4).normalize(), Rgb::splat(4.0));
     let lighting = FrameLighting {
@@ -554,6 +564,14 @@ fn a_turned_model_draws_as_one_baked_turned() {
         renderer.move_vertices(&turned).unwrap();
         renderer.render().unwrap();
         let unturned_bake = renderer.read_back().unwrap();
+        let mut refused =
+            |bake: &precompute::bake::Transfer| match renderer.set_transfer(&turned, bake) {
+                Err(e) => e.to_string(),
+                Ok(()) => panic!("{}: a mismatched bake was taken", gpu.description()),
+            };
+        let (order_error, mesh_error) = (refused(&lower_order), refused(&other_mesh));
+        assert!(order_error.contains("SH order 3"), "{order_error}");
+        assert!(mesh_error.contains("vertices"), "{mesh_error}");
         renderer.set_transfer(&turned, &turned_bake).unwrap();
         renderer.render().unwrap();
         let with_turned_bake = renderer.read_back().unwrap();

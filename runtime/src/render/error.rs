@@ -23,6 +23,8 @@ pub enum RenderError {
 pub enum BakeMismatch {
     #[error("the bake has {bake} vertices, the scene {scene}")]
     VertexCount { bake: usize, scene: usize },
+    #[error("the bake has SH order {bake}, the scene's renderer order {scene}")]
+    Order { bake: usize, scene: usize },
     #[error("the bake's SH order {order} is above the renderer's maximum {max}")]
     OrderTooHigh { order: usize, max: usize },
     #[error("the transfer ({mb} MB) exceeds the adapter's storage buffer limit ({limit_mb} MB)")]

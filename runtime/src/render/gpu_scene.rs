@@ -200,8 +200,12 @@ impl GpuScene {
         transfer: &Transfer,
     ) -> Result<(), BakeMismatch> {
         let (bake, scene) = (transfer.direct.vertex_count(), self.vertex_count as usize);
-        if bake != scene || transfer.settings.order != self.order {
+        if bake != scene {
             return Err(BakeMismatch::VertexCount { bake, scene });
+        }
+        if transfer.settings.order != self.order {
+            let (bake, scene) = (transfer.settings.order, self.order);
+            return Err(BakeMismatch::Order { bake, scene });
         }
         self.transfer_pass.write(queue, transfer);
         self.materials
