@@ -19,6 +19,7 @@ use glam::{Mat3, Quat, Vec3};
 use precompute::bake::Transfer;
 use runtime::render::{FrameLighting, RenderMode, Renderer, rows_of, with_objects_alone};
 use runtime::{DecomposeSettings, ProbeFrame, ProbeLighting, RoomShadow, TrackingSettings};
+use std::borrow::Cow;
 
 /// A scene's room (its proxies and probes) and the model (its objects) that moves through it.
 pub struct RoomModel {
@@ -148,13 +149,16 @@ impl RoomModel {
         lighting: &FrameLighting,
     ) -> anyhow::Result<f64> {
         renderer.move_vertices(&posed.geometry)?;
-        let mut transfer = posed.turned.as_ref().unwrap_or(&self.transfer).clone();
+        // Copied only to be scaled by the soft shadow.
+        let mut transfer = Cow::Borrowed(posed.turned.as_ref().unwrap_or(&self.transfer));
         let start = std::time::Instant::now();
         if self.soft_shadow {
             let radiance = runtime::model_radiance(&posed.geometry, &transfer, lighting);
-            for (v, factor) in self.shadow.factors(posed.pose, &lighting.sh, &radiance) {
-                transfer.direct.scale_vertex(v, factor);
-                transfer.indirect.scale_vertex(v, factor);
+            let factors = self.shadow.factors(posed.pose, &lighting.sh, &radiance);
+            let scaled = transfer.to_mut();
+            for (v, factor) in factors {
+                scaled.direct.scale_vertex(v, factor);
+                scaled.indirect.scale_vertex(v, factor);
             }
         }
         let shadow_ms = start.elapsed().as_secs_f64() * 1e3;

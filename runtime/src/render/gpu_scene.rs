@@ -199,10 +199,7 @@ impl GpuScene {
         geometry: &SceneMesh,
         transfer: &Transfer,
     ) -> Result<(), BakeMismatch> {
-        let (bake, scene) = (transfer.direct.vertex_count(), self.vertex_count as usize);
-        if bake != scene {
-            return Err(BakeMismatch::VertexCount { bake, scene });
-        }
+        check_vertex_count(self.vertex_count as usize, transfer)?;
         if transfer.settings.order != self.order {
             let (bake, scene) = (transfer.settings.order, self.order);
             return Err(BakeMismatch::Order { bake, scene });
@@ -279,6 +276,18 @@ impl GpuScene {
     }
 }
 
+/// Refuses a bake of a mesh with another number of vertices than the scene's `vertices`.
+fn check_vertex_count(vertices: usize, transfer: &Transfer) -> Result<(), BakeMismatch> {
+    let bake = transfer.direct.vertex_count();
+    if bake != vertices {
+        return Err(BakeMismatch::VertexCount {
+            bake,
+            scene: vertices,
+        });
+    }
+    Ok(())
+}
+
 /// Refuses a bake the renderer cannot draw with this scene on this adapter.
 fn check_bake(
     device: &wgpu::Device,
@@ -286,12 +295,7 @@ fn check_bake(
     transfer: &Transfer,
 ) -> Result<(), BakeMismatch> {
     let order = transfer.settings.order;
-    if transfer.direct.vertex_count() != vertices {
-        return Err(BakeMismatch::VertexCount {
-            bake: transfer.direct.vertex_count(),
-            scene: vertices,
-        });
-    }
+    check_vertex_count(vertices, transfer)?;
     if order > MAX_GPU_ORDER {
         return Err(BakeMismatch::OrderTooHigh {
             order,

@@ -57,12 +57,13 @@ pub(in crate::report) fn mark_popping(temporal: &[Option<f64>]) -> Vec<bool> {
             let Some(value) = temporal[t] else {
                 return false;
             };
-            let side = |range: &mut dyn Iterator<Item = usize>| -> Vec<(f64, f64)> {
-                (range.filter_map(|u| Some((u as f64, temporal.get(u).copied().flatten()?))))
+            let side = |frames: std::ops::Range<usize>| -> Vec<(f64, f64)> {
+                frames
+                    .filter_map(|u| Some((u as f64, temporal.get(u).copied().flatten()?)))
                     .collect()
             };
-            let before = side(&mut (t.saturating_sub(POP_WINDOW)..t));
-            let after = side(&mut (t + 1..=t + POP_WINDOW));
+            let before = side(t.saturating_sub(POP_WINDOW)..t);
+            let after = side(t + 1..t + 1 + POP_WINDOW);
             let neighbours: Vec<f64> = before.iter().chain(&after).map(|(_, v)| *v).collect();
             if neighbours.is_empty() {
                 return false;
