@@ -17,10 +17,9 @@
 //! another tree must also trace those lanes again alone: prune and test a little past the
 //! closest so far (`ROUNDING`), and re-trace a lane whose closest has a rival that near or lies
 //! nearer than `MIN_BOX_DISTANCE`. An eight-wide tree for the fans was tried that way
-//! (2026-12-03): byte-identical bakes, but 5–10% slower than these packets, which test each
-//! child box for their eight lanes, so a wider node costs them more than the levels it saves.
-//! A lone ray was 28% faster through it than through the four-wide tree, and still no faster
-//! than the packets.
+//! (2026-12-03, branch `attempt/bvh8-fans`): byte-identical bakes, but 5–10% slower than these
+//! packets, which test each child box for their eight lanes, so a wider node costs them more
+//! than the levels it saves.
 
 use super::packet::{LANES, RayPacket};
 use super::wide::ChildRef;
