@@ -20,6 +20,15 @@
 //! (2026-12-03, branch `attempt/bvh8-fans`): byte-identical bakes, but 5–10% slower than these
 //! packets, which test each child box for their eight lanes, so a wider node costs them more
 //! than the levels it saves.
+//!
+//! Cheaper arithmetic per node did not pay either (2026-12-03, same machine, byte-identical
+//! bakes each time): culling a node's children by the packet's frustum before the lane-by-lane
+//! test made the dragon slower (branch `attempt/packet-frustum`); a vector reduction for the
+//! children's nearest entries, a branch-free ranking of them, and tracing each fan in the four
+//! runs its rotation's wrap cuts the sample curve into gained no more than the machine's noise
+//! (`attempt/packet-ordering`). Tracing every fan twice in a row took 1.74 times as long as
+//! once (`attempt/fan-twice`): the second pass, from a warm cache, costs three quarters of the
+//! first, so cache misses are not where most of the time goes either.
 
 use super::packet::{LANES, RayPacket};
 use super::wide::ChildRef;
