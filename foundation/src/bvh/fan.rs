@@ -26,9 +26,11 @@
 //! test made the dragon slower (branch `attempt/packet-frustum`); a vector reduction for the
 //! children's nearest entries, a branch-free ranking of them, and tracing each fan in the four
 //! runs its rotation's wrap cuts the sample curve into gained no more than the machine's noise
-//! (`attempt/packet-ordering`). Tracing every fan twice in a row took 1.74 times as long as
-//! once (`attempt/fan-twice`): the second pass, from a warm cache, costs three quarters of the
-//! first, so cache misses are not where most of the time goes either.
+//! (`attempt/packet-ordering`). Four-lane packets, whose operations this machine's Zen 1 cores
+//! do not split in two, were slower still (`attempt/packet4`). Tracing every fan twice in a
+//! row took 1.74 times as long as once (`attempt/fan-twice`): the second pass, from a warm
+//! cache, costs three quarters of the first, so cache misses are not where most of the time
+//! goes either.
 
 use super::packet::{LANES, RayPacket};
 use super::wide::ChildRef;
