@@ -41,6 +41,23 @@
 //! tree changes more than ties. One vertex of the 810k-triangle bake came out with a direct
 //! transfer 0.046 apart, and 464 others' indirect moved by more than 1e-6, so that tree waits
 //! on a decision to let a bake's answers change.
+//!
+//! The near rule is what makes trees disagree (2026-12-04): with triangles held to the boxes'
+//! floor, so that nothing nearer than `MIN_BOX_DISTANCE` is hit in whichever leaf it lies,
+//! the two trees' 810k bakes agree (the direct transfer bit for bit; the indirect at all but 8
+//! vertices, one of them off by more than 1e-6; branch `attempt/build-params-floor`). That
+//! floor alone moves today's answers, though (173 vertices' direct transfer on the 810k bake,
+//! by up to 0.17; `attempt/near-floor`), and dropping the boxes' floor instead fails the open
+//! box's white furnace. Timed alternately with the floor in both, the better tree traced the
+//! 810k bake in 51.2 s against 55.0 s: 7%, too little to change answers for. Laying a node's
+//! inner children side by side in memory, which changes no answer, gained nothing (2.70
+//! against 2.68 M rays/s on the 810k bake's direct pass, `attempt/node-layout`).
+//!
+//! Where Embree is ahead is the lone ray. On the 810k bake's own rays (256 a vertex, 2
+//! threads, 2026-12-04) Embree's single-ray closest hit traced 3.12 M rays/s, these packets
+//! 2.39–2.72, and the same traversal with every lane alone 1.97 (`attempt/alone-probe`).
+//! What Embree does differently there (its own tree, one fused multiply-add a plane) moves
+//! boxes' leaves or rounding, and so, through the near rule, can move today's answers.
 
 use super::packet::{LANES, RayPacket};
 use super::wide::ChildRef;
