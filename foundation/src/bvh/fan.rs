@@ -56,8 +56,8 @@
 //! Where Embree is ahead is the lone ray. On the 810k bake's own rays (256 a vertex, 2
 //! threads, 2026-12-04) Embree's single-ray closest hit traced 3.12 M rays/s, these packets
 //! 2.39–2.72, and the same traversal with every lane alone 1.97 (`attempt/alone-probe`).
-//! What Embree does differently there (its own tree, one fused multiply-add a plane) moves
-//! boxes' leaves or rounding, and so, through the near rule, can move today's answers.
+//! What Embree does differently there (its own tree, one fused multiply-add a plane) changes
+//! the leaves or the boxes' rounding, and so, through the near rule, can move today's answers.
 
 use super::packet::{LANES, RayPacket};
 use super::wide::ChildRef;
