@@ -61,7 +61,11 @@ pub fn bake_path(scene: &Scene, settings: &BakeSettings) -> PathBuf {
         .collect();
     cache_dir().join(format!(
         "{}-{hash}-o{}-s{}-b{}-seed{}.bake",
-        scene.name, settings.order, settings.samples, settings.bounces, settings.seed
+        foundation::infra::names::as_file_name(&scene.name),
+        settings.order,
+        settings.samples,
+        settings.bounces,
+        settings.seed
     ))
 }
 

@@ -286,6 +286,29 @@ pub fn parse_finite(text: &str) -> Result<f32, String> {
     }
 }
 
+/// A count of repetitions (`--repeat`): 1 to [`MAX_REPEAT`](foundation::infra::limits::MAX_REPEAT),
+/// so that no flag can ask for a loop or an allocation without end.
+pub fn parse_repeat(text: &str) -> Result<usize, String> {
+    match parse_count(text)? {
+        0 => Err(format!(
+            "{text}: must be 1 to {}",
+            foundation::infra::limits::MAX_REPEAT
+        )),
+        n => Ok(n),
+    }
+}
+
+/// A count a benchmark runs or keeps (frames, steps, positions): 0 to
+/// [`MAX_REPEAT`](foundation::infra::limits::MAX_REPEAT).
+pub fn parse_count(text: &str) -> Result<usize, String> {
+    let max = foundation::infra::limits::MAX_REPEAT;
+    match text.parse::<u128>() {
+        Ok(n) if n <= max as u128 => Ok(n as usize),
+        Ok(_) => Err(format!("{text}: must be at most {max}")),
+        Err(_) => Err(format!("{text:?} is not a count")),
+    }
+}
+
 /// A finite number above zero.
 pub fn parse_positive(text: &str) -> Result<f32, String> {
     match parse_finite(text)? {

@@ -8,6 +8,7 @@ mod env_sequence;
 mod gpu_composite;
 mod maps;
 mod outputs;
+mod recorded;
 mod report;
 mod room;
 mod support;

@@ -102,15 +102,19 @@ pub fn check_folder_spares_inputs(
     Ok(())
 }
 
-/// What a command reads of a scene (its file and meshes), with the command's `other` inputs.
+/// What a command reads of a scene (its file, meshes, backplate, map, and its probes' images
+/// and distance maps), with the command's `other` inputs.
 pub fn scene_inputs<'a>(scene: &'a Scene, other: &[Option<&'a Path>]) -> Vec<&'a Path> {
     let environment = scene.environment.as_ref().map(|e| e.map.as_path());
+    let probes = (scene.probes.iter())
+        .flat_map(|p| std::iter::once(p.image.as_path()).chain(p.distances.as_deref()));
     scene
         .sources
         .iter()
         .map(PathBuf::as_path)
         .chain(other.iter().flatten().copied())
         .chain(environment)
+        .chain(probes)
         .collect()
 }
 

@@ -306,3 +306,69 @@ fn mutated_gltf_models_never_crash_the_program() {
     }
     assert!(start.elapsed().as_secs() < 120, "{:?}", start.elapsed());
 }
+
+/// `bytes` with its trailing CRC-32 made right, so a mutation reaches the decoder's checks
+/// behind the checksum (as a hostile editor's would).
+fn resealed(mut bytes: Vec<u8>) -> Vec<u8> {
+    if bytes.len() >= 4 {
+        let n = bytes.len() - 4;
+        let crc = crc32fast::hash(&bytes[..n]).to_le_bytes();
+        bytes[n..].copy_from_slice(&crc);
+    }
+    bytes
+}
+
+/// Mutated bake shards and reference bands, checksums made right, merged: a clean result or
+/// a clean error (issue 58: declared sizes, recorded paths and values inside them).
+#[test]
+fn mutated_shards_and_bands_never_crash_the_merges() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_scene(
+        d,
+        "s.toml",
+        "box = { min = [0, 0, 0], max = [1, 1, 1] }\nalbedo = [0.5, 0.5, 0.5]",
+    );
+    let env = repo().join("scenes/env/sunrise.exr");
+    for i in ["0/2", "1/2"] {
+        let out = hprt(d, &["bake", "s.toml", "--shard", i, "-o", "shards"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let args = [
+            "reference",
+            "s.toml",
+            "--env",
+            env.to_str().unwrap(),
+            "--spp",
+            "1",
+        ];
+        let out = hprt(
+            d,
+            &[
+                &args[..],
+                &["--width", "8", "--height", "6", "--shard", i, "-o", "bands"],
+            ]
+            .concat(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    for (file, merge, seed) in [
+        (
+            "shards/bake-0000-of-0002.hprtshard",
+            ["bake", "merge", "shards", "-o", "m.bake"],
+            11,
+        ),
+        (
+            "bands/reference-0000-of-0002.hprtband",
+            ["reference", "merge", "bands", "-o", "m.exr"],
+            12,
+        ),
+    ] {
+        let original = std::fs::read(d.join(file)).unwrap();
+        let mut mutator = Mutator(seed);
+        for case in 0..CASES_PER_FORMAT {
+            std::fs::write(d.join(file), resealed(mutator.mutate(&original))).unwrap();
+            assert_survives(d, &merge, &format!("{file} case {case} (seed {seed})"));
+        }
+        std::fs::write(d.join(file), &original).unwrap();
+    }
+}

@@ -254,7 +254,8 @@ fn slurm_dry_run_prints_the_jobs_and_writes_nothing() {
         out.contains("reference merge r.exr.shards -o r.exr --png r.png"),
         "{out}"
     );
-    assert!(out.contains("--partition=gpu --time=30"), "{out}");
+    // Every word of the printed sbatch calls is quoted as a shell needs it.
+    assert!(out.contains("'--partition=gpu' '--time=30'"), "{out}");
     assert!(out.contains("--dependency=afterok:"), "{out}");
     assert!(
         std::fs::read_dir(d).unwrap().next().is_none(),

@@ -9,9 +9,10 @@ use crate::error::CaptureError;
 use crate::exif::{ExifExposure, read_exposure};
 use crate::photo::{Photo, View};
 use foundation::infra::limits::{
-    MAX_BACKPLATE_PIXELS, MAX_BACKPLATE_SIDE, MAX_SIDE_FILE_BYTES, read_regular_file,
-    read_text_file,
+    MAX_BACKPLATE_SIDE, MAX_CAPTURE_PHOTOS, MAX_CAPTURE_PIXELS, MAX_PHOTO_PIXELS,
+    MAX_SIDE_FILE_BYTES, read_regular_file, read_text_file,
 };
+use foundation::texture::TextureError;
 use std::path::{Path, PathBuf};
 
 /// A capture's photographs and what loading them noticed (for the user to read).
@@ -45,13 +46,19 @@ pub fn load_capture(path: &Path) -> Result<LoadedCapture, CaptureError> {
             "names no photographs: give [[shot]] or [[ball]] entries".into(),
         ));
     }
+    let count = description.shot.len() + description.ball.len();
+    if count > MAX_CAPTURE_PHOTOS {
+        return Err(invalid(format!(
+            "names {count} photographs; hprt reads at most {MAX_CAPTURE_PHOTOS} in one capture"
+        )));
+    }
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut notes = Vec::new();
     let mut photos = Vec::new();
     let mut given = Vec::new();
     for (i, shot) in description.shot.iter().enumerate() {
         check_shot(shot).map_err(|m| invalid(format!("shot {}: {m}", i + 1)))?;
-        let read = read_photo(&folder.join(&shot.image), &mut notes)?;
+        let read = read_photo(&folder.join(&shot.image), count, &mut notes)?;
         let (_, width, height) = read.levels;
         let camera = ShotCamera::new(
             (shot.yaw, shot.pitch, shot.roll),
@@ -62,12 +69,18 @@ pub fn load_capture(path: &Path) -> Result<LoadedCapture, CaptureError> {
         given.push(shot.exposure);
         photos.push((read, View::Shot(camera)));
     }
-    let balls = load_balls(&description.ball, folder, path, &mut notes)?;
+    let balls = load_balls(&description.ball, count, folder, path, &mut notes)?;
     for (ball, (read, view)) in description.ball.iter().zip(balls) {
         given.push(ball.exposure);
         photos.push((read, view));
     }
     let times = exposures(&photos, &given, &mut notes)?;
+    for ((read, _), time) in photos.iter().zip(&times) {
+        check_exposure_range(*time).map_err(|message| CaptureError::Photo {
+            path: read.file.clone(),
+            message: format!("{message} (from its EXIF or its entry)"),
+        })?;
+    }
     let photos: Vec<Photo> = photos
         .into_iter()
         .zip(times)
@@ -79,8 +92,10 @@ pub fn load_capture(path: &Path) -> Result<LoadedCapture, CaptureError> {
 
 /// The mirror-ball photographs and their views: the outline as given, or found in the
 /// photographs of one camera (one tripod position) together.
+/// `count` is every photograph of the capture, shots included.
 fn load_balls(
     balls: &[BallDescription],
+    count: usize,
     folder: &Path,
     description: &Path,
     notes: &mut Vec<String>,
@@ -91,7 +106,7 @@ fn load_balls(
             path: description.to_path_buf(),
             message: format!("ball {}: {message}", i + 1),
         })?;
-        let read = read_photo(&folder.join(&ball.image), notes)?;
+        let read = read_photo(&folder.join(&ball.image), count, notes)?;
         let (_, width, height) = read.levels;
         let camera = ShotCamera::new(
             (ball.yaw, ball.pitch, 0.0),
@@ -241,6 +256,21 @@ fn check_exposure(exposure: Option<f32>) -> Result<(), String> {
     if !(exposure.is_finite() && exposure > 0.0) {
         return Err(format!("exposure {exposure} s is not a positive time"));
     }
+    check_exposure_range(exposure)
+}
+
+/// Shortest and longest exposure hprt takes (seconds, after ISO and aperture): a billionth of
+/// a second is past any shutter behind the darkest filter, a million seconds past any night;
+/// beyond them a reading divided by its exposure overflows or vanishes in f32.
+pub(crate) const EXPOSURE_RANGE: (f32, f32) = (1e-9, 1e6);
+
+fn check_exposure_range(exposure: f32) -> Result<(), String> {
+    let (lo, hi) = EXPOSURE_RANGE;
+    if !(lo..=hi).contains(&exposure) {
+        return Err(format!(
+            "exposure {exposure} s is outside the {lo} to {hi} s hprt takes"
+        ));
+    }
     Ok(())
 }
 
@@ -293,8 +323,11 @@ fn check_ball(ball: &BallDescription) -> Result<(), String> {
     {
         return Err("centre, yaw and pitch must be numbers".into());
     }
-    if !ball.reflectance.iter().all(|r| *r > 0.0 && *r <= 1.0) {
-        return Err(format!("reflectance {:?} outside (0, 1]", ball.reflectance));
+    if !ball.reflectance.iter().all(|r| *r >= 0.01 && *r <= 1.0) {
+        return Err(format!(
+            "reflectance {:?} outside [0.01, 1] (polished chrome reflects about 0.6)",
+            ball.reflectance
+        ));
     }
     Ok(())
 }
@@ -304,15 +337,23 @@ type Levels = (Vec<[u8; 3]>, usize, usize);
 
 /// A JPEG, PNG or TIFF as 8-bit RGB levels (16-bit images keep their top 8 bits: the response
 /// is recovered at 256 levels), within the backplate's limits, and its EXIF exposure.
-fn read_photo(path: &Path, notes: &mut Vec<String>) -> Result<Read, CaptureError> {
+/// `count` is how many photographs the capture holds (all of one size).
+fn read_photo(path: &Path, count: usize, notes: &mut Vec<String>) -> Result<Read, CaptureError> {
     let fail = |message: String| CaptureError::Photo {
         path: path.to_path_buf(),
         message,
     };
     let bytes = read_regular_file(path, MAX_SIDE_FILE_BYTES).map_err(|e| fail(e.to_string()))?;
     let image =
-        foundation::texture::decode_image_within(&bytes, MAX_BACKPLATE_PIXELS, MAX_BACKPLATE_SIDE)
-            .map_err(|e| fail(format!("cannot be read as a photograph: {e}")))?
+        foundation::texture::decode_image_within(&bytes, MAX_PHOTO_PIXELS, MAX_BACKPLATE_SIDE)
+            .map_err(|e| match e {
+                TextureError::TooLarge { width, height } => fail(format!(
+                    "is {width}x{height}: hprt reads photographs of at most \
+                     {MAX_PHOTO_PIXELS} pixels and {MAX_BACKPLATE_SIDE} per side \
+                     (downscale it)"
+                )),
+                other => fail(format!("cannot be read as a photograph: {other}")),
+            })?
             .into_rgb8();
     let (width, height) = (image.width() as usize, image.height() as usize);
     if width < 8 || height < 8 {
@@ -320,6 +361,7 @@ fn read_photo(path: &Path, notes: &mut Vec<String>) -> Result<Read, CaptureError
             "is {width}x{height}: too small to be a photograph"
         )));
     }
+    check_total(count, width, height).map_err(fail)?;
     let exif = read_exposure(&bytes).unwrap_or_else(|message| {
         notes.push(format!(
             "{}: {message}; its exposure is taken from the description",
@@ -333,6 +375,23 @@ fn read_photo(path: &Path, notes: &mut Vec<String>) -> Result<Read, CaptureError
         levels: (levels, width, height),
         exif,
     })
+}
+
+/// Refuses a capture whose `count` photographs of `width × height` (they share one size)
+/// would hold more than [`MAX_CAPTURE_PIXELS`]: checked at the first photograph, before the
+/// others are decoded.
+fn check_total(count: usize, width: usize, height: usize) -> Result<(), String> {
+    let total = (count as u64).saturating_mul(width as u64 * height as u64);
+    if total > MAX_CAPTURE_PIXELS {
+        return Err(format!(
+            "{count} photographs of {width}x{height} pixels ({:.1} G pixels in all) are more \
+             than the {:.1} G pixels hprt holds for one capture (downscale them, or capture \
+             fewer)",
+            total as f64 / 1e9,
+            MAX_CAPTURE_PIXELS as f64 / 1e9
+        ));
+    }
+    Ok(())
 }
 
 /// Refuses photographs of different sizes.

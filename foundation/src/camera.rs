@@ -30,9 +30,17 @@ pub struct CameraBasis {
 }
 
 /// Largest image side a camera may have.
-pub(crate) const MAX_IMAGE_SIDE: u32 = 16384;
+pub const MAX_IMAGE_SIDE: u32 = 16384;
 /// Most pixels of an image (8192², 1 GB as float RGBA): checked before any image is allocated.
-pub(crate) const MAX_IMAGE_PIXELS: u64 = 8192 * 8192;
+pub const MAX_IMAGE_PIXELS: u64 = 8192 * 8192;
+
+/// Whether `width × height` is an image size a camera may have (as read from a file, before
+/// anything of that size is allocated).
+pub fn image_size_allowed(width: u64, height: u64) -> bool {
+    (1..=u64::from(MAX_IMAGE_SIDE)).contains(&width)
+        && (1..=u64::from(MAX_IMAGE_SIDE)).contains(&height)
+        && width * height <= MAX_IMAGE_PIXELS
+}
 
 impl Camera {
     /// The same camera rendering `width × height` pixels.

@@ -3,6 +3,7 @@
 
 use crate::color::Rgb;
 use crate::infra::atomic_file::write_atomic;
+use crate::infra::limits::{MAX_EXR_PIXELS, regular_file_size};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
@@ -199,9 +200,27 @@ pub fn exr_bytes(image: &RgbImageF32) -> Result<Vec<u8>, EncodeError> {
     Ok(bytes.into_inner())
 }
 
-/// Reads the RGB channels of an OpenEXR file.
+/// Reads the RGB channels of an OpenEXR file: refused first when it is not a regular file (a
+/// FIFO would block forever) or when its header declares more than [`MAX_EXR_PIXELS`] in a
+/// layer, before anything of that size is allocated.
 pub fn read_exr(path: &Path) -> Result<RgbImageF32, ImageError> {
+    read_exr_within(path, MAX_EXR_PIXELS)
+}
+
+/// [`read_exr`] with a tighter pixel limit of the caller's.
+pub fn read_exr_within(path: &Path, max_pixels: u64) -> Result<RgbImageF32, ImageError> {
     use exr::prelude::*;
+    let error = |message: String| ImageError::Read {
+        path: path.to_owned(),
+        message,
+    };
+    let (width, height) = exr_size(path).map_err(error)?;
+    if width.saturating_mul(height) > max_pixels {
+        return Err(error(format!(
+            "the image declares {width}x{height} pixels; hprt reads at most {max_pixels} from \
+             such a file"
+        )));
+    }
     let image = read_first_rgba_layer_from_file(
         path,
         |resolution, _| RgbImageF32::filled(resolution.width(), resolution.height(), Rgb::ZERO),
@@ -215,6 +234,18 @@ pub fn read_exr(path: &Path) -> Result<RgbImageF32, ImageError> {
         message: e.to_string(),
     })?;
     Ok(image.layer_data.channel_data.pixels)
+}
+
+/// The largest layer an OpenEXR file declares (width, height), read from its header alone
+/// after checking that it is a regular file.
+pub fn exr_size(path: &Path) -> Result<(u64, u64), String> {
+    regular_file_size(path).map_err(|e| e.to_string())?;
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
+    meta.headers
+        .iter()
+        .map(|h| (h.layer_size.width() as u64, h.layer_size.height() as u64))
+        .max_by_key(|(w, h)| w.saturating_mul(*h))
+        .ok_or_else(|| "the file has no image".to_owned())
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 use crate::Rgb;
 use crate::bvh::{SceneBvh, Skip};
 use crate::envmap::{self, EnvMap, EnvMapError, Layout, texel_centre_direction};
-use crate::image_io::{RgbImageF32, read_exr};
+use crate::image_io::{RgbImageF32, exr_size, read_exr};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -194,6 +194,15 @@ impl ProbeSource {
                     path: path.clone(),
                     cause,
                 };
+                // Its declared size first: it must be the image's, and nothing larger is
+                // allocated.
+                let (w, h) = exr_size(path).map_err(error)?;
+                if (w, h) != (width as u64, height as u64) {
+                    return Err(error(format!(
+                        "the distance map is {w}×{h}, its probe image {width}×{height}: give \
+                         both at one size"
+                    )));
+                }
                 let image = read_exr(path).map_err(|e| error(e.to_string()))?;
                 DistanceMap::from_image(&image).map_err(|e| error(e.to_string()))?
             }

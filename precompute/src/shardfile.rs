@@ -4,7 +4,7 @@
 //! ```text
 //! offset size  field
 //!      0    8  magic "HPRTSHRD"
-//!      8    4  u32 format version (1)
+//!      8    4  u32 format version (2)
 //!     12    4  u32 header size in bytes (256)
 //!     16    4  u32 SH order n
 //!     20    4  u32 bounces
@@ -22,7 +22,8 @@
 //!    144   16  hprt version (UTF-8, zero-padded)
 //!    160    4  u32 scene path length P in bytes
 //!    164    8  u64 operator entries E
-//!    172   84  reserved (zero)
+//!    172   32  BLAKE3 hash of the scene file's bytes
+//!    204   52  reserved (zero)
 //!    256    P  scene path (UTF-8), zero-padded to a multiple of 4
 //!      …  4·R·n²  visibility, f32 [R][n²]: (1/samples) Σ over escaping rays of Y_k(ω)
 //!      …  4·(R+1)  u32 operator row starts (relative to the shard's first entry)
@@ -42,9 +43,13 @@ use foundation::infra::shard::ShardSpec;
 use foundation::sh::{self, num_coeffs};
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
+use values::{check_row_sums, check_rows, check_visibility, check_weights};
+
+mod values;
 
 const MAGIC: &[u8; 8] = b"HPRTSHRD";
-const VERSION: u32 = 1;
+/// Version 2 added the scene file's hash (version 1 named the scene by its path alone).
+const VERSION: u32 = 2;
 const HEADER_SIZE: usize = 256;
 /// The file name extension of bake shards.
 pub const EXTENSION: &str = "hprtshard";
@@ -145,6 +150,7 @@ fn header_bytes(shard: &BakeShard, entries: usize) -> Vec<u8> {
     out.extend_from_slice(&version);
     out.extend_from_slice(&(shard.scene_path.len() as u32).to_le_bytes());
     out.extend_from_slice(&(entries as u64).to_le_bytes());
+    out.extend_from_slice(&shard.scene_hash);
     out.resize(HEADER_SIZE, 0);
     out.extend_from_slice(shard.scene_path.as_bytes());
     out.resize(out.len().div_ceil(4) * 4, 0);
@@ -235,10 +241,10 @@ impl Layout {
             *start = at;
             at = at.checked_add(size).ok_or("size")?;
         }
-        if at + 4 != len {
+        if at.checked_add(4) != Some(len) {
             return Err(format!(
                 "{len} bytes where its header describes {} (truncated or damaged)",
-                at + 4
+                at.saturating_add(4)
             ));
         }
         Ok(Self {
@@ -435,7 +441,7 @@ fn decode_checked<R: Read + Seek>(
             .into_iter()
             .map(f32::from_bits)
             .collect();
-        check_finite(&weights)?;
+        check_weights(&weights)?;
         blocks.push(OperatorBlock {
             row_starts: row_starts[first_row..=end]
                 .iter()
@@ -445,7 +451,8 @@ fn decode_checked<R: Read + Seek>(
             weights,
         });
     }
-    check_finite(&visibility)?;
+    check_visibility(&visibility, order)?;
+    check_row_sums(&blocks)?;
     let mut inside = vec![0u8; layout.rows];
     source.seek(SeekFrom::Start(layout.inside))?;
     source.read_exact(&mut inside)?;
@@ -457,6 +464,7 @@ fn decode_checked<R: Read + Seek>(
         mesh_hash: header[80..112].try_into().expect("32 bytes"),
         partition_hash: header[112..144].try_into().expect("32 bytes"),
         scene_path: String::from_utf8_lossy(&path_bytes).into_owned(),
+        scene_hash: header[172..204].try_into().expect("32 bytes"),
         seconds: f64::from_le_bytes(header[72..80].try_into().expect("8 bytes")),
         traced: TracedVertices {
             order,
@@ -465,25 +473,6 @@ fn decode_checked<R: Read + Seek>(
             inside: inside.into_iter().map(|b| b != 0).collect(),
         },
     })
-}
-
-fn check_finite(values: &[f32]) -> Result<(), String> {
-    match values.iter().find(|x| !x.is_finite()) {
-        Some(x) => Err(format!("a stored value is {x} (finite numbers only)")),
-        None => Ok(()),
-    }
-}
-
-/// Row starts that rise from 0 to the entry count.
-fn check_rows(row_starts: &[u32], entries: usize) -> Result<(), String> {
-    let rising = row_starts.windows(2).all(|w| w[0] <= w[1]);
-    if row_starts.first() != Some(&0)
-        || !rising
-        || row_starts.last().map(|&e| e as usize) != Some(entries)
-    {
-        return Err("operator rows out of order".into());
-    }
-    Ok(())
 }
 
 #[cfg(test)]
@@ -517,7 +506,15 @@ mod tests {
             seed: 3,
         };
         let spec = ShardSpec::new(1, 2).unwrap();
-        trace_shard(&scene, &bvh, &settings, spec, "ball.toml", &NoProgress).unwrap()
+        trace_shard(
+            &scene,
+            &bvh,
+            &settings,
+            spec,
+            ("ball.toml", [7; 32]),
+            &NoProgress,
+        )
+        .unwrap()
     }
 
     /// `bytes` with its checksum made right again (a damage the checksum cannot see).
@@ -574,5 +571,13 @@ mod tests {
         column[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
         let text = message(&resealed(column));
         assert!(text.contains("beyond the scene's vertices"), "{text}");
+        // Finite values no tracing makes (the bounds are tested in `values`).
+        let mut absurd = bytes.clone();
+        let at = layout.visibility as usize;
+        absurd[at..at + 4].copy_from_slice(&3e38f32.to_le_bytes());
+        let text = message(&resealed(absurd));
+        assert!(text.contains("visibility coefficient is 3"), "{text}");
+        // The shard it was made from reads back whole: real values pass every bound.
+        assert!(decode(Path::new("s.hprtshard"), &bytes).is_ok());
     }
 }

@@ -179,11 +179,14 @@ fn run_shard(
     // The merge reloads the scene by this path, perhaps from another folder.
     let scene_path = std::path::absolute(&scene.path)
         .with_context(|| format!("cannot resolve {}", scene.path.display()))?;
+    let scene_hash = crate::recorded::file_hash(&scene_path)
+        .with_context(|| format!("cannot read {}", scene_path.display()))?;
     let shard = with_threads(threads, || {
         let bvh = SceneBvh::build(&scene.geometry.mesh);
         let progress = TerminalProgress::new("tracing");
         let name = scene_path.to_string_lossy();
-        bake::shard::trace_shard(&scene.geometry, &bvh, settings, spec, &name, &progress)
+        let scene_file = (name.as_ref(), scene_hash);
+        bake::shard::trace_shard(&scene.geometry, &bvh, settings, spec, scene_file, &progress)
     })??;
     let bytes = file
         .commit_streamed(|out| shardfile::write(&shard, out))
@@ -212,7 +215,21 @@ fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
         .context("cannot merge the shards")?;
     let scene_path = match &args.scene {
         Some(path) => path.clone(),
-        None => PathBuf::from(&shards[0].scene_path),
+        None => {
+            // A path read from a shard: the file must still be the one it was baked from
+            // before any of it is read.
+            let recorded = crate::recorded::RecordedFile {
+                path: PathBuf::from(&shards[0].scene_path),
+                blake3: blake3::Hash::from_bytes(shards[0].scene_hash)
+                    .to_hex()
+                    .to_string(),
+            };
+            crate::recorded::check_scene_path(&files[0], &recorded.path)?;
+            recorded.check(&files[0]).context(
+                "cannot merge the shards (give the scene with --scene if it moved or changed)",
+            )?;
+            recorded.path
+        }
     };
     let scene = load_scene(&scene_path)?;
     let mut inputs = scene_inputs(&scene, &[]);

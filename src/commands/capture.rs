@@ -48,7 +48,7 @@ pub fn run(args: CaptureArgs) -> anyhow::Result<()> {
         ("--coverage", args.coverage.as_deref()),
         ("--preview", args.preview.as_deref()),
     ];
-    let mut inputs = vec![args.description.as_path()];
+    let mut inputs: Vec<&Path> = vec![args.description.as_path()];
     inputs.extend(args.response.as_deref());
     check_outputs(&inputs, &outputs)?;
     if args.scale <= 0.0 {
@@ -60,6 +60,9 @@ pub fn run(args: CaptureArgs) -> anyhow::Result<()> {
         log::warn!("{note}");
     }
     let photos = loaded.photos;
+    // The photographs are inputs too: no output may be written over one.
+    inputs.extend(photos.iter().map(|p| p.path.as_path()));
+    check_outputs(&inputs, &outputs)?;
     let width = args.width as usize;
     let settings = AssemblySettings {
         width,
@@ -77,6 +80,7 @@ pub fn run(args: CaptureArgs) -> anyhow::Result<()> {
     };
     let mut captured = capture::assemble(&photos, &response, &settings);
     scale_map(&mut captured, args.scale);
+    check_radiance(&args, &captured, &photos, &response)?;
     report(&args.description, &captured, photos.len());
     let image = RgbImageF32::new(width, width / 2, captured.map.texels().to_vec());
     let mut bytes = vec![exr_bytes(&image)?];
@@ -94,6 +98,44 @@ pub fn run(args: CaptureArgs) -> anyhow::Result<()> {
         )?);
     }
     write_outputs(files, bytes)
+}
+
+/// Refuses a map whose radiance overflowed, naming what multiplied to it: the exposures, the
+/// response, the reflectance and `--scale` (each is bounded where it enters, but not their
+/// product).
+fn check_radiance(
+    args: &CaptureArgs,
+    captured: &Assembled,
+    photos: &[capture::Photo],
+    response: &InverseResponse,
+) -> anyhow::Result<()> {
+    let bad = captured
+        .map
+        .texels()
+        .iter()
+        .filter(|c| !c.is_finite())
+        .count();
+    if bad == 0 {
+        return Ok(());
+    }
+    let times = photos.iter().map(|p| p.time);
+    let (shortest, longest) = times.fold((f32::MAX, 0.0f32), |(a, b), t| (a.min(t), b.max(t)));
+    let top = response
+        .curves
+        .iter()
+        .flatten()
+        .fold(0.0f32, |m, v| m.max(*v));
+    anyhow::bail!(
+        "{}: {bad} texels of the map overflowed: the exposures ({shortest} to {longest} s), the \
+         response (up to {top}{}), the balls' reflectance and --scale {} divide or multiply to \
+         more than a float holds; check them",
+        args.description.display(),
+        args.response
+            .as_ref()
+            .map(|p| format!(", from {}", p.display()))
+            .unwrap_or_default(),
+        args.scale
+    )
 }
 
 fn scale_map(captured: &mut Assembled, scale: f32) {
@@ -169,6 +211,36 @@ fn response_csv(response: &InverseResponse) -> String {
     text
 }
 
+/// Largest exposure an inverse response may give a level, relative to its middle level:
+/// a camera's brightest level is at most a few hundred times its middle one, and beyond this
+/// a merged radiance can overflow.
+const MAX_RESPONSE_SPAN: f32 = 1e9;
+
+/// Refuses a response that cannot be a camera's: a channel that does not rise from its
+/// darkest to its brightest level (an all-zero file would make a black map), or one whose
+/// brightest level is more than [`MAX_RESPONSE_SPAN`] times its middle one.
+fn check_response_range(path: &Path, curves: &[Vec<f32>; 3]) -> anyhow::Result<()> {
+    for (curve, channel) in curves.iter().zip(["red", "green", "blue"]) {
+        let (first, middle, last) = (curve[0], curve[RESPONSE_BINS / 2], curve[RESPONSE_BINS - 1]);
+        anyhow::ensure!(
+            last > first && middle > 0.0,
+            "{}: the {channel} response does not rise ({first} at level 0, {middle} at level {}, \
+             {last} at level {}): a camera's brighter levels mean more light; give a response \
+             as --save-response writes it",
+            path.display(),
+            RESPONSE_BINS / 2,
+            RESPONSE_BINS - 1
+        );
+        anyhow::ensure!(
+            last <= MAX_RESPONSE_SPAN * middle,
+            "{}: the {channel} response spans {first} to {last}, more than {MAX_RESPONSE_SPAN:e} \
+             times its middle level {middle}: not a camera's",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 /// An inverse response as `--save-response` writes it.
 fn read_response(path: &Path) -> anyhow::Result<InverseResponse> {
     let text = read_text_file(path).with_context(|| format!("cannot read {}", path.display()))?;
@@ -203,5 +275,6 @@ fn read_response(path: &Path) -> anyhow::Result<InverseResponse> {
     if curves.iter().any(|c| c.windows(2).any(|w| w[1] < w[0])) {
         anyhow::bail!("{}: a response must not decrease", path.display());
     }
+    check_response_range(path, &curves)?;
     Ok(InverseResponse { curves })
 }

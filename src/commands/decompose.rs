@@ -41,7 +41,7 @@ pub struct DecomposeArgs {
     #[arg(long)]
     pub png: Option<PathBuf>,
     /// Decompose this many times (for timing from outside); the JSON reports the median.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, value_parser = crate::cli::parse_repeat, default_value_t = 1)]
     pub repeat: usize,
 }
 
@@ -84,9 +84,6 @@ pub fn run(args: DecomposeArgs) -> anyhow::Result<()> {
     ];
     check_outputs(&[&args.env], &outputs)?;
     let files = open_outputs(&outputs)?;
-    if args.repeat == 0 {
-        anyhow::bail!("--repeat must be at least 1");
-    }
     let loaded = load_map(&args.env, args.layout)?;
     let mut lighting = EnvironmentLighting::new(&loaded.map, settings.clone())?;
     let mut times = Vec::with_capacity(args.repeat);

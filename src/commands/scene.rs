@@ -93,11 +93,12 @@ fn init(args: SceneInitArgs) -> anyhow::Result<()> {
             rotation_deg: 0.0,
         });
     }
+    // The model's path is quoted in the comment: a newline in it cannot start a line.
     let text = format!(
-        "# Written by `hprt scene init {}`: the model scaled so its longest side is 2 units,\n\
+        "# Written by `hprt scene init {:?}`: the model scaled so its longest side is 2 units,\n\
          # standing on the ground (y = 0), framed by the camera. Edit freely; the format is in\n\
          # scenes/README.md.\n{}",
-        args.model.display(),
+        args.model.display().to_string(),
         toml::to_string_pretty(&file).context("cannot write the scene as TOML")?
     );
     // What is written must load: the same check every command makes.

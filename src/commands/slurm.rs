@@ -184,6 +184,47 @@ fn quote(word: &str) -> anyhow::Result<String> {
         .into_owned())
 }
 
+/// `words` as one shell command line, each quoted: what `--dry-run` prints can be pasted into
+/// a shell and runs exactly these words, whatever they hold.
+fn command_line(words: &[String]) -> anyhow::Result<String> {
+    Ok(words
+        .iter()
+        .map(|w| quote(w))
+        .collect::<anyhow::Result<Vec<_>>>()?
+        .join(" "))
+}
+
+/// Refuses a path Slurm itself would misread: Slurm takes `%` in a log path as a pattern and
+/// a `\` as "no patterns", and a control character (a newline) has no safe form in its
+/// options. `what` names the path for the message.
+fn check_slurm_path(what: &str, path: &Path) -> anyhow::Result<()> {
+    let text = path.to_str().with_context(|| {
+        format!(
+            "{what} {} is not UTF-8, which Slurm cannot be given",
+            path.display()
+        )
+    })?;
+    if let Some(c) = text
+        .chars()
+        .find(|c| c.is_control() || matches!(c, '%' | '\\'))
+    {
+        anyhow::bail!(
+            "{what} {text:?} holds {c:?}, which Slurm would misread in a job's working folder \
+             or log path; use a folder and an -o path without it"
+        );
+    }
+    Ok(())
+}
+
+/// How one batch job is submitted: its script, and the options that say where it runs and
+/// logs (given to sbatch as arguments, never written into the script, so no path can become
+/// a line of it).
+struct Submission {
+    script: String,
+    /// `--output=LOG` and `--chdir=WORKDIR`.
+    placement: Vec<String>,
+}
+
 /// A batch script running `hprt ARGS` from `workdir`, its log in `dir`.
 fn script(
     hprt: &Path,
@@ -192,7 +233,7 @@ fn script(
     name: &str,
     array: Option<u32>,
     command: &[String],
-) -> anyhow::Result<String> {
+) -> anyhow::Result<Submission> {
     let log = match array {
         Some(_) => dir.join(format!("{name}-%A_%a.log")),
         None => dir.join(format!("{name}-%j.log")),
@@ -200,19 +241,23 @@ fn script(
     let mut lines = vec![
         "#!/bin/bash".to_owned(),
         format!("#SBATCH --job-name=hprt-{name}"),
-        format!("#SBATCH --output={}", log.display()),
-        format!("#SBATCH --chdir={}", workdir.display()),
     ];
     if let Some(n) = array {
         lines.push(format!("#SBATCH --array=0-{}", n - 1));
     }
     lines.push("set -euo pipefail".to_owned());
-    let words = std::iter::once(hprt.display().to_string())
+    lines.push(format!("cd -- {}", quote(&workdir.display().to_string())?));
+    let words: Vec<String> = std::iter::once(hprt.display().to_string())
         .chain(command.iter().cloned())
-        .map(|w| quote(&w))
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    lines.push(format!("exec {}", words.join(" ")));
-    Ok(lines.join("\n") + "\n")
+        .collect();
+    lines.push(format!("exec {}", command_line(&words)?));
+    Ok(Submission {
+        script: lines.join("\n") + "\n",
+        placement: vec![
+            format!("--output={}", log.display()),
+            format!("--chdir={}", workdir.display()),
+        ],
+    })
 }
 
 pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
@@ -224,6 +269,8 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
     let hprt = std::env::current_exe().context("cannot find this hprt's own path")?;
     let workdir = std::env::current_dir().context("cannot read the current folder")?;
     let dir = workdir.join(&commands.dir);
+    check_slurm_path("the working folder", &workdir)?;
+    check_slurm_path("the shards' folder", &dir)?;
     let name = format!("{:?}", args.job).to_lowercase();
     let task = script(&hprt, &workdir, &dir, &name, Some(shards), &commands.task)?;
     let merge = script(
@@ -240,34 +287,65 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
         common.push(format!("--partition={p}"));
     }
     common.extend(options.sbatch.iter().cloned());
+    let task_call = [common.clone(), task.placement.clone()].concat();
+    let merge_call = [common, merge.placement.clone()].concat();
     if options.dry_run {
-        println!(
-            "# {}\n{task}\n# {}\n{merge}",
-            task_path.display(),
-            merge_path.display()
+        return print_dry_run(
+            (&task_path, &task, &task_call),
+            (&merge_path, &merge, &merge_call),
         );
-        println!("sbatch {} {}", common.join(" "), task_path.display());
-        println!(
-            "sbatch {} --dependency=afterok:ARRAY_JOB_ID {}",
-            common.join(" "),
-            merge_path.display()
-        );
-        return Ok(());
     }
     crate::support::create_folder(&dir)?;
-    for (path, text) in [(&task_path, &task), (&merge_path, &merge)] {
+    for (path, text) in [(&task_path, &task.script), (&merge_path, &merge.script)] {
         foundation::infra::atomic_file::write_atomic(path, text.as_bytes())
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    let array_id = sbatch(&common, &task_path)?;
+    let array_id = sbatch(&task_call, &task_path)?;
     let dependency = format!("--dependency=afterok:{array_id}");
-    let merge_id = sbatch(&[common.clone(), vec![dependency]].concat(), &merge_path)?;
+    let merge_id = sbatch(&[merge_call, vec![dependency]].concat(), &merge_path)?;
     println!(
         "submitted the array job {array_id} ({shards} tasks) and the merge job {merge_id} \
          (after every task succeeded); logs in {}",
         dir.display()
     );
     println!("{array_id} {merge_id}");
+    Ok(())
+}
+
+/// What `--dry-run` prints: each script, then the two sbatch calls as quoted command lines.
+fn print_dry_run(
+    (task_path, task, task_call): (&Path, &Submission, &[String]),
+    (merge_path, merge, merge_call): (&Path, &Submission, &[String]),
+) -> anyhow::Result<()> {
+    let call = |options: &[String], extra: &[&str], script: &Path| {
+        let words: Vec<String> = std::iter::once("sbatch".to_owned())
+            .chain(options.iter().cloned())
+            .chain(extra.iter().map(|w| (*w).to_owned()))
+            .chain(std::iter::once(script.display().to_string()))
+            .collect();
+        command_line(&words)
+    };
+    // The scripts are shown as comments, one `# ` per line: pasting the whole output into a
+    // shell runs only the two sbatch calls.
+    let commented = |text: &str| {
+        text.lines()
+            .map(|l| format!("# {l}"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    for (path, submission) in [(task_path, task), (merge_path, merge)] {
+        println!("{}", commented(&path.display().to_string()));
+        println!("{}", commented(&submission.script));
+    }
+    println!("{}", call(task_call, &[], task_path)?);
+    println!(
+        "{}",
+        call(
+            merge_call,
+            &["--dependency=afterok:ARRAY_JOB_ID"],
+            merge_path
+        )?
+    );
     Ok(())
 }
 

@@ -71,8 +71,10 @@ fn unique_map_names(envs: &[PathBuf]) -> Vec<String> {
 }
 
 fn map_name(path: &Path) -> String {
+    // A folder of the report: one plain name whatever the file is called (`...exr` has the
+    // stem `..`).
     path.file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
+        .map(|s| foundation::infra::names::as_file_name(&s.to_string_lossy()))
         .unwrap_or_else(|| "map".into())
 }
 

@@ -23,12 +23,7 @@ pub(crate) fn read_image(path: &Path) -> Result<RgbImage, EnvMapError> {
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    if !path.exists() {
-        return Err(EnvMapError::Io {
-            path: path.to_owned(),
-            cause: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
-        });
-    }
+    check_regular(path)?;
     match ext.as_str() {
         "exr" => read_exr(path),
         "hdr" => read_hdr(path),
@@ -157,6 +152,25 @@ fn read_hdr(path: &Path) -> Result<RgbImage, EnvMapError> {
     })
 }
 
+/// Refuses a path that is not a regular file before anything opens it: a FIFO would block the
+/// reader forever, a device never end.
+fn check_regular(path: &Path) -> Result<(), EnvMapError> {
+    use crate::infra::limits::{ReadError, regular_file_size};
+    match regular_file_size(path) {
+        Ok(_) => Ok(()),
+        Err(ReadError::Io(cause)) if cause.kind() == std::io::ErrorKind::NotFound => {
+            Err(EnvMapError::Io {
+                path: path.to_owned(),
+                cause: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+            })
+        }
+        Err(e) => Err(EnvMapError::Io {
+            path: path.to_owned(),
+            cause: e.into(),
+        }),
+    }
+}
+
 /// Most texels an input image may declare (8192 × 4096: 400 MB as float RGB): checked against
 /// the file's header before its pixels are allocated.
 pub(super) const MAX_IMAGE_TEXELS: usize = 8192 * 4096;
@@ -185,12 +199,7 @@ pub fn read_size(path: &Path) -> Result<(usize, usize), EnvMapError> {
     let is_exr = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    if !path.is_file() {
-        return Err(EnvMapError::Io {
-            path: path.to_owned(),
-            cause: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
-        });
-    }
+    check_regular(path)?;
     if is_exr {
         let meta =
             exr::meta::MetaData::read_from_file(path, false).map_err(|e| decode(e.to_string()))?;

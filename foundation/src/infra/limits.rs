@@ -48,6 +48,31 @@ pub const MAX_PATH_FRAMES: u32 = 36_000;
 /// spawning them cannot exhaust the process's resources.
 pub const MAX_THREADS: usize = 1024;
 
+/// Largest coordinate magnitude a mesh vertex or a `[path]` point may have: products of two
+/// edge vectors (areas, normals) and a path's summed length must stay finite in f32.
+pub const MAX_COORDINATE: f32 = 1e15;
+
+/// Most pixels of an OpenEXR file hprt reads (every layer of it, checked from its header):
+/// the largest backplate photograph; maps, probes and distance maps have tighter limits of
+/// their own.
+pub const MAX_EXR_PIXELS: u64 = MAX_BACKPLATE_PIXELS;
+
+/// Most photographs one capture description may name: 64 directions at 16 exposures each,
+/// four times more than a thorough capture takes; each is decoded and kept in memory.
+pub const MAX_CAPTURE_PHOTOS: usize = 1024;
+
+/// Most pixels of all a capture's photographs together (they are held as 8-bit RGB: 6.4 GB at
+/// the limit): a hundred 20-megapixel photographs fit; checked at the first photograph.
+pub const MAX_CAPTURE_PIXELS: u64 = 1 << 31;
+
+/// Most pixels of one capture photograph (its header is read first): a 40-megapixel
+/// camera's full frame, as for backplates.
+pub const MAX_PHOTO_PIXELS: u64 = MAX_BACKPLATE_PIXELS;
+
+/// Most repetitions `hprt decompose --repeat` times: each is a full decomposition, so this is
+/// hours of work already.
+pub const MAX_REPEAT: usize = 100_000;
+
 /// Why a file could not be read within a limit.
 #[derive(Debug, thiserror::Error)]
 pub enum ReadError {
@@ -69,20 +94,24 @@ impl From<ReadError> for std::io::Error {
     }
 }
 
-/// The bytes of the regular file at `path`, refused before reading when it is not a regular
-/// file (`/dev/zero`, a folder, a FIFO) or larger than `max` bytes.
-pub fn read_regular_file(path: &Path, max: u64) -> Result<Vec<u8>, ReadError> {
+/// The size of the regular file at `path` (links followed), or why it cannot be read as one:
+/// a FIFO would block the reader forever, a device never end.
+pub fn regular_file_size(path: &Path) -> Result<u64, ReadError> {
     let metadata = std::fs::metadata(path)?;
     if !metadata.is_file() {
         return Err(ReadError::NotAFile);
     }
-    if metadata.len() > max {
-        return Err(ReadError::TooLarge {
-            size: metadata.len(),
-            max,
-        });
+    Ok(metadata.len())
+}
+
+/// The bytes of the regular file at `path`, refused before reading when it is not a regular
+/// file (`/dev/zero`, a folder, a FIFO) or larger than `max` bytes.
+pub fn read_regular_file(path: &Path, max: u64) -> Result<Vec<u8>, ReadError> {
+    let len = regular_file_size(path)?;
+    if len > max {
+        return Err(ReadError::TooLarge { size: len, max });
     }
-    let mut bytes = Vec::with_capacity(metadata.len() as usize);
+    let mut bytes = Vec::with_capacity(len as usize);
     // The file may grow while it is read: never read past the limit.
     std::fs::File::open(path)?
         .take(max + 1)
@@ -108,18 +137,21 @@ pub fn read_text_file(path: &Path) -> Result<String, ReadError> {
 }
 
 /// The expansion of gzip data, refused once it passes `max` bytes (a small file can expand to
-/// gigabytes).
+/// gigabytes). The expansion is first streamed and counted, holding nothing, so a bomb is
+/// refused in constant memory; only data within the limit is expanded into memory, into a
+/// buffer of exactly its size.
 pub fn gunzip_limited(bytes: &[u8], max: u64) -> Result<Vec<u8>, ReadError> {
-    let mut out = Vec::new();
-    flate2::read::MultiGzDecoder::new(bytes)
-        .take(max + 1)
-        .read_to_end(&mut out)?;
-    if out.len() as u64 > max {
-        return Err(ReadError::TooLarge {
-            size: out.len() as u64,
-            max,
-        });
+    let size = std::io::copy(
+        &mut flate2::read::MultiGzDecoder::new(bytes).take(max + 1),
+        &mut std::io::sink(),
+    )?;
+    if size > max {
+        return Err(ReadError::TooLarge { size, max });
     }
+    let mut out = Vec::with_capacity(size as usize);
+    flate2::read::MultiGzDecoder::new(bytes)
+        .take(size)
+        .read_to_end(&mut out)?;
     Ok(out)
 }
 

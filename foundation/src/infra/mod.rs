@@ -1,9 +1,11 @@
 //! Infrastructure under the domain code: files written atomically, huge-page tables, cache
-//! prefetching, progress bars, enums named in settings files, and shards of a job.
+//! prefetching, progress bars, enums named in settings files, names that become file names,
+//! and shards of a job.
 
 pub mod atomic_file;
 pub mod huge_pages;
 pub mod limits;
+pub mod names;
 #[macro_use]
 pub mod named_enum;
 pub mod prefetch;

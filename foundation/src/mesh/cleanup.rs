@@ -116,9 +116,7 @@ impl MeshCleanup {
     }
 }
 
-/// Largest coordinate magnitude a mesh may have: products of two edge vectors (areas, normals)
-/// must stay finite in f32.
-pub(super) const MAX_COORDINATE: f32 = 1e15;
+use crate::infra::limits::MAX_COORDINATE;
 
 /// Finite coordinates, finite normals of the right count, indices in range.
 fn validate(raw: &RawMesh) -> Result<(), String> {

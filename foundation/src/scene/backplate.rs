@@ -48,13 +48,8 @@ pub fn load_backplate_image(
 
 /// The image's declared size, refused over the limits before its pixels are read.
 fn check_exr_size(path: &Path) -> Result<(), String> {
-    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
-    let size = meta
-        .headers
-        .first()
-        .map(|h| h.layer_size)
-        .ok_or("the file has no image")?;
-    check_size(size.width() as u64, size.height() as u64)
+    let (width, height) = crate::image_io::exr_size(path)?;
+    check_size(width, height)
 }
 
 fn check_size(width: u64, height: u64) -> Result<(), String> {

@@ -6,6 +6,7 @@ use super::geometry::SceneMesh;
 use super::{Scene, SceneError};
 use crate::color::Rgb;
 use crate::infra::limits::{MAX_SCENE_TRIANGLES, ReadError, read_text_file};
+use crate::infra::names::check_file_name;
 use crate::material::{MAX_SHININESS, Material, check_energy};
 use crate::mesh::{
     self, LoadOptions, MeshCleanup, MeshError, TriangleMesh, annulus_mesh, box_mesh,
@@ -78,6 +79,9 @@ impl Scene {
             map: dir.join(env.map),
             rotation_deg: env.rotation_deg,
         });
+        if let Some(name) = &file.name {
+            check_file_name("the scene's name", name).map_err(invalid)?;
+        }
         Ok(Self {
             name: file.name.unwrap_or_else(|| {
                 path.file_stem()
@@ -137,6 +141,12 @@ fn check_roles<'a>(
     }
 }
 
+/// Whether `name` is one `hprt probes --at` gives its probes (`at-1`, `at-2`, …).
+fn is_at_name(name: &str) -> bool {
+    name.strip_prefix("at-")
+        .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
+}
+
 /// Checks a scene's probes: named once each, at finite positions inside the room (the
 /// bounds of the proxies, which a scene with probes must have).
 fn check_probes(geometry: &SceneMesh, probes: &[ProbeSource]) -> Result<(), String> {
@@ -153,6 +163,13 @@ fn check_probes(geometry: &SceneMesh, probes: &[ProbeSource]) -> Result<(), Stri
         let name = &probe.name;
         if name.is_empty() {
             return Err(format!("[[probe]] {}: the name is empty", index + 1));
+        }
+        check_file_name("[[probe]] name", name)?;
+        if is_at_name(name) {
+            return Err(format!(
+                "[[probe]] name {name:?} is kept for `hprt probes --at` (its probes are \
+                 written as probes/at-N.exr): choose another name"
+            ));
         }
         if probes[..index].iter().any(|p| p.name == *name) {
             return Err(format!("[[probe]] \"{name}\" is named twice"));

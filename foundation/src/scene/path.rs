@@ -3,7 +3,7 @@
 
 use super::rotation::rotation_from_deg;
 use crate::bvh::{SceneBvh, Skip};
-use crate::infra::limits::MAX_PATH_FRAMES;
+use crate::infra::limits::{MAX_COORDINATE, MAX_PATH_FRAMES};
 use crate::mesh::TriangleMesh;
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
@@ -82,6 +82,12 @@ impl PathSpec {
             .find(|p| !p.iter().all(|x| x.is_finite()))
         {
             return Err(format!("[path]: the point {p:?} is not finite"));
+        }
+        if let Some(p) = (self.points.iter()).find(|p| p.iter().any(|x| x.abs() > MAX_COORDINATE)) {
+            return Err(format!(
+                "[path]: the point {p:?} lies beyond ±{MAX_COORDINATE:e}, the largest \
+                 coordinate hprt takes (the path's length must stay finite)"
+            ));
         }
         if !(2..=MAX_PATH_FRAMES).contains(&self.frames) {
             return Err(format!(
@@ -301,6 +307,10 @@ mod tests {
                 .unwrap_err()
                 .contains("does not move")
         );
+        // Finite points whose distance overflows (it once panicked inside the BVH).
+        let far = path(&[[-3e38, 0.0, 0.0], [3e38, 0.0, 0.0]], 10).unwrap_err();
+        assert!(far.contains("beyond"), "{far}");
+        assert!(path(&[[-1e15, 0.0, 0.0], [1e15, 0.0, 0.0]], 10).is_ok());
     }
 
     /// A path from one room into the next, through the wall between them: one crossing, at

@@ -34,6 +34,9 @@ pub struct BakeShard {
     pub partition_hash: [u8; 32],
     /// The scene file the shard was baked from (the merge reloads it to sum the bounces).
     pub scene_path: String,
+    /// BLAKE3 hash of that file's bytes: the merge reads the file only when it still holds
+    /// them, so a path rewritten in a shard cannot make hprt read (and quote) another file.
+    pub scene_hash: [u8; 32],
     /// Seconds the tracing took.
     pub seconds: f64,
     pub(crate) traced: TracedVertices,
@@ -85,13 +88,14 @@ pub fn partition_hash(ranges: &[Range<usize>]) -> [u8; 32] {
     *hasher.finalize().as_bytes()
 }
 
-/// Traces shard `spec`'s vertices. `progress` counts vertices.
+/// Traces shard `spec`'s vertices. `scene_file` is the scene file's path and the hash of its
+/// bytes, recorded for the merge. `progress` counts vertices.
 pub fn trace_shard(
     geometry: &SceneMesh,
     bvh: &SceneBvh,
     settings: &BakeSettings,
     spec: ShardSpec,
-    scene_path: &str,
+    (scene_path, scene_hash): (&str, [u8; 32]),
     progress: &dyn Progress,
 ) -> Result<BakeShard, InvalidSettings> {
     settings.validate()?;
@@ -109,6 +113,7 @@ pub fn trace_shard(
         mesh_hash: geometry.content_hash(),
         partition_hash: partition_hash(&ranges),
         scene_path: scene_path.to_owned(),
+        scene_hash,
         seconds: start.elapsed().as_secs_f64(),
         traced,
     })
@@ -243,7 +248,8 @@ mod tests {
                 .map(|i| {
                     let spec = ShardSpec::new(i, count).unwrap();
                     let shard =
-                        trace_shard(&scene, &bvh, &s, spec, "scene.toml", &NoProgress).unwrap();
+                        trace_shard(&scene, &bvh, &s, spec, ("scene.toml", [0; 32]), &NoProgress)
+                            .unwrap();
                     let path = std::path::Path::new("shard");
                     let decoded = shardfile::decode(path, &shardfile::encode(&shard)).unwrap();
                     assert_eq!(decoded.vertices, shard.vertices);
@@ -302,7 +308,7 @@ mod tests {
                 &bvh,
                 s,
                 ShardSpec::new(i, n).unwrap(),
-                "x",
+                ("x", [0; 32]),
                 &NoProgress,
             )
             .unwrap()

@@ -268,7 +268,8 @@ fn walking_out_of_the_sun_never_pops() {
         steps.push((followed, afresh));
     }
     // The largest change of the lights' power at a step where their number changes.
-    let pop = |pick: fn(&((f32, usize), (f32, usize))) -> (f32, usize)| {
+    type Step = ((f32, usize), (f32, usize));
+    let pop = |pick: fn(&Step) -> (f32, usize)| {
         (steps.windows(2))
             .map(|w| (pick(&w[0]), pick(&w[1])))
             .filter(|((_, a), (_, b))| a != b)

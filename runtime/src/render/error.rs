@@ -14,8 +14,22 @@ pub enum RenderError {
     Settings(#[from] InvalidSettings),
     #[error("reading the image back failed: {0}")]
     Readback(#[from] ReadbackError),
+    #[error(
+        "the GPU ran out of memory ({0}): draw at a smaller size, with smaller shadow maps or \
+         fewer lights, or on an adapter with more memory"
+    )]
+    OutOfMemory(wgpu::Error),
     #[error("the graphics driver rejected the work: {0}")]
-    Device(#[from] wgpu::Error),
+    Device(wgpu::Error),
+}
+
+impl From<wgpu::Error> for RenderError {
+    fn from(error: wgpu::Error) -> Self {
+        match error {
+            wgpu::Error::OutOfMemory { .. } => Self::OutOfMemory(error),
+            other => Self::Device(other),
+        }
+    }
 }
 
 /// A bake the renderer cannot draw with this scene or adapter.
@@ -66,8 +80,52 @@ pub(super) fn checked<T>(
     let result = work();
     let validation = pollster::block_on(validation.pop());
     let memory = pollster::block_on(memory.pop());
-    match (validation.or(memory), result) {
-        (Some(error), _) => Err(RenderError::Device(error)),
-        (None, result) => result,
+    match first_cause(validation, memory, super::gpu::ran_out_of_memory()) {
+        Some(error) => Err(error),
+        None => result,
+    }
+}
+
+/// The error to report of those two scopes caught: running out of memory first, since the
+/// resource it left invalid makes every later use of it a validation error that hides the
+/// cause.
+/// `ran_out`: memory ran out earlier where no scope caught it.
+fn first_cause(
+    validation: Option<wgpu::Error>,
+    memory: Option<wgpu::Error>,
+    ran_out: bool,
+) -> Option<RenderError> {
+    match (memory, validation) {
+        (Some(memory), _) => Some(RenderError::from(memory)),
+        // Memory ran out outside any scope (creating a texture): what failed later is its
+        // consequence.
+        (None, Some(v)) if ran_out => Some(RenderError::OutOfMemory(v)),
+        (None, validation) => validation.map(RenderError::from),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn running_out_of_memory_is_reported_before_what_it_invalidated() {
+        let memory = || wgpu::Error::OutOfMemory {
+            source: Box::new(std::io::Error::other("allocation failed")),
+        };
+        let validation = || wgpu::Error::Validation {
+            source: Box::new(std::io::Error::other("invalid")),
+            description: "Texture `shadow maps` is invalid".into(),
+        };
+        let e = first_cause(Some(validation()), Some(memory()), false).unwrap();
+        assert!(matches!(e, RenderError::OutOfMemory(_)), "{e}");
+        assert!(e.to_string().contains("ran out of memory"), "{e}");
+        let e = first_cause(Some(validation()), None, false).unwrap();
+        assert!(matches!(e, RenderError::Device(_)), "{e}");
+        assert!(first_cause(None, None, false).is_none());
+        // After memory ran out where no scope caught it, the texture it left invalid is
+        // reported as what it is.
+        let e = first_cause(Some(validation()), None, true).unwrap();
+        assert!(matches!(e, RenderError::OutOfMemory(_)), "{e}");
     }
 }

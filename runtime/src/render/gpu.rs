@@ -152,6 +152,7 @@ impl GpuContext {
         })?;
         // Errors outside the renderer's error scopes are reported, not turned into a panic.
         device.on_uncaptured_error(std::sync::Arc::new(|error: wgpu::Error| {
+            note_uncaptured(&error);
             log::error!("graphics driver: {error}");
         }));
         Ok(Self {
@@ -171,4 +172,20 @@ impl GpuContext {
         // Only fails if the device is lost, which the next call reports anyway.
         let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
     }
+}
+
+/// Whether the driver ran out of memory outside an error scope in this process.
+static RAN_OUT_OF_MEMORY: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Notes an error no scope caught (the device's uncaptured-error handler calls this).
+fn note_uncaptured(error: &wgpu::Error) {
+    if matches!(error, wgpu::Error::OutOfMemory { .. }) {
+        RAN_OUT_OF_MEMORY.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+}
+
+/// Whether memory ran out earlier where no error scope caught it: what fails later is then
+/// reported as running out of memory, its cause.
+pub(super) fn ran_out_of_memory() -> bool {
+    RAN_OUT_OF_MEMORY.load(std::sync::atomic::Ordering::Relaxed)
 }

@@ -24,7 +24,7 @@ pub struct BenchBakeArgs {
     #[arg(long, default_value_t = 3)]
     pub bounces: u32,
     /// Bakes per scene; the median is reported.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, value_parser = crate::cli::parse_repeat, default_value_t = 3)]
     pub repeat: usize,
     /// Worker threads (default: all cores).
     #[arg(long)]

@@ -23,10 +23,10 @@ pub struct BenchCompositeArgs {
     #[arg(long, default_value_t = 720)]
     pub height: u32,
     /// Frames timed per configuration (after one warm-up frame); medians are reported.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, value_parser = crate::cli::parse_repeat, default_value_t = 20)]
     pub frames: usize,
     /// Repeats of each configuration, alternated; the median of their medians is reported.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, value_parser = crate::cli::parse_repeat, default_value_t = 5)]
     pub repeats: usize,
     /// Rays per vertex of the bakes made for the benchmark (their quality does not matter).
     #[arg(long, default_value_t = 32)]

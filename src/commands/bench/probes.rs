@@ -24,7 +24,7 @@ pub struct BenchProbesArgs {
     pub face: usize,
     /// Positions along the path through the probes (first to last), when the scene has no
     /// [path] of its own.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, value_parser = crate::cli::parse_repeat, default_value_t = 200)]
     pub steps: usize,
     #[arg(long, default_value = "consistent")]
     pub mode: DecomposeMode,
@@ -34,7 +34,7 @@ pub struct BenchProbesArgs {
     /// Also path-trace the true probe at this many points of the path and compare the local
     /// map with it, beside one probe's map (the one nearest the room's centre: a single
     /// capture) and the nearest probe's.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, value_parser = crate::cli::parse_count, default_value_t = 0)]
     pub truth: usize,
     /// Light paths per texel of the true probes.
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65_536))]

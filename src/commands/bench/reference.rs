@@ -21,7 +21,7 @@ pub struct BenchReferenceArgs {
     #[arg(long, default_value_t = 3)]
     pub bounces: u32,
     /// Renders; the median is reported.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, value_parser = crate::cli::parse_repeat, default_value_t = 3)]
     pub repeat: usize,
     /// Worker threads (default: all cores).
     #[arg(long)]

@@ -20,7 +20,7 @@ pub struct BenchReflectionsArgs {
     #[arg(long, value_delimiter = ',', default_values_t = [128, 256])]
     pub sizes: Vec<usize>,
     /// Prefilterings timed per size (after one warm-up); medians are reported.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, value_parser = crate::cli::parse_repeat, default_value_t = 10)]
     pub repeat: usize,
     /// Graphics backend: auto, vulkan or gl.
     #[arg(long, default_value = "auto")]

@@ -38,7 +38,7 @@ pub struct BenchRenderArgs {
     #[arg(long, value_enum, default_value = "on")]
     pub pcf_from_radius: Switch,
     /// Frames timed per configuration (after one warm-up frame); medians are reported.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, value_parser = crate::cli::parse_repeat, default_value_t = 20)]
     pub frames: usize,
     /// Rays per vertex of the bakes made for the benchmark (their quality does not matter).
     #[arg(long, default_value_t = 32)]

@@ -10,23 +10,23 @@
 
 use super::job::{JobSpec, OutputFiles, ReferenceJob};
 use crate::outputs::{check_outputs, scene_inputs};
+use crate::recorded::RecordedFile;
 use crate::support::{create_folder, files_with_extension};
 use anyhow::Context;
 use clap::Args;
 use foundation::color::Rgb;
 use foundation::image_io::RgbImageF32;
 use foundation::infra::atomic_file::AtomicOutput;
-use foundation::infra::limits::read_regular_file;
+use foundation::infra::limits::{read_regular_file, regular_file_size};
 use foundation::infra::shard::{ShardSpec, check_indices};
 use reference::{ReferenceImage, RenderStats};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8; 8] = b"HPRTBAND";
-const VERSION: u32 = 1;
+/// Version 2 records every input file with its hash ([`BandHeader::files`]).
+const VERSION: u32 = 2;
 const EXTENSION: &str = "hprtband";
-/// Largest band file read (a 4K reference band of a composite is a few hundred MB).
-const MAX_BAND_BYTES: u64 = 16 << 30;
 
 #[derive(Args)]
 pub struct MergeArgs {
@@ -49,6 +49,9 @@ struct BandHeader {
     height: usize,
     /// 1, or 2 for a composite (the scene, then the proxies alone).
     images: usize,
+    /// Every file the job read (the scene, its meshes and backplate, the map) with its hash:
+    /// the merge reads the job's files only when they still hold these bytes.
+    files: Vec<RecordedFile>,
 }
 
 /// Hash of the job and of the contents it reads: bands of one job agree on it, and a merge
@@ -63,9 +66,9 @@ fn fingerprint(spec: &JobSpec, job: &ReferenceJob) -> anyhow::Result<String> {
         files.push(path.clone());
     }
     for file in files.iter().filter(|f| f.is_file()) {
-        let bytes =
-            std::fs::read(file).with_context(|| format!("cannot read {}", file.display()))?;
-        hasher.update(blake3::hash(&bytes).as_bytes());
+        let hash = crate::recorded::file_hash(file)
+            .with_context(|| format!("cannot read {}", file.display()))?;
+        hasher.update(&hash);
     }
     Ok(hasher.finalize().to_hex().to_string())
 }
@@ -112,6 +115,11 @@ pub fn run_band(
         width: job.camera.width as usize,
         height: job.camera.height as usize,
         images: 1 + usize::from(without.is_some()),
+        // The files there are (a room's probe images may not be rendered yet, a map given
+        // by faces is a pattern).
+        files: (inputs.iter().filter(|p| p.is_file()))
+            .map(|p| RecordedFile::of(&std::path::absolute(p)?))
+            .collect::<anyhow::Result<_>>()?,
     };
     let images: Vec<&ReferenceImage> = std::iter::once(&with).chain(without.as_ref()).collect();
     let bytes = encode(&header, &images)?;
@@ -237,12 +245,11 @@ fn decode(bytes: &[u8]) -> anyhow::Result<Band> {
     let shard = ShardSpec::new(header.index, header.count).map_err(anyhow::Error::msg)?;
     // Within any camera's limits (checked again when the merge loads the job) before
     // anything is allocated for them.
-    let pixels = header.width as u64 * header.height as u64;
+    let (width, height) = (header.width as u64, header.height as u64);
     anyhow::ensure!(
         (1..=2).contains(&header.images)
-            && header.width > 0
-            && header.height > 0
-            && pixels <= (body.len() as u64).saturating_mul(u64::from(header.count)),
+            && foundation::camera::image_size_allowed(width, height)
+            && width * height <= (body.len() as u64).saturating_mul(u64::from(header.count)),
         "{} images of {}x{} pixels in {} bytes",
         header.images,
         header.width,
@@ -281,20 +288,65 @@ fn decode(bytes: &[u8]) -> anyhow::Result<Band> {
     })
 }
 
+/// Most bytes of a band's JSON header (its job and recorded files: a few kilobytes).
+const MAX_HEADER_BYTES: u64 = 1 << 20;
+
+/// Reads a band, its header first: a file whose size is not the one its header declares, or
+/// whose header declares no image a camera could make, is refused before the rest is read.
+fn read_band(path: &Path) -> anyhow::Result<Band> {
+    use std::io::Read;
+    let size = regular_file_size(path).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut file = std::fs::File::open(path)?;
+    let mut head = [0u8; 16];
+    file.read_exact(&mut head).context("truncated")?;
+    anyhow::ensure!(&head[..8] == MAGIC, "not an hprt reference band");
+    let json_len = u64::from(u32::from_le_bytes([head[12], head[13], head[14], head[15]]));
+    anyhow::ensure!(
+        json_len <= MAX_HEADER_BYTES && 16 + json_len <= size,
+        "a header of {json_len} bytes in a file of {size}"
+    );
+    let mut json = vec![0u8; json_len as usize];
+    file.read_exact(&mut json).context("truncated")?;
+    let header: BandHeader = serde_json::from_slice(&json).context("unreadable header")?;
+    let expected = band_size(json_len, &header)?;
+    anyhow::ensure!(
+        expected == size,
+        "{size} bytes where its header describes {expected} (truncated or damaged)"
+    );
+    decode(&read_regular_file(path, size).map_err(|e| anyhow::anyhow!("{e}"))?)
+}
+
+/// The size in bytes of a band whose JSON header takes `json_len` bytes, from its header's
+/// image size, shard and image count (checked arithmetic: the numbers are the file's).
+fn band_size(json_len: u64, header: &BandHeader) -> anyhow::Result<u64> {
+    let (width, height) = (header.width as u64, header.height as u64);
+    anyhow::ensure!(
+        foundation::camera::image_size_allowed(width, height) && (1..=2).contains(&header.images),
+        "{} images of {}x{} pixels",
+        header.images,
+        header.width,
+        header.height
+    );
+    let shard = ShardSpec::new(header.index, header.count).map_err(anyhow::Error::msg)?;
+    let rows = band_rows(shard, height as usize).len() as u64;
+    // Radiance and specular (RGB), coverage, visibility, primary: nine words a pixel; then
+    // the rays and seconds.
+    let image = rows * width * 9 * 4 + 16;
+    Ok((16 + json_len).div_ceil(4) * 4 + header.images as u64 * image + 4)
+}
+
 /// The band files in `dir`, read, in index order.
 fn read_bands(dir: &Path) -> anyhow::Result<(Vec<PathBuf>, Vec<Band>)> {
     let how = format!("hprt reference SCENE --shard I/N -o {}", dir.display());
     let files = files_with_extension(dir, EXTENSION, "reference bands", &how)?;
     let mut bands = Vec::new();
-    for file in &files {
-        let bytes = read_regular_file(file, MAX_BAND_BYTES)
-            .map_err(|e| anyhow::anyhow!("{e}"))
-            .and_then(|b| decode(&b))
+    for file in files {
+        let band = read_band(&file)
             .with_context(|| format!("{}: not a usable reference band", file.display()))?;
-        bands.push(bytes);
+        bands.push((file, band));
     }
-    bands.sort_by_key(|b| b.header.index);
-    Ok((files, bands))
+    bands.sort_by_key(|(_, b)| b.header.index);
+    Ok(bands.into_iter().unzip())
 }
 
 /// Checks that `bands` are every shard of one job.
@@ -321,6 +373,30 @@ fn check_bands(dir: &Path, bands: &[Band]) -> anyhow::Result<()> {
     check_indices(&specs).with_context(|| format!("cannot merge the bands in {}", dir.display()))
 }
 
+/// Refuses a band whose job names files it did not record, or files that no longer hold the
+/// recorded bytes: checked before any of them is read, so a path rewritten in a band cannot
+/// make the merge read (and quote) another file.
+fn check_recorded(band: &Path, header: &BandHeader) -> anyhow::Result<()> {
+    let job = &header.job;
+    crate::recorded::check_scene_path(band, &job.scene)?;
+    // The scene, and the map where it is a file (a map given by faces is a pattern whose
+    // faces are among the recorded files).
+    let map = job.env.as_ref().filter(|m| m.is_file());
+    for path in std::iter::once(&job.scene).chain(map) {
+        anyhow::ensure!(
+            header.files.iter().any(|f| f.path == *path),
+            "{}: its job names {}, which it does not record as an input: the band was \
+             altered; render the bands again",
+            band.display(),
+            path.display()
+        );
+    }
+    for file in &header.files {
+        file.check(band)?;
+    }
+    Ok(())
+}
+
 /// `hprt reference merge DIR -o FILE`.
 pub fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
     let Some(output) = &args.files.output else {
@@ -329,7 +405,17 @@ pub fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
     let (band_files, bands) = read_bands(&args.bands)?;
     check_bands(&args.bands, &bands)?;
     let spec = bands[0].header.job.clone();
+    check_recorded(&band_files[0], &bands[0].header)?;
     let job = ReferenceJob::prepare(&spec)?;
+    let (width, height) = (bands[0].header.width, bands[0].header.height);
+    anyhow::ensure!(
+        (width, height) == (job.camera.width as usize, job.camera.height as usize),
+        "{}: the bands hold {width}x{height} pixels, but their job renders {}x{}: a band \
+         was altered; render them again",
+        band_files[0].display(),
+        job.camera.width,
+        job.camera.height
+    );
     anyhow::ensure!(
         fingerprint(&spec, &job)? == bands[0].header.fingerprint,
         "{}: the scene, its map or its backplate changed since the bands were rendered; \
@@ -338,7 +424,6 @@ pub fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
     );
     let band_files: Vec<&Path> = band_files.iter().map(PathBuf::as_path).collect();
     let files = job.open_outputs(&args.files, output, &band_files)?;
-    let (width, height) = (bands[0].header.width, bands[0].header.height);
     let mut parts: [Vec<(Vec<usize>, ReferenceImage)>; 2] = Default::default();
     for band in bands {
         for (k, image) in band.images.into_iter().enumerate() {
