@@ -10,19 +10,15 @@ use common::*;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// `hprt args` in `dir` under the memory limit, stopped after a minute (a reader blocked on a
-/// FIFO would otherwise hang the test; the needles then fail it).
-fn hprt_bounded(dir: &Path, args: &[&str]) -> Output {
-    Command::new("timeout")
-        .args(["60", "sh", "-c"])
-        .arg(format!("ulimit -v {MEMORY_LIMIT_KIB}; exec \"$0\" \"$@\""))
-        .arg(env!("CARGO_BIN_EXE_hprt"))
-        .args(args)
-        .current_dir(dir)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .env("HPRT_CACHE", dir.join("cache"))
-        .output()
-        .expect("timeout runs")
+/// The first line of `/etc/passwd`, which no error may quote, and the file's bytes.
+fn passwd() -> (String, Vec<u8>) {
+    let bytes = std::fs::read("/etc/passwd").unwrap();
+    let first = String::from_utf8_lossy(&bytes)
+        .lines()
+        .next()
+        .unwrap_or("root")
+        .to_owned();
+    (first, bytes)
 }
 
 fn box_scene(dir: &Path, extra: &str) -> PathBuf {
@@ -80,15 +76,10 @@ fn shards_that_name_another_file_are_refused_before_it_is_read() {
     }
     let shard = d.join("shards/bake-0000-of-0002.hprtshard");
     let original = std::fs::read(&shard).unwrap();
-    let passwd = std::fs::read("/etc/passwd").unwrap();
-    let first_line = String::from_utf8_lossy(&passwd)
-        .lines()
-        .next()
-        .unwrap_or("root")
-        .to_owned();
+    let (first_line, passwd) = passwd();
     for hash in [None, Some(*blake3::hash(&passwd).as_bytes())] {
         std::fs::write(&shard, shard_naming(&original, "/etc/passwd", hash)).unwrap();
-        let out = hprt_bounded(d, &["bake", "merge", "shards", "-o", "m.bake"]);
+        let out = hprt_limited(d, &["bake", "merge", "shards", "-o", "m.bake"]);
         assert_clean_failure(&out, &["/etc/passwd"]);
         assert!(!stderr(&out).contains(&first_line), "{}", stderr(&out));
         assert!(!d.join("m.bake").exists());
@@ -105,7 +96,7 @@ fn shards_that_name_another_file_are_refused_before_it_is_read() {
         shard_naming(&original, other.to_str().unwrap(), None),
     )
     .unwrap();
-    let out = hprt_bounded(d, &["bake", "merge", "shards", "-o", "m.bake"]);
+    let out = hprt_limited(d, &["bake", "merge", "shards", "-o", "m.bake"]);
     assert_clean_failure(&out, &["other.toml", "now holds other bytes"]);
     // Absurd but finite values: refused by name, not merged into a bake render then fails on.
     let path_len = u32::from_le_bytes(original[160..164].try_into().unwrap()) as usize;
@@ -113,7 +104,7 @@ fn shards_that_name_another_file_are_refused_before_it_is_read() {
     let mut absurd = original.clone();
     absurd[visibility..visibility + 4].copy_from_slice(&3e38f32.to_le_bytes());
     std::fs::write(&shard, resealed(absurd)).unwrap();
-    let out = hprt_bounded(d, &["bake", "merge", "shards", "-o", "m.bake"]);
+    let out = hprt_limited(d, &["bake", "merge", "shards", "-o", "m.bake"]);
     assert_clean_failure(
         &out,
         &["bake-0000-of-0002.hprtshard", "visibility coefficient"],
@@ -159,12 +150,7 @@ fn bands_that_name_another_file_or_size_are_refused() {
     }
     let band = d.join("bands/reference-0000-of-0002.hprtband");
     let original = std::fs::read(&band).unwrap();
-    let passwd = std::fs::read("/etc/passwd").unwrap();
-    let first_line = String::from_utf8_lossy(&passwd)
-        .lines()
-        .next()
-        .unwrap_or("root")
-        .to_owned();
+    let (first_line, passwd) = passwd();
     let hash = blake3::hash(&passwd).to_hex().to_string();
     let merge = ["reference", "merge", "bands", "-o", "r.exr"];
     // The scene's path rewritten; then also recorded with the right hash.
@@ -175,7 +161,7 @@ fn bands_that_name_another_file_or_size_are_refused() {
     });
     for bytes in [rewritten, forged] {
         std::fs::write(&band, bytes).unwrap();
-        let out = hprt_bounded(d, &merge);
+        let out = hprt_limited(d, &merge);
         assert_clean_failure(&out, &["/etc/passwd"]);
         assert!(!stderr(&out).contains(&first_line), "{}", stderr(&out));
     }
@@ -188,7 +174,7 @@ fn bands_that_name_another_file_or_size_are_refused() {
         }),
     )
     .unwrap();
-    assert_clean_failure(&hprt_bounded(d, &merge), &["8x16", "16x8"]);
+    assert_clean_failure(&hprt_limited(d, &merge), &["8x16", "16x8"]);
     // Sizes whose products overflow or exceed memory, refused before allocating.
     for (w, h) in [(1u64 << 62, 4u64), (1 << 32, 1 << 32), (1 << 62, 1)] {
         std::fs::write(
@@ -199,7 +185,7 @@ fn bands_that_name_another_file_or_size_are_refused() {
             }),
         )
         .unwrap();
-        let out = hprt_bounded(d, &merge);
+        let out = hprt_limited(d, &merge);
         assert_clean_failure(
             &out,
             &[
@@ -258,7 +244,7 @@ fn captures_with_impossible_counts_sizes_and_values_are_refused() {
             extra,
         ]
         .concat();
-        hprt_bounded(d, &args)
+        hprt_limited(d, &args)
     };
     capture(shot("a.png", "1").repeat(100_000));
     assert_clean_failure(&run(&[]), &["c.toml", "100000 photographs", "at most 1024"]);
@@ -356,25 +342,25 @@ fn declared_sizes_and_pipes_are_refused_on_every_image_path() {
     mkfifo(&d.join("fifo.exr"));
     let bench = ["bench", "probes", "room.toml", "--steps", "2"];
     room(d, "a.exr", "huge.exr", "environment");
-    assert_clean_failure(&hprt_bounded(d, &bench), &["huge.exr", "30000"]);
+    assert_clean_failure(&hprt_limited(d, &bench), &["huge.exr", "30000"]);
     room(d, "fifo.exr", "dist.exr", "environment");
     assert_clean_failure(
-        &hprt_bounded(d, &bench),
+        &hprt_limited(d, &bench),
         &["fifo.exr", "not a regular file"],
     );
     room(d, "a.exr", "fifo.exr", "environment");
     assert_clean_failure(
-        &hprt_bounded(d, &bench),
+        &hprt_limited(d, &bench),
         &["fifo.exr", "not a regular file"],
     );
     room(d, "a.exr", "dist.exr", "fifo.exr");
     let reference = ["reference", "room.toml", "--spp", "1", "-o", "r.exr"];
     assert_clean_failure(
-        &hprt_bounded(d, &reference),
+        &hprt_limited(d, &reference),
         &["fifo.exr", "not a regular file"],
     );
     room(d, "a.exr", "dist.exr", "huge.exr");
-    assert_clean_failure(&hprt_bounded(d, &reference), &["huge.exr", "30000x30000"]);
+    assert_clean_failure(&hprt_limited(d, &reference), &["huge.exr", "30000x30000"]);
     assert!(!d.join("r.exr").exists());
 }
 
@@ -392,13 +378,13 @@ fn flags_and_scene_values_that_overflow_are_refused() {
             "-o",
             "l.json",
         ];
-        assert_clean_failure(&hprt_bounded(d, &args), &["--repeat", "at most 100000"]);
+        assert_clean_failure(&hprt_limited(d, &args), &["--repeat", "at most 100000"]);
     }
     box_scene(
         d,
         "[path]\npoints = [[-3e38, 0.5, 0], [3e38, 0.5, 0]]\nframes = 10\n",
     );
-    let out = hprt_bounded(d, &["bake", "box.toml", "-o", "b.bake"]);
+    let out = hprt_limited(d, &["bake", "box.toml", "-o", "b.bake"]);
     assert_clean_failure(&out, &["box.toml", "[path]", "beyond"]);
 }
 
@@ -425,6 +411,6 @@ fn a_gzip_bomb_is_refused_in_constant_memory() {
         "bomb.toml",
         "mesh = \"bomb.ply.gz\"\nalbedo = [0.5, 0.5, 0.5]",
     );
-    let out = hprt_bounded(d, &["bake", scene.to_str().unwrap(), "-o", "b.bake"]);
+    let out = hprt_limited(d, &["bake", scene.to_str().unwrap(), "-o", "b.bake"]);
     assert_clean_failure(&out, &["bomb.ply.gz", "expands beyond 1024 MB"]);
 }

@@ -292,10 +292,12 @@ pub fn glb(document: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
 /// Address space of a run under [`hprt_limited`] (KiB): hostile inputs must not need more.
 pub const MEMORY_LIMIT_KIB: u64 = 1024 * 1024;
 
-/// `hprt ARGS` in `dir` under an address-space limit of `limit_kib` (`ulimit -v`).
+/// `hprt ARGS` in `dir` under an address-space limit of `limit_kib` (`ulimit -v`), stopped
+/// after five minutes (a reader blocked on a FIFO would otherwise hang the test; its needles
+/// then fail it).
 pub fn hprt_limited_to(dir: &Path, args: &[&str], limit_kib: u64) -> Output {
-    Command::new("sh")
-        .arg("-c")
+    Command::new("timeout")
+        .args(["300", "sh", "-c"])
         .arg(format!("ulimit -v {limit_kib}; exec \"$0\" \"$@\""))
         .arg(env!("CARGO_BIN_EXE_hprt"))
         .args(args)
@@ -303,7 +305,7 @@ pub fn hprt_limited_to(dir: &Path, args: &[&str], limit_kib: u64) -> Output {
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
         .env("HPRT_CACHE", dir.join("cache"))
         .output()
-        .expect("sh runs")
+        .expect("timeout runs")
 }
 
 /// `hprt ARGS` in `dir` under [`MEMORY_LIMIT_KIB`].
