@@ -10,12 +10,8 @@ use foundation::{Rgb, luminance};
 use rand_pcg::Pcg32;
 use runtime::{CubeSource, DecomposeSettings, Decomposer};
 
-/// A response curve with a knee and a gamma, different per channel.
-const RESPONSE: CameraResponse = CameraResponse {
-    knee: [0.9, 1.0, 1.15],
-    gamma: 2.0,
-    noise: 0.6,
-};
+/// A response curve with a knee and a gamma, different per channel, saturating at exposure 8.
+const RESPONSE: CameraResponse = CameraResponse::knee([0.9, 1.0, 1.15], 2.0, 8.0, 0.6);
 
 /// The bundled map, at `width × width/2`.
 fn truth(width: usize) -> EnvMap {
@@ -133,11 +129,12 @@ fn median(mut values: Vec<f32>) -> f32 {
 }
 
 /// The recovered inverse response against the true one (both scaled to 1 at level 128), within
-/// 5% from level 32 up (below it, one level of the noise is more than 5% of the exposure).
+/// 5% from level 32 up (below it, one level of the noise is more than 5% of the exposure) to
+/// the clipping level (the merge reads nothing above it, and the fit no level).
 fn assert_response_matches(curve: &InverseResponse) {
     for c in 0..3 {
         let scale = RESPONSE.exposure(c, 128.0);
-        for z in [32u16, 48, 64, 128, 192, 232, 245] {
+        for z in [32u16, 48, 64, 128, 192, 220] {
             let (got, want) = (curve.g(c, z), RESPONSE.exposure(c, z as f32) / scale);
             assert!(
                 (got / want - 1.0).abs() < 0.05,

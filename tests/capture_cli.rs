@@ -12,11 +12,7 @@ use rand_pcg::Pcg32;
 use std::fmt::Write;
 use std::path::Path;
 
-const RESPONSE: CameraResponse = CameraResponse {
-    knee: [0.9, 1.0, 1.1],
-    gamma: 2.0,
-    noise: 0.5,
-};
+const RESPONSE: CameraResponse = CameraResponse::knee([0.9, 1.0, 1.1], 2.0, f32::INFINITY, 0.5);
 
 /// Exposure times for the bundled interior map (its lamps to its dark corners).
 const TIMES: [f32; 6] = [4e-5, 1.3e-4, 6e-4, 2.5e-3, 1.1e-2, 4.6e-2];
@@ -96,6 +92,13 @@ fn a_ball_capture_becomes_a_map_hprt_reads() {
         let image = image::open(dir.path().join(png)).unwrap();
         assert_eq!((image.width(), image.height()), (128, 64));
     }
+    // The response's spread is printed beside the map and saved with it; the recovered
+    // response leaves noise, no warning.
+    let spread = printed_spread(&stdout(&out));
+    assert!(spread < 5.0, "{}", stdout(&out));
+    assert!(!stderr(&out).contains("spread is"), "{}", stderr(&out));
+    let saved = std::fs::read_to_string(dir.path().join("response.csv")).unwrap();
+    assert!(saved.starts_with("# spread 0.0"), "{saved}");
     // The rest of hprt takes it; and the saved response gives the same map back.
     let out = hprt(
         dir.path(),
@@ -121,6 +124,60 @@ fn a_ball_capture_becomes_a_map_hprt_reads() {
             "{a} vs {b}"
         );
     }
+}
+
+/// The response spread `hprt capture` printed, in percent.
+fn printed_spread(stdout: &str) -> f32 {
+    let after = stdout.split(" spread ").nth(1).expect("a spread printed");
+    after
+        .split('%')
+        .next()
+        .and_then(|v| v.parse().ok())
+        .expect("a percentage")
+}
+
+/// A response that does not fit the photographs (a linear camera's, for a camera with a
+/// gamma of 2) spreads a texel's exposures apart: the spread says so, with a warning, and
+/// `--coverage` marks the texels yellow.
+#[test]
+fn a_wrong_response_is_flagged_by_its_spread() {
+    let dir = tempfile::tempdir().unwrap();
+    write_ball_capture(dir.path(), &TIMES);
+    let mut linear = String::from("# a linear camera\nlevel,r,g,b\n");
+    for z in 0..256 {
+        let g = z as f32 / 128.0;
+        writeln!(linear, "{z},{g},{g},{g}").unwrap();
+    }
+    std::fs::write(dir.path().join("linear.csv"), linear).unwrap();
+    let args = [
+        "capture",
+        "capture.toml",
+        "-o",
+        "captured.exr",
+        "--width",
+        "128",
+        "--response",
+        "linear.csv",
+        "--coverage",
+        "coverage.png",
+    ];
+    let out = hprt(dir.path(), &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let spread = printed_spread(&stdout(&out));
+    assert!(spread > 10.0, "{}", stdout(&out));
+    assert!(
+        stderr(&out).contains("spread is") && stderr(&out).contains("linear.csv"),
+        "{}",
+        stderr(&out)
+    );
+    let coverage = image::open(dir.path().join("coverage.png"))
+        .unwrap()
+        .to_rgb8();
+    let yellow = coverage
+        .pixels()
+        .filter(|p| p.0[2] == 0 && p.0[0] >= 128 && p.0[1] >= 128)
+        .count();
+    assert!(yellow >= 32, "{yellow} yellow texels");
 }
 
 /// Runs `hprt capture` on `toml` in a folder of the ball capture and expects a clean failure
@@ -320,6 +377,7 @@ fn ball_plan(times: Vec<f32>, seed: u64) -> CapturePlan {
         response: RESPONSE,
         samples: 4,
         seed,
+        quality: 92,
         provenance: String::new(),
     }
 }

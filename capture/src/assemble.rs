@@ -3,9 +3,9 @@
 //! the photographs that see it, holes filled and marked, unresolved highlights flagged.
 
 use crate::error::CaptureError;
-use crate::merge::{Reading, clip_level, merge_readings};
+use crate::merge::{Reading, clip_level, merge_readings, spread_terms};
 use crate::photo::Photo;
-use crate::response::{InverseResponse, Observation, RESPONSE_BINS, calibrate_debevec};
+use crate::response::{InverseResponse, Observation, RESPONSE_BINS, recover_response};
 use foundation::Rgb;
 use foundation::envmap::EnvMap;
 use glam::Vec3;
@@ -18,8 +18,6 @@ pub struct AssemblySettings {
     pub height: usize,
     /// Sample directions the response is recovered from.
     pub calibration_points: usize,
-    /// The response's curvature penalty ([`crate::calibrate_debevec`]).
-    pub smoothness: f64,
     /// Each texel merges `supersample²` directions across it.
     pub supersample: usize,
 }
@@ -30,7 +28,6 @@ impl Default for AssemblySettings {
             width: 1024,
             height: 512,
             calibration_points: 20_000,
-            smoothness: 1.0,
             supersample: 2,
         }
     }
@@ -46,6 +43,9 @@ pub struct Assembled {
     pub saturated: Vec<bool>,
     /// Texels no photograph sees, filled from their neighbours.
     pub filled: Vec<bool>,
+    /// Per texel, the RMS of its readings' log deviation from their merge across exposures
+    /// (NaN where fewer than two exposures read it): noise where the response is right.
+    pub spread: Vec<f32>,
 }
 
 impl Assembled {
@@ -63,6 +63,18 @@ impl Assembled {
         (
             self.solid_angle_where(|t| self.saturated[t]),
             clipped / total.max(f32::MIN_POSITIVE),
+        )
+    }
+
+    /// The response's spread ([`Assembled::spread`]): its median over the texels two or more
+    /// exposures read, `None` if there are none.
+    pub fn response_spread(&self) -> Option<f32> {
+        median(
+            self.spread
+                .iter()
+                .copied()
+                .filter(|s| s.is_finite())
+                .collect(),
         )
     }
 
@@ -86,29 +98,36 @@ fn luminance_power(map: &EnvMap, keep: impl Fn(usize) -> bool) -> f32 {
 }
 
 /// The camera's inverse response from `photos`: the levels every photograph records at a
-/// spread of sample directions (a Fibonacci lattice), fitted by Debevec and Malik's method.
+/// spread of sample directions (a Fibonacci lattice), fitted in the empirical model of response
+/// ([`crate::recover_response`]).
 pub fn calibrate(
     photos: &[Photo],
     settings: &AssemblySettings,
 ) -> Result<InverseResponse, CaptureError> {
     let points = fibonacci_sphere(settings.calibration_points);
+    let views = group_by_view(photos);
+    // A point is a direction as one view sees it: one view's exposures are registered pixel
+    // for pixel (a bracket from one place), while two views see a direction at slightly
+    // different points, and where the picture is not flat those differ in radiance.
     let observations: Vec<Observation> = points
         .par_iter()
         .enumerate()
         .flat_map_iter(|(i, d)| {
-            photos.iter().filter_map(move |photo| {
-                let (x, y, weight) = photo.view.locate(*d)?;
-                // Photographs from other places see a direction at slightly different points:
-                // only where the picture is flat do their levels all record one radiance.
-                (weight > 0.0 && photo.is_flat_at(x, y)).then(|| Observation {
-                    point: i as u32,
-                    time: photo.time,
-                    bins: photo.nearest(x, y).map(u16::from),
+            let views = &views;
+            views.iter().enumerate().flat_map(move |(v, group)| {
+                let located = group[0].view.locate(*d);
+                group.iter().filter_map(move |photo| {
+                    let (x, y, weight) = located?;
+                    (weight > 0.0 && photo.is_flat_at(x, y)).then(|| Observation {
+                        point: (i * views.len() + v) as u32,
+                        time: photo.time,
+                        bins: photo.nearest(x, y).map(u16::from),
+                    })
                 })
             })
         })
         .collect();
-    calibrate_debevec(&observations, points.len(), settings.smoothness)
+    recover_response(&observations, points.len() * views.len())
 }
 
 /// `n` directions spread evenly over the sphere.
@@ -126,7 +145,8 @@ fn fibonacci_sphere(n: usize) -> Vec<Vec3> {
 
 /// What one texel's observations say.
 enum Texel {
-    Resolved(Rgb, f32),
+    /// Radiance, precision, and the sums of the spread's weighted squares and weights.
+    Resolved(Rgb, f32, (f32, f32)),
     /// Clipped in every photograph: the lower bound of its radiance.
     Saturated(Rgb),
     Unseen,
@@ -159,7 +179,7 @@ pub fn assemble(
     let weights: Vec<f32> = texels
         .iter()
         .filter_map(|t| match t {
-            Texel::Resolved(_, weight) => Some(*weight),
+            Texel::Resolved(_, weight, _) => Some(*weight),
             _ => None,
         })
         .collect();
@@ -167,11 +187,15 @@ pub fn assemble(
     let mut radiance = vec![Rgb::ZERO; w * h];
     let (mut confidence, mut saturated, mut filled) =
         (vec![0.0; w * h], vec![false; w * h], vec![false; w * h]);
+    let mut spread = vec![f32::NAN; w * h];
     for (t, texel) in texels.iter().enumerate() {
         match texel {
-            Texel::Resolved(c, weight) => {
+            Texel::Resolved(c, weight, (sum, total)) => {
                 radiance[t] = *c;
                 confidence[t] = 1.0 - (-weight / reference).exp();
+                if *total > 0.0 {
+                    spread[t] = (sum / total).sqrt();
+                }
             }
             Texel::Saturated(c) => {
                 radiance[t] = *c;
@@ -186,6 +210,7 @@ pub fn assemble(
         confidence,
         saturated,
         filled,
+        spread,
     }
 }
 
@@ -193,13 +218,15 @@ pub fn assemble(
 /// any is (resolved samples counted at their value), else unseen.
 fn average(samples: impl Iterator<Item = Texel>) -> Texel {
     let (mut sum, mut weight, mut count) = (Rgb::ZERO, 0.0, 0);
+    let mut spread = (0.0, 0.0);
     let (mut saturated, mut unseen) = (false, false);
     for sample in samples {
         count += 1;
         match sample {
-            Texel::Resolved(c, w) => {
+            Texel::Resolved(c, w, (s, t)) => {
                 sum += c;
                 weight += w;
+                spread = (spread.0 + s, spread.1 + t);
             }
             Texel::Saturated(c) => {
                 sum += c;
@@ -214,7 +241,7 @@ fn average(samples: impl Iterator<Item = Texel>) -> Texel {
     } else if unseen {
         Texel::Unseen
     } else {
-        Texel::Resolved(mean, weight)
+        Texel::Resolved(mean, weight, spread)
     }
 }
 
@@ -245,6 +272,7 @@ fn merge_texel(
     // Per channel, the least sensitivity at which a photograph clipped it.
     let mut clipped: [Option<f32>; 3] = [None; 3];
     let mut precision = 0.0;
+    let mut spread = (0.0, 0.0);
     for group in groups {
         let Some((x, y, feather)) = group[0].view.locate(d) else {
             continue;
@@ -258,12 +286,15 @@ fn merge_texel(
                 sum[c] += feather * radiance;
                 total[c] += feather;
                 precision += weight / 3.0;
+                if let Some((s, t)) = spread_terms(&readings[c], radiance, response, c) {
+                    spread = (spread.0 + s, spread.1 + t);
+                }
             }
         }
     }
     if total.iter().all(|t| *t > 0.0) {
         let mean: [f32; 3] = std::array::from_fn(|c| sum[c] / total[c]);
-        return Texel::Resolved(Rgb::from_array(mean), precision);
+        return Texel::Resolved(Rgb::from_array(mean), precision, spread);
     }
     if clipped.iter().any(Option::is_some) {
         // Each channel: what it resolved, or the least radiance that clips it.

@@ -534,11 +534,7 @@ mod tests {
     #[test]
     fn a_ball_is_found_where_it_was_photographed() {
         let map = room();
-        let response = CameraResponse {
-            knee: [1.0; 3],
-            gamma: 2.0,
-            noise: 0.6,
-        };
+        let response = CameraResponse::knee([1.0; 3], 2.0, f32::INFINITY, 0.6);
         let mut rng = Pcg32::new(7, 9);
         for (size, centre, radius, yaw) in [
             ((160, 120), (80.0, 60.0), 45.0, 0.0),
@@ -568,11 +564,7 @@ mod tests {
     #[test]
     fn no_ball_no_circle() {
         let map = room();
-        let response = CameraResponse {
-            knee: [1.0; 3],
-            gamma: 2.0,
-            noise: 0.6,
-        };
+        let response = CameraResponse::knee([1.0; 3], 2.0, f32::INFINITY, 0.6);
         let camera = ShotCamera::new((30.0, 5.0, 0.0), 60.0, (160, 120), (0.0, 0.0));
         let photo = photograph(
             &map,

@@ -2,8 +2,9 @@
 //! 3.1; Debevec 1998 for the mirror ball).
 //!
 //! Three independent pieces, as OpenCV's photo module keeps them (docs/STYLE.md):
-//! - `response`: the camera's inverse response, recovered from overlapping exposures (Debevec
-//!   and Malik 1997), per channel;
+//! - `response`: the camera's inverse response, recovered per channel from overlapping
+//!   exposures, as a curve of the empirical model of measured responses (`emor`, Grossberg
+//!   and Nayar 2004) fitted by Debevec and Malik's least squares (1997);
 //! - `merge`: the radiance of one direction from its observations, weighted by a hat that
 //!   distrusts clipped and dark levels;
 //! - the views that say where a direction lands in a photograph: [`ShotCamera`] (an oriented
@@ -20,12 +21,16 @@ mod ball;
 mod ball_finder;
 mod camera;
 mod description;
+mod emor;
 mod error;
 mod exif;
+mod free_form;
 mod load;
 mod merge;
 mod photo;
 mod response;
+mod response_fit;
+
 pub mod synthetic;
 
 pub use assemble::{Assembled, AssemblySettings, assemble, calibrate};
@@ -38,4 +43,4 @@ pub use exif::{ExifExposure, exif_block, read_exposure};
 pub use load::{LoadedCapture, load_capture};
 pub use merge::hat_weight;
 pub use photo::{Photo, View};
-pub use response::{InverseResponse, Observation, RESPONSE_BINS, calibrate_debevec};
+pub use response::{InverseResponse, Observation, RESPONSE_BINS, recover_response};

@@ -1,17 +1,14 @@
 //! The camera's inverse response, recovered per channel from observations of the same
-//! directions at different exposures, by Debevec and Malik's least squares (1997): the log
-//! curve `G = ln g` and each direction's log radiance `e_i` fit `G(z_ij) = e_i + ln t_j`,
-//! weighted by the hat, with a penalty on `G''` and `G(mid) = 0`. The radiances are eliminated
-//! in closed form (each is a weighted mean given `G`), leaving one 256 × 256 system however
-//! many directions there are.
+//! directions at different exposures ([`crate::response_fit`]): a curve of the empirical model
+//! of measured responses, fitted in Debevec and Malik's least squares.
 //!
-//! Why not Robertson et al. (1999), which the mobile-AR paper uses: its fixed-point iteration
-//! converged slowly here and, started from the true curve, drifted away from it (tens of
-//! percent at some levels after hundreds of steps); exposure ratios determine a curve only up
-//! to a factor periodic in `log x`, and nothing in Robertson's method chooses among those
-//! curves, while the smoothness term does. Merging ([`crate::merge`]) is still Robertson's.
+//! Each channel is fixed only up to a factor: the convention is that a channel's middle level
+//! means exposure 1 (`g(128) = 1`), so that a surface the camera recorded as a neutral mid grey
+//! (the camera's own white balance) comes out grey.
 
 use crate::error::CaptureError;
+use crate::free_form::free_form_log_curve;
+use crate::response_fit::{fit_channel, fit_weight};
 
 /// Levels of an 8-bit photograph: the curve's resolution (16-bit photographs are read at this
 /// many levels too).
@@ -80,12 +77,10 @@ impl InverseResponse {
     }
 }
 
-/// Recovers the inverse response from `observations` of `points` directions; `smoothness`
-/// weighs the curvature penalty against the fit (1 suits 8-bit photographs).
-pub fn calibrate_debevec(
+/// Recovers the inverse response from `observations` of `points` directions.
+pub fn recover_response(
     observations: &[Observation],
     points: usize,
-    smoothness: f64,
 ) -> Result<InverseResponse, CaptureError> {
     check_overlap(observations, points)?;
     let mut by_point: Vec<Vec<&Observation>> = vec![Vec::new(); points];
@@ -94,27 +89,111 @@ pub fn calibrate_debevec(
             list.push(o);
         }
     }
-    let curves = std::array::from_fn(|channel| {
-        let log_g = solve_log_curve(&by_point, channel, smoothness);
-        log_g.iter().map(|g| g.exp() as f32).collect()
+    let model: [Vec<f32>; 3] = std::array::from_fn(|channel| {
+        let lists: Vec<Vec<(usize, f64)>> = by_point
+            .iter()
+            .map(|list| {
+                list.iter()
+                    .map(|o| (o.bins[channel] as usize, f64::from(o.time).ln()))
+                    .filter(|(z, _)| fit_weight(*z) > 0.0)
+                    .collect::<Vec<_>>()
+            })
+            .filter(|list| list.len() >= 2)
+            .collect();
+        normalised(&fit_channel(&lists))
     });
-    Ok(InverseResponse { curves })
+    let model = InverseResponse { curves: model };
+    if equal_steps(observations) {
+        // The free curve is as ambiguous as any here, and its extra freedom fits the noise:
+        // its spread says nothing.
+        return Ok(model);
+    }
+    let free = InverseResponse {
+        curves: std::array::from_fn(|channel| {
+            let log_g = free_form_log_curve(&by_point, channel);
+            normalised(&log_g.iter().map(|g| g.exp()).collect::<Vec<_>>())
+        }),
+    };
+    // The model's curve unless the free one fits the photographs clearly better.
+    let (a, b) = (
+        observation_spread(&by_point, &model),
+        observation_spread(&by_point, &free),
+    );
+    Ok(if b < FREE_FORM_MARGIN * a {
+        free
+    } else {
+        model
+    })
 }
 
-/// The calibration's hat: over the whole range, 0 only at the two end levels (the merge's
-/// hat, [`crate::hat_weight`], stops short of the top: the curve there is what this fits).
-fn calibration_weight(bin: u16, bins: usize) -> f32 {
-    if bin == 0 || bin as usize >= bins - 1 {
-        return 0.0;
+/// Whether the exposure times step by one ratio (within 5% in log): a bracket of equal steps,
+/// which fixes a curve only up to a factor periodic in `ln g`.
+fn equal_steps(observations: &[Observation]) -> bool {
+    let mut logs: Vec<f64> = observations
+        .iter()
+        .map(|o| f64::from(o.time).ln())
+        .collect();
+    logs.sort_by(f64::total_cmp);
+    logs.dedup_by(|a, b| (*a - *b).abs() < 1e-3);
+    let steps: Vec<f64> = logs.windows(2).map(|w| w[1] - w[0]).collect();
+    let (lo, hi) = steps.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), s| {
+        (lo.min(*s), hi.max(*s))
+    });
+    steps.is_empty() || hi <= 1.05 * lo
+}
+
+/// How much lower the free-form curve's spread must be for it to be kept: equal-step brackets
+/// leave both equally consistent, and the model's curve is the camera-like one.
+const FREE_FORM_MARGIN: f64 = 0.8;
+
+/// `g` scaled to 1 at the middle level, as `f32`.
+fn normalised(g: &[f64]) -> Vec<f32> {
+    let mid = g[RESPONSE_BINS / 2].max(f64::MIN_POSITIVE);
+    g.iter().map(|v| (v / mid) as f32).collect()
+}
+
+/// The response's spread on the observations themselves: per point and channel, the RMS of
+/// `ln(g(z_j) / t_j)` about its mean over the readings from level 32 to the clipping level
+/// (hat-weighted), with two or more such readings; the median over them (infinite if none).
+fn observation_spread(by_point: &[Vec<&Observation>], response: &InverseResponse) -> f64 {
+    let top = crate::merge::clip_level(RESPONSE_BINS);
+    let mut spreads = Vec::new();
+    for list in by_point {
+        for c in 0..3 {
+            let terms: Vec<(f64, f64)> = list
+                .iter()
+                .filter(|o| (32..top).contains(&(o.bins[c] as usize)))
+                .map(|o| {
+                    let g = f64::from(response.g(c, o.bins[c])).max(1e-30);
+                    let w = f64::from(crate::hat_weight(o.bins[c], RESPONSE_BINS));
+                    (w, g.ln() - f64::from(o.time).ln())
+                })
+                .collect();
+            let total: f64 = terms.iter().map(|t| t.0).sum();
+            if terms.len() < 2 || total <= 0.0 {
+                continue;
+            }
+            let mean = terms.iter().map(|(w, x)| w * x).sum::<f64>() / total;
+            let var = terms
+                .iter()
+                .map(|(w, x)| w * (x - mean).powi(2))
+                .sum::<f64>()
+                / total;
+            spreads.push(var.sqrt());
+        }
     }
-    1.0 - (2.0 * bin as f32 / (bins - 1) as f32 - 1.0).abs()
+    if spreads.is_empty() {
+        return f64::INFINITY;
+    }
+    let mid = spreads.len() / 2;
+    *spreads.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 /// Refuses observations in which no direction is seen, with weight, at two exposure times.
 fn check_overlap(observations: &[Observation], points: usize) -> Result<(), CaptureError> {
     let mut first_time = vec![f32::NAN; points];
     for o in observations {
-        let usable = (0..3).any(|c| calibration_weight(o.bins[c], RESPONSE_BINS) > 0.0);
+        let usable = (0..3).any(|c| fit_weight(o.bins[c] as usize) > 0.0);
         let Some(slot) = first_time.get_mut(o.point as usize) else {
             continue;
         };
@@ -130,96 +209,19 @@ fn check_overlap(observations: &[Observation], points: usize) -> Result<(), Capt
     Err(CaptureError::NoOverlap)
 }
 
-/// One channel's `G = ln g`, the normal equations of the fit with the radiances eliminated.
-fn solve_log_curve(by_point: &[Vec<&Observation>], channel: usize, smoothness: f64) -> Vec<f64> {
-    let n = RESPONSE_BINS;
-    let mut a = vec![0.0f64; n * n];
-    let mut rhs = vec![0.0f64; n];
-    let mut total_weight = 0.0;
-    for list in by_point {
-        // Σ_j a_j x_j² − (Σ_j a_j x_j)² / W with x_j = G(z_j) − ln t_j, a_j = w_j².
-        let terms: Vec<(usize, f64, f64)> = list
-            .iter()
-            .map(|o| {
-                let z = o.bins[channel];
-                let w = calibration_weight(z, n) as f64;
-                (z as usize, w * w, (o.time as f64).ln())
-            })
-            .filter(|(_, a, _)| *a > 0.0)
-            .collect();
-        let w_sum: f64 = terms.iter().map(|t| t.1).sum();
-        if terms.len() < 2 || w_sum <= 0.0 {
-            continue;
-        }
-        let mean_log_t: f64 = terms.iter().map(|(_, a, l)| a * l).sum::<f64>() / w_sum;
-        for &(zj, aj, lj) in &terms {
-            a[zj * n + zj] += aj;
-            rhs[zj] += aj * (lj - mean_log_t);
-            for &(zk, ak, _) in &terms {
-                a[zj * n + zk] -= aj * ak / w_sum;
-            }
-            total_weight += aj;
-        }
-    }
-    // The curvature penalty, scaled with the data so that its effect does not depend on how
-    // many directions were sampled; weak (not zero) where the hat is zero, so that the
-    // clipped levels' values are extrapolated smoothly.
-    let lambda = smoothness * total_weight / n as f64;
-    for z in 1..n - 1 {
-        let w = (calibration_weight(z as u16, n) as f64).max(0.05);
-        let row = [(z - 1, 1.0), (z, -2.0), (z + 1, 1.0)];
-        for &(i, ci) in &row {
-            for &(j, cj) in &row {
-                a[i * n + j] += lambda * w * w * ci * cj;
-            }
-        }
-    }
-    // G(mid) = 0.
-    let mid = n / 2;
-    a[mid * n + mid] += total_weight.max(1.0);
-    solve_symmetric(a, rhs, n)
-}
-
-/// Solves the symmetric positive-definite system `a x = b` (Cholesky, `a` row-major).
-fn solve_symmetric(mut a: Vec<f64>, mut b: Vec<f64>, n: usize) -> Vec<f64> {
-    for j in 0..n {
-        let mut d = a[j * n + j];
-        for k in 0..j {
-            d -= a[j * n + k] * a[j * n + k];
-        }
-        let d = d.max(1e-300).sqrt();
-        a[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
-            }
-            a[i * n + j] = s / d;
-        }
-    }
-    for i in 0..n {
-        let s: f64 = (0..i).map(|k| a[i * n + k] * b[k]).sum();
-        b[i] = (b[i] - s) / a[i * n + i];
-    }
-    for i in (0..n).rev() {
-        let s: f64 = (i + 1..n).map(|k| a[k * n + i] * b[k]).sum();
-        b[i] = (b[i] - s) / a[i * n + i];
-    }
-    b
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A camera with response `z = 255 (x / (x + 1))^(1/2)` (unknown to the calibration)
-    /// photographs 400 directions at six exposures: the recovered curve is that response's
-    /// inverse, up to the scale.
+    /// A camera with response `z = 255 (f(x) / f(20))^(1/2)`, `f(x) = x / (x + 1)`, saturating
+    /// at 20 (unknown to the calibration), photographs 400 directions at six exposures: the
+    /// recovered curve is that response's inverse, up to the scale.
     #[test]
     fn recovers_a_nonlinear_response() {
-        let response = |x: f32| 255.0 * (x / (x + 1.0)).sqrt();
+        let f = |x: f32| x / (x + 1.0);
+        let response = |x: f32| 255.0 * (f(x.min(20.0)) / f(20.0)).sqrt();
         let inverse = |z: f32| {
-            let y = (z / 255.0).powi(2);
+            let y = (z / 255.0).powi(2) * f(20.0);
             y / (1.0 - y)
         };
         // Exposure ratios that are not all powers of one number: with ratios k^n only, any
@@ -237,9 +239,9 @@ mod tests {
                 });
             }
         }
-        let curve = calibrate_debevec(&observations, 400, 1.0).unwrap();
+        let curve = recover_response(&observations, 400).unwrap();
         let scale = inverse(128.0);
-        for z in [16u16, 32, 60, 128, 200, 240] {
+        for z in [16u16, 32, 60, 128, 200, 225] {
             let (got, want) = (curve.g(1, z), inverse(z as f32) / scale);
             assert!(
                 (got / want - 1.0).abs() < 0.05,
@@ -258,7 +260,7 @@ mod tests {
             })
             .collect();
         assert!(matches!(
-            calibrate_debevec(&observations, 10, 1.0),
+            recover_response(&observations, 10),
             Err(CaptureError::NoOverlap)
         ));
     }

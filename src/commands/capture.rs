@@ -26,10 +26,12 @@ pub struct CaptureArgs {
     /// Use this inverse response (CSV: level,r,g,b; 256 rows) instead of recovering one.
     #[arg(long)]
     pub response: Option<PathBuf>,
-    /// Write the inverse response used (CSV, as --response reads it).
+    /// Write the inverse response used (CSV, as --response reads it), with its spread on a
+    /// `# spread` line.
     #[arg(long)]
     pub save_response: Option<PathBuf>,
-    /// Confidence image (PNG): grey from 0 (filled hole) to 1; red where every exposure clipped.
+    /// Confidence image (PNG): grey from 0 (filled hole) to 1; red where every exposure clipped;
+    /// yellow where the exposures disagree by more than 10% through the response.
     #[arg(long)]
     pub coverage: Option<PathBuf>,
     /// Tone-mapped preview (PNG) with filled holes tinted blue and clipped texels red.
@@ -82,10 +84,12 @@ pub fn run(args: CaptureArgs) -> anyhow::Result<()> {
     scale_map(&mut captured, args.scale);
     check_radiance(&args, &captured, &photos, &response)?;
     report(&args.description, &captured, photos.len());
+    let spread = captured.response_spread();
+    report_spread(&args.description, spread, args.response.as_deref());
     let image = RgbImageF32::new(width, width / 2, captured.map.texels().to_vec());
     let mut bytes = vec![exr_bytes(&image)?];
     if args.save_response.is_some() {
-        bytes.push(response_csv(&response).into_bytes());
+        bytes.push(response_csv(&response, spread).into_bytes());
     }
     if args.coverage.is_some() {
         bytes.push(png_bytes(&coverage_rgb(&captured), width, width / 2)?);
@@ -166,6 +170,41 @@ fn report(description: &Path, captured: &Assembled, photos: usize) {
     }
 }
 
+/// A response spread above this (the median texel's readings scattering by more than 10% in
+/// log across exposures) says the response is poor: the right one leaves the noise, a few
+/// percent.
+const SPREAD_WARNING: f32 = 0.10;
+
+/// The response's spread beside the map, and a warning where it shows the response is poor.
+fn report_spread(description: &Path, spread: Option<f32>, given: Option<&Path>) {
+    let Some(spread) = spread else {
+        println!(
+            "{}: no texel was read by two exposures above the darkest levels (at or above level \
+             32): the response's spread is unknown (exposures too far apart to check it)",
+            description.display()
+        );
+        return;
+    };
+    let source = given.map_or("recovered".to_owned(), |p| format!("from {}", p.display()));
+    println!(
+        "{}: response ({source}) spread {:.1}%: the median texel's exposures, through it, \
+         disagree by that much (RMS of the log)",
+        description.display(),
+        100.0 * spread
+    );
+    if spread > SPREAD_WARNING {
+        log::warn!(
+            "{}: the response's ({source}) spread is {:.1}%, above {:.0}%: the response does not \
+             fit these photographs (a camera that changed its tone curve, white balance or ISO \
+             between exposures, misregistered shots, or a wrong --response); texels that \
+             disagree most are yellow in --coverage",
+            description.display(),
+            100.0 * spread,
+            100.0 * SPREAD_WARNING
+        );
+    }
+}
+
 fn filled_fraction(captured: &Assembled) -> f32 {
     let w = captured.map.width();
     // Summed from +0 (an empty float sum is −0, printed "-0.0%").
@@ -182,6 +221,8 @@ fn coverage_rgb(captured: &Assembled) -> Vec<u8> {
         let grey = (255.0 * c.sqrt()).round() as u8;
         rgb.extend(if captured.saturated[t] {
             [255, 0, 0]
+        } else if captured.spread[t] > SPREAD_WARNING {
+            [grey.max(128), grey.max(128), 0]
         } else {
             [grey; 3]
         });
@@ -202,8 +243,14 @@ fn preview_rgb(captured: &Assembled, image: &RgbImageF32) -> Vec<u8> {
     rgb
 }
 
-fn response_csv(response: &InverseResponse) -> String {
-    let mut text = String::from("level,r,g,b\n");
+fn response_csv(response: &InverseResponse, spread: Option<f32>) -> String {
+    let mut text = match spread {
+        Some(s) => {
+            format!("# spread {s}: the median texel's exposures disagree by this (RMS log)\n")
+        }
+        None => String::new(),
+    };
+    text.push_str("level,r,g,b\n");
     for z in 0..RESPONSE_BINS {
         let [r, g, b] = [0, 1, 2].map(|c| response.curves[c][z]);
         text.push_str(&format!("{z},{r},{g},{b}\n"));
@@ -242,10 +289,15 @@ fn check_response_range(path: &Path, curves: &[Vec<f32>; 3]) -> anyhow::Result<(
 }
 
 /// An inverse response as `--save-response` writes it.
-fn read_response(path: &Path) -> anyhow::Result<InverseResponse> {
+pub(crate) fn read_response(path: &Path) -> anyhow::Result<InverseResponse> {
     let text = read_text_file(path).with_context(|| format!("cannot read {}", path.display()))?;
     let mut curves: [Vec<f32>; 3] = Default::default();
-    for (n, line) in text.lines().enumerate().skip(1) {
+    // Comment lines (`# spread ...`) first, then the header.
+    let lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.starts_with('#'));
+    for (n, line) in lines.skip(1) {
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
         let values: Option<Vec<f32>> = fields.iter().map(|f| f.parse().ok()).collect();
         match values.as_deref() {

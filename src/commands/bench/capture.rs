@@ -18,9 +18,9 @@ pub struct BenchCaptureArgs {
     /// The map photographed.
     #[arg(default_value = "scenes/env/interior.exr")]
     pub map: PathBuf,
-    /// Photographs' size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "4000x3000", value_parser = parse_size)]
-    pub size: (u32, u32),
+    /// Photographs' size, WIDTHxHEIGHT (default 4000x3000).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
     /// Photograph a mirror ball from two sides instead of oriented shots.
     #[arg(long)]
     pub ball: bool,
@@ -33,14 +33,16 @@ pub struct BenchCaptureArgs {
     /// Keep the photographs and their description in this folder (default: a temporary one).
     #[arg(long)]
     pub keep: Option<PathBuf>,
+    /// Instead of timing: the battery's camera NAME (or `all`) photographs the map as shots and
+    /// as a ball, at --size (default here 320x240); prints the error of the response hprt
+    /// recovers beside the true response's and OpenCV's Robertson and Debevec (when python3
+    /// with opencv-python is installed).
+    #[arg(long, value_name = "NAME|all")]
+    pub camera: Option<String>,
 }
 
 /// The camera's response: a knee and a gamma, different per channel, with sensor noise.
-const RESPONSE: CameraResponse = CameraResponse {
-    knee: [0.9, 1.0, 1.15],
-    gamma: 2.0,
-    noise: 0.6,
-};
+const RESPONSE: CameraResponse = CameraResponse::knee([0.9, 1.0, 1.15], 2.0, f32::INFINITY, 0.6);
 /// Exposure times for the interior map, its lamps to its corners, in unequal steps (equal
 /// ratios leave the response determined only up to a periodic factor).
 const TIMES: [f32; 4] = [5e-5, 4.6e-4, 3.7e-3, 3.8e-2];
@@ -50,15 +52,14 @@ pub(super) fn bench_capture(args: BenchCaptureArgs) -> anyhow::Result<()> {
         .with_context(|| format!("cannot read {}", args.map.display()))?
         .map;
     let temp = tempfile::tempdir().context("cannot make a temporary folder")?;
-    let dir = match &args.keep {
-        Some(dir) => {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot make {}", dir.display()))?;
-            dir.clone()
-        }
-        None => temp.path().to_owned(),
-    };
-    let (w, h) = (args.size.0 as usize, args.size.1 as usize);
+    let dir = folder(args.keep.as_deref(), temp.path())?;
+    if let Some(which) = &args.camera {
+        let (w, h) = args.size.unwrap_or((320, 240));
+        let size = (w as usize, h as usize);
+        return super::capture_cameras::bench_cameras(&map, which, size, args.width as usize, &dir);
+    }
+    let (w, h) = args.size.unwrap_or((4000, 3000));
+    let (w, h) = (w as usize, h as usize);
     if args.times.is_empty() || args.times.iter().any(|t| !(t.is_finite() && *t > 0.0)) {
         anyhow::bail!(
             "--times {:?}: exposure times must be positive seconds",
@@ -92,12 +93,11 @@ pub(super) fn bench_capture(args: BenchCaptureArgs) -> anyhow::Result<()> {
         // benchmark's pictures need not be that sharp, and are made in seconds).
         samples: if w * h > 1_000_000 { 1 } else { 4 },
         seed: 1,
+        quality: 92,
         provenance: format!(
-            "Synthetic photographs of {} through a known response (knee {:?}, gamma {}, noise \
-             {} levels),\nmade by `hprt bench capture {} --size {w}x{h}{} --times {}{}`.",
+            "Synthetic photographs of {} through a known response (knee [0.9, 1.0, 1.15], gamma \
+             2, noise {} levels),\nmade by `hprt bench capture {} --size {w}x{h}{} --times {}{}`.",
             args.map.display(),
-            RESPONSE.knee,
-            RESPONSE.gamma,
             RESPONSE.noise,
             args.map.display(),
             if args.ball { " --ball" } else { "" },
@@ -141,6 +141,18 @@ pub(super) fn bench_capture(args: BenchCaptureArgs) -> anyhow::Result<()> {
         100.0 * median_log_error(&map, &captured)
     );
     Ok(())
+}
+
+/// `--keep`'s folder, made, or the temporary one.
+fn folder(keep: Option<&std::path::Path>, temp: &std::path::Path) -> anyhow::Result<PathBuf> {
+    match keep {
+        Some(dir) => {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot make {}", dir.display()))?;
+            Ok(dir.to_owned())
+        }
+        None => Ok(temp.to_owned()),
+    }
 }
 
 /// The median over texels of `|ln(captured · s_c / truth)|` (luminance), `s_c` per channel

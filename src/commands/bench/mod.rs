@@ -2,6 +2,7 @@
 
 mod bake;
 mod capture;
+mod capture_cameras;
 mod composite;
 mod probes;
 mod process;

@@ -8,28 +8,11 @@ use foundation::envmap::EnvMap;
 use rand_core::Rng;
 use std::path::PathBuf;
 
-/// A camera's response: exposure (radiance × time) to a level in [0, 255], before rounding:
-/// `255 (x / (x + knee))^(1/γ)` per channel, with Gaussian noise of `noise` levels.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CameraResponse {
-    pub knee: [f32; 3],
-    pub gamma: f32,
-    pub noise: f32,
-}
+mod battery;
+mod curves;
 
-impl CameraResponse {
-    /// The level of exposure `x` in `channel`, without noise.
-    pub fn level(&self, channel: usize, x: f32) -> f32 {
-        let x = x.max(0.0);
-        255.0 * (x / (x + self.knee[channel])).powf(1.0 / self.gamma)
-    }
-
-    /// The exposure that gives level `z` in `channel`: the true inverse response.
-    pub fn exposure(&self, channel: usize, z: f32) -> f32 {
-        let y = (z / 255.0).clamp(0.0, 0.999_999).powf(self.gamma);
-        self.knee[channel] * y / (1.0 - y)
-    }
-}
+pub use battery::{BatteryCamera, CaptureErrors, battery, capture_errors, white_balanced};
+pub use curves::{CameraResponse, Curve};
 
 /// A photograph of `map` through `view` (`width × height`), exposed for `time`: each pixel
 /// averages the map over 4 × 4 directions across it (6 × 6 on a ball) (on a ball: reflected,
@@ -128,6 +111,8 @@ pub struct CapturePlan {
     /// Directions averaged per pixel: `samples × samples`.
     pub samples: usize,
     pub seed: u64,
+    /// JPEG quality of the files written.
+    pub quality: u8,
     /// Written as comments at the top of the description: where the photographs come from.
     pub provenance: String,
 }
@@ -180,7 +165,7 @@ pub fn write_capture(
                 &mut rng,
                 plan.samples,
             );
-            write_jpeg(&dir.join(name), &photo)
+            write_jpeg(&dir.join(name), &photo, plan.quality)
         })?;
     let mut toml: String = plan
         .provenance
@@ -196,11 +181,15 @@ pub fn write_capture(
     Ok(path)
 }
 
-/// `photo` as a JPEG (quality 92) with its exposure time in an EXIF block.
-fn write_jpeg(path: &std::path::Path, photo: &Photo) -> std::io::Result<()> {
-    use image::ImageEncoder;
+/// `photo` as a JPEG of `quality` with its exposure time in an EXIF block.
+fn write_jpeg(path: &std::path::Path, photo: &Photo, quality: u8) -> std::io::Result<()> {
     let file = std::io::BufWriter::new(std::fs::File::create(path)?);
-    let mut encoder = image::codecs::jpeg::JpegEncoder::new_with_quality(file, 92);
+    encode_jpeg(file, photo, quality)
+}
+
+fn encode_jpeg(out: impl std::io::Write, photo: &Photo, quality: u8) -> std::io::Result<()> {
+    use image::ImageEncoder;
+    let mut encoder = image::codecs::jpeg::JpegEncoder::new_with_quality(out, quality);
     let exif = crate::exif_block(&crate::ExifExposure {
         time: photo.time,
         iso: None,
@@ -218,4 +207,18 @@ fn write_jpeg(path: &std::path::Path, photo: &Photo) -> std::io::Result<()> {
             image::ExtendedColorType::Rgb8,
         )
         .map_err(std::io::Error::other)
+}
+
+/// `photo` as it comes back from a JPEG of `quality`: its levels with the compression's
+/// blocks and ringing.
+pub fn through_jpeg(photo: &Photo, quality: u8) -> Photo {
+    let mut bytes = Vec::new();
+    encode_jpeg(&mut bytes, photo, quality).expect("encoding into memory");
+    let decoded = image::load_from_memory(&bytes)
+        .expect("a JPEG just encoded")
+        .to_rgb8();
+    Photo {
+        levels: decoded.pixels().map(|p| p.0).collect(),
+        ..photo.clone()
+    }
 }
