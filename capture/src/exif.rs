@@ -60,17 +60,47 @@ pub fn read_exposure(bytes: &[u8]) -> Result<Option<ExifExposure>, String> {
     }))
 }
 
+/// The fraction nearest `v` (≥ 0) with numerator and denominator below 2^32: the last
+/// continued-fraction convergent that fits.
+fn nearest_fraction(v: f64) -> (u32, u32) {
+    let limit = u64::from(u32::MAX);
+    let (mut h0, mut h1, mut k0, mut k1) = (0u64, 1u64, 1u64, 0u64);
+    let mut x = v.max(0.0);
+    for _ in 0..64 {
+        let a = x.floor();
+        if a > limit as f64 {
+            break;
+        }
+        let a = a as u64;
+        let (h2, k2) = (a * h1 + h0, a * k1 + k0);
+        if h2 > limit || k2 > limit {
+            break;
+        }
+        (h0, h1, k0, k1) = (h1, h2, k1, k2);
+        let fraction = x - x.floor();
+        if fraction < 1e-12 {
+            break;
+        }
+        x = 1.0 / fraction;
+    }
+    if k1 == 0 {
+        return (u32::MAX, 1);
+    }
+    (h1 as u32, k1 as u32)
+}
+
 /// An EXIF block (TIFF layout, as a JPEG's APP1 segment carries it after its `Exif` header)
 /// recording `exposure`: what a camera writes, for photographs made by
 /// [`crate::synthetic`].
 pub fn exif_block(exposure: &ExifExposure) -> Vec<u8> {
     let rational = |v: f32| {
-        // 1/n where that is exact (as cameras store short times), else in millionths.
+        // 1/n where that is exact (as cameras store short times), else the nearest fraction
+        // of 32-bit terms: millionths made a 0.3 µs bracket step off by a tenth.
         let n = (1.0 / v).round();
         let r = if v < 1.0 && (1.0 / n - v).abs() <= 1e-6 * v {
             exif::Rational::from((1, n as u32))
         } else {
-            exif::Rational::from(((v * 1e6).round().min(u32::MAX as f32) as u32, 1_000_000))
+            exif::Rational::from(nearest_fraction(f64::from(v)))
         };
         Value::Rational(vec![r])
     };
@@ -107,6 +137,15 @@ pub fn exif_block(exposure: &ExifExposure) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fractions_hold_short_and_long_times() {
+        for v in [3.1e-7f64, 1.234_567e-5, 0.3, 1.0, 2.5, 30.0, 1234.5] {
+            let (n, d) = nearest_fraction(v);
+            assert!((n as f64 / d as f64 / v - 1.0).abs() < 1e-7, "{v}: {n}/{d}");
+        }
+        assert_eq!(nearest_fraction(0.0), (0, 1));
+    }
     use image::ImageEncoder;
 
     fn jpeg_with(exif: Option<Vec<u8>>) -> Vec<u8> {
