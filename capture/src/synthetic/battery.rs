@@ -109,6 +109,15 @@ pub fn battery() -> Vec<BatteryCamera> {
             90,
             Some(FIVE_STOPS),
         ),
+        // The same two cameras as a phone's auto-exposure brackets them, in unequal steps.
+        camera("s-curve-auto", [s_curve; 3], 1.0, 85, None),
+        camera(
+            "measured-auto",
+            [Curve::Measured { white: 2.0 }; 3],
+            0.8,
+            90,
+            None,
+        ),
     ]
 }
 
