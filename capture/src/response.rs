@@ -78,52 +78,70 @@ impl InverseResponse {
 }
 
 /// Recovers the inverse response from `observations` of `points` directions.
-pub fn recover_response(
-    observations: &[Observation],
+pub fn recover_response<'a>(
+    observations: &'a [Observation],
     points: usize,
 ) -> Result<InverseResponse, CaptureError> {
     check_overlap(observations, points)?;
-    let mut by_point: Vec<Vec<&Observation>> = vec![Vec::new(); points];
+    let mut by_point: Vec<Vec<&'a Observation>> = vec![Vec::new(); points];
     for o in observations {
         if let Some(list) = by_point.get_mut(o.point as usize) {
             list.push(o);
         }
     }
-    let model: [Vec<f32>; 3] = std::array::from_fn(|channel| {
-        let lists: Vec<Vec<(usize, f64)>> = by_point
-            .iter()
-            .map(|list| {
-                list.iter()
-                    .map(|o| (o.bins[channel] as usize, f64::from(o.time).ln()))
-                    .filter(|(z, _)| fit_weight(*z) > 0.0)
-                    .collect::<Vec<_>>()
-            })
-            .filter(|list| list.len() >= 2)
-            .collect();
-        normalised(&fit_channel(&lists))
-    });
-    let model = InverseResponse { curves: model };
     if equal_steps(observations) {
-        // The free curve is as ambiguous as any here, and its extra freedom fits the noise:
-        // its spread says nothing.
-        return Ok(model);
+        // The free curve is as ambiguous as any here, and its extra freedom fits the noise.
+        return Ok(fit_model(&by_point));
     }
-    let free = InverseResponse {
+    // Which curve fits the photographs better is judged on points neither was fitted to: on
+    // its own points the free curve's wiggles follow the noise and always look better.
+    let (train, test): (Vec<_>, Vec<_>) = by_point
+        .into_iter()
+        .enumerate()
+        .partition(|(i, _)| i % 2 == 0);
+    let strip = |half: Vec<(usize, Vec<&'a Observation>)>| -> Vec<Vec<&'a Observation>> {
+        half.into_iter().map(|(_, list)| list).collect()
+    };
+    let (train, test) = (strip(train), strip(test));
+    let (a, b) = (
+        observation_spread(&test, &fit_model(&train)),
+        observation_spread(&test, &fit_free(&train)),
+    );
+    let all: Vec<Vec<&Observation>> = train.into_iter().chain(test).collect();
+    Ok(if b < FREE_FORM_MARGIN * a {
+        fit_free(&all)
+    } else {
+        fit_model(&all)
+    })
+}
+
+/// Each channel's curve in the model of measured responses ([`crate::response_fit`]).
+fn fit_model(by_point: &[Vec<&Observation>]) -> InverseResponse {
+    InverseResponse {
         curves: std::array::from_fn(|channel| {
-            let log_g = free_form_log_curve(&by_point, channel);
+            let lists: Vec<Vec<(usize, f64)>> = by_point
+                .iter()
+                .map(|list| {
+                    list.iter()
+                        .map(|o| (o.bins[channel] as usize, f64::from(o.time).ln()))
+                        .filter(|(z, _)| fit_weight(*z) > 0.0)
+                        .collect::<Vec<_>>()
+                })
+                .filter(|list| list.len() >= 2)
+                .collect();
+            normalised(&fit_channel(&lists))
+        }),
+    }
+}
+
+/// Each channel's free curve ([`crate::free_form`]).
+fn fit_free(by_point: &[Vec<&Observation>]) -> InverseResponse {
+    InverseResponse {
+        curves: std::array::from_fn(|channel| {
+            let log_g = free_form_log_curve(by_point, channel);
             normalised(&log_g.iter().map(|g| g.exp()).collect::<Vec<_>>())
         }),
-    };
-    // The model's curve unless the free one fits the photographs clearly better.
-    let (a, b) = (
-        observation_spread(&by_point, &model),
-        observation_spread(&by_point, &free),
-    );
-    Ok(if b < FREE_FORM_MARGIN * a {
-        free
-    } else {
-        model
-    })
+    }
 }
 
 /// Whether the exposure times step by one ratio (within 5% in log): a bracket of equal steps,
