@@ -6,7 +6,7 @@
 //! brackets of equal steps it is as ambiguous as any curve, and the model's priors choose.
 
 use crate::response::{Observation, RESPONSE_BINS};
-use crate::response_fit::solve_symmetric;
+use crate::response_fit::{DataTerm, solve_symmetric};
 
 /// The curvature penalty's weight (1 suits 8-bit photographs).
 const SMOOTHNESS: f64 = 1.0;
@@ -19,13 +19,8 @@ fn calibration_weight(bin: u16, bins: usize) -> f32 {
     1.0 - (2.0 * bin as f32 / (bins - 1) as f32 - 1.0).abs()
 }
 pub(crate) fn free_form_log_curve(by_point: &[Vec<&Observation>], channel: usize) -> Vec<f64> {
-    let smoothness = SMOOTHNESS;
     let n = RESPONSE_BINS;
-    let mut a = vec![0.0f64; n * n];
-    let mut rhs = vec![0.0f64; n];
-    let mut total_weight = 0.0;
-    for list in by_point {
-        // Σ_j a_j x_j² − (Σ_j a_j x_j)² / W with x_j = G(z_j) − ln t_j, a_j = w_j².
+    let per_point = by_point.iter().filter_map(|list| {
         let terms: Vec<(usize, f64, f64)> = list
             .iter()
             .map(|o| {
@@ -35,24 +30,18 @@ pub(crate) fn free_form_log_curve(by_point: &[Vec<&Observation>], channel: usize
             })
             .filter(|(_, a, _)| *a > 0.0)
             .collect();
-        let w_sum: f64 = terms.iter().map(|t| t.1).sum();
-        if terms.len() < 2 || w_sum <= 0.0 {
-            continue;
-        }
-        let mean_log_t: f64 = terms.iter().map(|(_, a, l)| a * l).sum::<f64>() / w_sum;
-        for &(zj, aj, lj) in &terms {
-            a[zj * n + zj] += aj;
-            rhs[zj] += aj * (lj - mean_log_t);
-            for &(zk, ak, _) in &terms {
-                a[zj * n + zk] -= aj * ak / w_sum;
-            }
-            total_weight += aj;
-        }
-    }
+        (terms.len() >= 2).then_some(terms)
+    });
+    let DataTerm {
+        mut a,
+        b: rhs,
+        total_weight,
+        ..
+    } = DataTerm::new(per_point);
     // The curvature penalty, scaled with the data so that its effect does not depend on how
     // many directions were sampled; weak (not zero) where the hat is zero, so that the
     // clipped levels' values are extrapolated smoothly.
-    let lambda = smoothness * total_weight / n as f64;
+    let lambda = SMOOTHNESS * total_weight / n as f64;
     for z in 1..n - 1 {
         let w = (calibration_weight(z as u16, n) as f64).max(0.05);
         let row = [(z - 1, 1.0), (z, -2.0), (z + 1, 1.0)];

@@ -127,6 +127,49 @@ fn robust_weights(
         .collect()
 }
 
+/// The normal equations of `Σ_i Σ_j a_ij (G(z_ij) − ln t_ij − e_i)²` with each `e_i`
+/// eliminated (`Σ_j a_j x_j² − (Σ_j a_j x_j)² / W`, `x_j = G(z_j) − ln t_j`): the matrix `A`,
+/// the vector `b`, the points that weigh something and the sum of all weights. Shared by the
+/// model's fit and the free curve ([`crate::free_form`]).
+pub(crate) struct DataTerm {
+    pub(crate) a: Vec<f64>,
+    pub(crate) b: Vec<f64>,
+    pub(crate) points: usize,
+    pub(crate) total_weight: f64,
+}
+
+impl DataTerm {
+    /// From each point's terms `(level, a_j, ln t_j)`; points whose weights sum to nothing are
+    /// skipped.
+    pub(crate) fn new(per_point: impl Iterator<Item = Vec<(usize, f64, f64)>>) -> Self {
+        let n = RESPONSE_BINS;
+        let (mut a, mut b) = (vec![0.0f64; n * n], vec![0.0f64; n]);
+        let (mut points, mut total_weight) = (0, 0.0);
+        for terms in per_point {
+            let w_sum: f64 = terms.iter().map(|t| t.1).sum();
+            if w_sum <= 0.0 {
+                continue;
+            }
+            points += 1;
+            let mean_log_t: f64 = terms.iter().map(|(_, a, l)| a * l).sum::<f64>() / w_sum;
+            for &(zj, aj, lj) in &terms {
+                a[zj * n + zj] += aj;
+                b[zj] += aj * (lj - mean_log_t);
+                for &(zk, ak, _) in &terms {
+                    a[zj * n + zk] -= aj * ak / w_sum;
+                }
+                total_weight += aj;
+            }
+        }
+        Self {
+            a,
+            b,
+            points,
+            total_weight,
+        }
+    }
+}
+
 /// The data term `Gᵀ A G − 2 bᵀ G` (plus a constant) of `Σ_i Σ_j a_ij (G(z_ij) − ln t_ij −
 /// e_i)²` with each `e_i` eliminated.
 struct QuadraticForm {
@@ -142,30 +185,13 @@ impl QuadraticForm {
         robust: &[Vec<f64>],
         weight: &dyn Fn(usize) -> f64,
     ) -> Self {
-        let n = RESPONSE_BINS;
-        let (mut a, mut b) = (vec![0.0f64; n * n], vec![0.0f64; n]);
-        let mut points = 0;
-        for (list, robust) in lists.iter().zip(robust) {
-            // Σ_j a_j x_j² − (Σ_j a_j x_j)² / W with x_j = G(z_j) − ln t_j.
-            let terms: Vec<(usize, f64, f64)> = list
-                .iter()
+        let per_point = lists.iter().zip(robust).map(|(list, robust)| {
+            list.iter()
                 .zip(robust)
                 .map(|(&(z, l), r)| (z, weight(z) * r, l))
-                .collect();
-            let w_sum: f64 = terms.iter().map(|t| t.1).sum();
-            if w_sum <= 0.0 {
-                continue;
-            }
-            points += 1;
-            let mean_log_t: f64 = terms.iter().map(|(_, a, l)| a * l).sum::<f64>() / w_sum;
-            for &(zj, aj, lj) in &terms {
-                a[zj * n + zj] += aj;
-                b[zj] += aj * (lj - mean_log_t);
-                for &(zk, ak, _) in &terms {
-                    a[zj * n + zk] -= aj * ak / w_sum;
-                }
-            }
-        }
+                .collect()
+        });
+        let DataTerm { a, b, points, .. } = DataTerm::new(per_point);
         let mut form = Self { a, b, points };
         form.add_log_log_curvature(SMOOTHNESS * points as f64);
         form
