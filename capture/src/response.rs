@@ -78,12 +78,12 @@ impl InverseResponse {
 }
 
 /// Recovers the inverse response from `observations` of `points` directions.
-pub fn recover_response<'a>(
-    observations: &'a [Observation],
+pub fn recover_response(
+    observations: &[Observation],
     points: usize,
 ) -> Result<InverseResponse, CaptureError> {
     check_overlap(observations, points)?;
-    let mut by_point: Vec<Vec<&'a Observation>> = vec![Vec::new(); points];
+    let mut by_point: Vec<Vec<&Observation>> = vec![Vec::new(); points];
     for o in observations {
         if let Some(list) = by_point.get_mut(o.point as usize) {
             list.push(o);
@@ -95,23 +95,18 @@ pub fn recover_response<'a>(
     }
     // Which curve fits the photographs better is judged on points neither was fitted to: on
     // its own points the free curve's wiggles follow the noise and always look better.
-    let (train, test): (Vec<_>, Vec<_>) = by_point
-        .into_iter()
-        .enumerate()
-        .partition(|(i, _)| i % 2 == 0);
-    let strip = |half: Vec<(usize, Vec<&'a Observation>)>| -> Vec<Vec<&'a Observation>> {
-        half.into_iter().map(|(_, list)| list).collect()
+    let half = |first: usize| -> Vec<Vec<&Observation>> {
+        by_point.iter().skip(first).step_by(2).cloned().collect()
     };
-    let (train, test) = (strip(train), strip(test));
+    let (train, test) = (half(0), half(1));
     let (a, b) = (
         observation_spread(&test, &fit_model(&train)),
         observation_spread(&test, &fit_free(&train)),
     );
-    let all: Vec<Vec<&Observation>> = train.into_iter().chain(test).collect();
     Ok(if b < FREE_FORM_MARGIN * a {
-        fit_free(&all)
+        fit_free(&by_point)
     } else {
-        fit_model(&all)
+        fit_model(&by_point)
     })
 }
 
