@@ -3,22 +3,17 @@
 //! several exposures, as oriented shots and as a mirror ball seen from two sides; captured
 //! back, then compared texel by texel, response by response, and through the decomposition.
 
+mod common;
+
 use capture::synthetic::{CameraResponse, photograph};
 use capture::{Assembled, AssemblySettings, InverseResponse, MirrorBall, Photo, ShotCamera, View};
-use foundation::envmap::{self, EnvMap};
+use common::{decompose_map, interior};
+use foundation::envmap::EnvMap;
 use foundation::{Rgb, luminance};
 use rand_pcg::Pcg32;
-use runtime::{CubeSource, DecomposeSettings, Decomposer};
 
 /// A response curve with a knee and a gamma, different per channel, saturating at exposure 8.
 const RESPONSE: CameraResponse = CameraResponse::knee([0.9, 1.0, 1.15], 2.0, 8.0, 0.6);
-
-/// The bundled map, at `width × width/2`.
-fn truth(width: usize) -> EnvMap {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/env/interior.exr");
-    let map = envmap::load(&path, None).expect("the bundled map").map;
-    map.downsampled(map.width() / width)
-}
 
 /// Exposure times spanning the map's range, in steps of 3.1 and 4.4 by turns: ratios that
 /// are all powers of one number determine a response only up to a factor periodic in the log
@@ -146,13 +141,7 @@ fn assert_response_matches(curve: &InverseResponse) {
 
 /// The strongest light and the SH part's first three bands, captured against true.
 fn assert_decompositions_agree(captured: &EnvMap, truth: &EnvMap) {
-    let decompose = |map: &EnvMap| {
-        let cube = CubeSource::new(map, 64).cube(0.0);
-        Decomposer::new(DecomposeSettings::default())
-            .expect("default settings")
-            .decompose(&cube)
-    };
-    let (got, want) = (decompose(captured), decompose(truth));
+    let (got, want) = (decompose_map(captured), decompose_map(truth));
     let (a, b) = (&got.lights[0], &want.lights[0]);
     let power = luminance(a.power) / luminance(b.power);
     let angle = a.direction.angle_between(b.direction).to_degrees();
@@ -197,14 +186,14 @@ fn capture_and_check(photos: &[Photo], truth: &EnvMap, min_covered: f32) {
 
 #[test]
 fn oriented_shots_capture_the_map() {
-    let map = truth(256);
+    let map = interior(256);
     let photos = oriented_shots(&map, &mut Pcg32::new(7, 11));
     capture_and_check(&photos, &map, 0.97);
 }
 
 #[test]
 fn a_mirror_ball_from_two_sides_captures_the_map() {
-    let map = truth(256);
+    let map = interior(256);
     let photos = ball_shots(&map, &mut Pcg32::new(3, 5));
     capture_and_check(&photos, &map, 0.97);
 }

@@ -5,20 +5,16 @@
 //! (chromaticity within 5% on average, the camera's white balance the convention) and its
 //! strongest light (power within 10%, direction within 2°).
 
+mod common;
+
 use capture::synthetic::{
     BatteryCamera, CaptureErrors, battery, capture_errors, photograph, through_jpeg, white_balanced,
 };
 use capture::{AssemblySettings, InverseResponse, MirrorBall, Photo, ShotCamera, View};
-use foundation::envmap::{self, EnvMap};
+use common::{decompose_map, interior};
+use foundation::envmap::EnvMap;
 use foundation::luminance;
 use rand_pcg::Pcg32;
-use runtime::{CubeSource, DecomposeSettings, Decomposer};
-
-fn interior() -> EnvMap {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/env/interior.exr");
-    let map = envmap::load(&path, None).expect("the bundled map").map;
-    map.downsampled(map.width() / 256)
-}
 
 /// 16 orientations covering the sphere, 80° vertical fields, a little barrel distortion.
 fn shots(map: &EnvMap, camera: &BatteryCamera, rng: &mut Pcg32) -> Vec<Photo> {
@@ -57,13 +53,7 @@ fn ball(map: &EnvMap, camera: &BatteryCamera, rng: &mut Pcg32) -> Vec<Photo> {
 
 /// The strongest light's power ratio and angle (degrees), `captured` against `truth`.
 fn strongest_light(captured: &EnvMap, truth: &EnvMap) -> (f32, f32) {
-    let decompose = |map: &EnvMap| {
-        let cube = CubeSource::new(map, 64).cube(0.0);
-        Decomposer::new(DecomposeSettings::default())
-            .expect("default settings")
-            .decompose(&cube)
-    };
-    let (got, want) = (decompose(captured), decompose(truth));
+    let (got, want) = (decompose_map(captured), decompose_map(truth));
     let (a, b) = (&got.lights[0], &want.lights[0]);
     (
         luminance(a.power) / luminance(b.power),
@@ -153,7 +143,7 @@ const OPEN: [&str; 3] = ["s-curve", "measured", "shoulder"];
 
 #[test]
 fn every_camera_of_the_battery_is_recovered() {
-    let map = interior();
+    let map = interior(256);
     let mut failures = Vec::new();
     for (k, camera) in battery().iter().enumerate() {
         let mut rng = Pcg32::new(11, k as u64);

@@ -6,7 +6,7 @@ mod common;
 use capture::synthetic::{CameraResponse, CapturePlan, photograph, write_capture};
 use capture::{MirrorBall, ShotCamera, View};
 use common::*;
-use foundation::envmap::{self, EnvMap};
+use foundation::envmap::EnvMap;
 use foundation::luminance;
 use rand_pcg::Pcg32;
 use std::fmt::Write;
@@ -17,16 +17,10 @@ const RESPONSE: CameraResponse = CameraResponse::knee([0.9, 1.0, 1.1], 2.0, f32:
 /// Exposure times for the bundled interior map (its lamps to its dark corners).
 const TIMES: [f32; 6] = [4e-5, 1.3e-4, 6e-4, 2.5e-3, 1.1e-2, 4.6e-2];
 
-fn interior() -> EnvMap {
-    let path = repo().join("scenes/env/interior.exr");
-    let map = envmap::load(&path, None).expect("the bundled map").map;
-    map.downsampled(map.width() / 128)
-}
-
 /// Writes a mirror ball seen from two sides at `times` as PNGs into `dir`, and a description
 /// of them; returns the description's text.
 fn write_ball_capture(dir: &Path, times: &[f32]) -> String {
-    let map = interior();
+    let map = interior(128);
     let mut rng = Pcg32::new(1, 2);
     let mut toml = String::new();
     for (v, yaw) in [0.0f32, 90.0].into_iter().enumerate() {
@@ -210,7 +204,7 @@ fn bad_captures_are_refused_with_the_file_named() {
     let plain = ShotCamera::new((0.0, 0.0, 0.0), 60.0, (96, 96), (0.0, 0.0));
     let mut rng = Pcg32::new(3, 4);
     let photo = photograph(
-        &interior(),
+        &interior(128),
         View::Shot(plain),
         (96, 96),
         6e-4,
@@ -275,7 +269,7 @@ fn exposures_are_read_from_exif() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let plan = ball_plan(vec![5e-5, 4.6e-4, 3.7e-3, 3.8e-2], 5);
-    write_capture(&interior(), &plan, d).unwrap();
+    write_capture(&interior(128), &plan, d).unwrap();
     let text = std::fs::read_to_string(d.join("capture.toml")).unwrap();
     assert!(
         !text.contains("exposure =") && !text.contains("centre ="),
@@ -320,7 +314,7 @@ fn exposures_are_read_from_exif() {
 fn a_ball_found_in_the_pictures_gives_the_map_its_true_outline_gives() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    write_capture(&interior(), &ball_plan(TIMES.to_vec(), 6), d).unwrap();
+    write_capture(&interior(128), &ball_plan(TIMES.to_vec(), 6), d).unwrap();
     // The outline write_capture drew: centred, 0.42 of the picture's side.
     with_outline(d, "given.toml", 84.0);
     for (description, output) in [("capture.toml", "found.exr"), ("given.toml", "given.exr")] {
@@ -329,7 +323,7 @@ fn a_ball_found_in_the_pictures_gives_the_map_its_true_outline_gives() {
     }
     // Each against the map photographed (one white-balance scale per channel: the capture is
     // in relative units).
-    let truth = interior();
+    let truth = interior(128);
     let error = |name: &str| {
         let map = foundation::image_io::read_exr(&d.join(name)).unwrap();
         log_errors(&truth, &map.pixels, map.width)
@@ -389,7 +383,7 @@ fn ball_plan(times: Vec<f32>, seed: u64) -> CapturePlan {
 fn an_outline_given_too_large_still_gives_a_finite_map() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    write_capture(&interior(), &ball_plan(TIMES.to_vec(), 6), d).unwrap();
+    write_capture(&interior(128), &ball_plan(TIMES.to_vec(), 6), d).unwrap();
     with_outline(d, "large.toml", 88.0);
     let out = hprt(
         d,

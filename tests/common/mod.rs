@@ -312,3 +312,21 @@ pub fn hprt_limited_to(dir: &Path, args: &[&str], limit_kib: u64) -> Output {
 pub fn hprt_limited(dir: &Path, args: &[&str]) -> Output {
     hprt_limited_to(dir, args, MEMORY_LIMIT_KIB)
 }
+
+/// The bundled interior map (`scenes/env/interior.exr`), downsampled to `width` texels across:
+/// what the capture tests photograph.
+pub fn interior(width: usize) -> foundation::envmap::EnvMap {
+    let path = repo().join("scenes/env/interior.exr");
+    let map = foundation::envmap::load(&path, None)
+        .expect("the bundled map")
+        .map;
+    map.downsampled(map.width() / width)
+}
+
+/// `map`'s decomposition with the default settings, on a 64-texel cube.
+pub fn decompose_map(map: &foundation::envmap::EnvMap) -> runtime::Decomposition {
+    let cube = runtime::CubeSource::new(map, 64).cube(0.0);
+    runtime::Decomposer::new(runtime::DecomposeSettings::default())
+        .expect("default settings")
+        .decompose(&cube)
+}
