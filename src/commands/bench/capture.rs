@@ -68,7 +68,11 @@ pub(super) fn bench_capture(args: BenchCaptureArgs) -> anyhow::Result<()> {
     }
     let plan = CapturePlan {
         size: (w, h),
-        orientations: if args.ball { Vec::new() } else { cube_faces() },
+        orientations: if args.ball {
+            Vec::new()
+        } else {
+            super::capture_cameras::cube_faces()
+        },
         fov: 90.0,
         ball_yaws: if args.ball {
             vec![0.0, 90.0]
@@ -129,18 +133,6 @@ pub(super) fn bench_capture(args: BenchCaptureArgs) -> anyhow::Result<()> {
         100.0 * median_log_error(&map, &captured)
     );
     Ok(())
-}
-
-/// A cube's six faces: a 90° vertical field at 4:3 covers each.
-pub(super) fn cube_faces() -> Vec<(f32, f32, f32)> {
-    vec![
-        (0.0, 0.0, 0.0),
-        (90.0, 0.0, 0.0),
-        (180.0, 0.0, 0.0),
-        (270.0, 0.0, 0.0),
-        (0.0, 90.0, 0.0),
-        (0.0, -90.0, 0.0),
-    ]
 }
 
 /// `--keep`'s folder, made, or the temporary one.

@@ -8,7 +8,6 @@
 //! error against the map photographed (white balanced as the camera did) and its strongest
 //! light against the map's.
 
-use super::capture::cube_faces;
 use anyhow::Context;
 use capture::synthetic::{
     BatteryCamera, CapturePlan, battery, capture_errors, white_balanced, write_capture,
@@ -126,6 +125,18 @@ fn bench_camera(
         rows.push((name, errors, (power, angle)));
     }
     Ok(rows)
+}
+
+/// A cube's six faces: a 90° vertical field at 4:3 covers each.
+pub(super) fn cube_faces() -> Vec<(f32, f32, f32)> {
+    vec![
+        (0.0, 0.0, 0.0),
+        (90.0, 0.0, 0.0),
+        (180.0, 0.0, 0.0),
+        (270.0, 0.0, 0.0),
+        (0.0, 90.0, 0.0),
+        (0.0, -90.0, 0.0),
+    ]
 }
 
 fn strongest_light(map: &EnvMap) -> anyhow::Result<(glam::Vec3, foundation::Rgb)> {
