@@ -91,6 +91,11 @@ fn a_ball_capture_becomes_a_map_hprt_reads() {
     let spread = printed_spread(&stdout(&out));
     assert!(spread < 5.0, "{}", stdout(&out));
     assert!(!stderr(&out).contains("spread is"), "{}", stderr(&out));
+    assert!(
+        !stderr(&out).contains("step by one ratio"),
+        "{}",
+        stderr(&out)
+    );
     let saved = std::fs::read_to_string(dir.path().join("response.csv")).unwrap();
     assert!(saved.starts_with("# spread 0.0"), "{saved}");
     // The rest of hprt takes it; and the saved response gives the same map back.
@@ -118,6 +123,30 @@ fn a_ball_capture_becomes_a_map_hprt_reads() {
             "{a} vs {b}"
         );
     }
+}
+
+/// Exposures in equal steps leave the response's shape within a step to the priors: the
+/// capture still succeeds, and says so.
+#[test]
+fn equal_exposure_steps_are_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    let times: Vec<f32> = (0..5).map(|k| 4e-5 * 8f32.powi(k)).collect();
+    write_ball_capture(dir.path(), &times);
+    let args = [
+        "capture",
+        "capture.toml",
+        "-o",
+        "captured.exr",
+        "--width",
+        "64",
+    ];
+    let out = hprt(dir.path(), &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("step by one ratio (x8.0, 3.0 stops)"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 /// The response spread `hprt capture` printed, in percent.

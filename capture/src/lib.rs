@@ -43,4 +43,6 @@ pub use exif::{ExifExposure, exif_block, read_exposure};
 pub use load::{LoadedCapture, load_capture};
 pub use merge::hat_weight;
 pub use photo::{Photo, View};
-pub use response::{InverseResponse, Observation, RESPONSE_BINS, recover_response};
+pub use response::{
+    InverseResponse, Observation, RESPONSE_BINS, equal_step_ratio, recover_response,
+};
