@@ -22,10 +22,8 @@ struct Backplate {
 // (luminance sum of B, proxy pixels).
 @group(1) @binding(5) var<uniform> floor_sums: array<vec4<f32>, FLOOR_SUMS>;
 
-// The largest ratio (`MAX_RATIO` in `reference/src/composite.rs`).
-const MAX_RATIO: f32 = 8.0;
-// ε over the mean luminance of B (`RATIO_FLOOR` there).
-const RATIO_FLOOR: f32 = 1e-3;
+// `MAX_RATIO` (the largest ratio) and `RATIO_FLOOR` (ε over the mean luminance of B) are
+// generated from `foundation/src/composite.rs`.
 
 fn luminance(c: vec3<f32>) -> f32 {
     return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));

@@ -19,6 +19,7 @@ pub mod bake_settings;
 pub mod bvh;
 pub mod camera;
 pub mod color;
+pub mod composite;
 pub mod envmap;
 pub mod image_io;
 pub mod material;

@@ -2,6 +2,7 @@
 //! Rust side sizes its buffers by, as WGSL constants, so the two cannot disagree; the render
 //! passes' modules also get `shaders/common.wgsl` (the uniform structs they share).
 
+use foundation::composite;
 use foundation::sh::num_coeffs;
 
 /// Most lights drawn per frame (the light pass's uniform array).
@@ -113,7 +114,8 @@ impl Shader {
     }
 }
 
-/// The Rust limits as WGSL constants.
+/// The Rust limits, and the composite's constants (`foundation::composite`), as WGSL
+/// constants.
 fn constants() -> String {
     format!(
         "// Generated from runtime/src/render/shaders.rs.\n\
@@ -122,9 +124,24 @@ fn constants() -> String {
          const MAX_MATERIALS: u32 = {MAX_MATERIALS}u;\n\
          const TRANSFER_WORKGROUP: u32 = {TRANSFER_WORKGROUP}u;\n\
          const FLOOR_GROUPS: u32 = {FLOOR_GROUPS}u;\n\
-         const FLOOR_SUMS: u32 = {FLOOR_SUMS}u;\n",
-        num_coeffs(MAX_GPU_ORDER)
+         const FLOOR_SUMS: u32 = {FLOOR_SUMS}u;\n\
+         const MAX_RATIO: f32 = {};\n\
+         const RATIO_FLOOR: f32 = {};\n",
+        num_coeffs(MAX_GPU_ORDER),
+        wgsl_float(composite::MAX_RATIO),
+        wgsl_float(composite::RATIO_FLOOR),
     )
+}
+
+/// `x` as a WGSL float literal that reads back as the same `f32` (Rust's shortest round-trip
+/// form, with a decimal point where it has neither point nor exponent).
+fn wgsl_float(x: f32) -> String {
+    let text = format!("{x:?}");
+    if text.contains(['.', 'e', 'E']) {
+        text
+    } else {
+        format!("{text}.0")
+    }
 }
 
 #[cfg(test)]
@@ -162,6 +179,21 @@ mod tests {
                     shader.file_name()
                 );
             }
+            // Declared once, by the generated constants: a shader declaring one by hand again
+            // fails to parse, with the name.
+            for generated in ["MAX_RATIO", "RATIO_FLOOR"] {
+                assert_eq!(source.matches(&format!("const {generated}")).count(), 1);
+            }
+        }
+    }
+
+    /// The generated floats read back as the Rust values.
+    #[test]
+    fn generated_floats_are_exact() {
+        for x in [8.0f32, 1e-3, 0.1, 3.0e-12, 1.5e20] {
+            let text = wgsl_float(x);
+            assert_eq!(text.parse::<f32>().unwrap(), x, "{text}");
+            assert!(text.contains(['.', 'e']), "{text}");
         }
     }
 }
