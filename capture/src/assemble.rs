@@ -3,9 +3,10 @@
 //! the photographs that see it, holes filled and marked, unresolved highlights flagged.
 
 use crate::error::CaptureError;
+use crate::inverse_response::{InverseResponse, Observation, RESPONSE_BINS};
 use crate::merge::{Reading, clip_level, merge_readings, spread_terms};
 use crate::photo::Photo;
-use crate::response::{InverseResponse, Observation, RESPONSE_BINS, recover_response};
+use crate::response::recover_response;
 use foundation::Rgb;
 use foundation::envmap::EnvMap;
 use glam::Vec3;

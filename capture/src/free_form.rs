@@ -5,7 +5,7 @@
 //! its spread says it fits the photographs clearly better ([`crate::recover_response`]); on
 //! brackets of equal steps it is as ambiguous as any curve, and the model's priors choose.
 
-use crate::response::{Observation, RESPONSE_BINS};
+use crate::inverse_response::{Observation, RESPONSE_BINS};
 use crate::response_fit::{DataTerm, solve_symmetric};
 
 /// The curvature penalty's weight (1 suits 8-bit photographs).

@@ -25,6 +25,7 @@ mod emor;
 mod error;
 mod exif;
 mod free_form;
+mod inverse_response;
 mod load;
 mod merge;
 mod photo;
@@ -40,9 +41,8 @@ pub use camera::ShotCamera;
 pub use description::{BallDescription, CaptureDescription, ShotDescription};
 pub use error::CaptureError;
 pub use exif::{ExifExposure, exif_block, read_exposure};
+pub use inverse_response::{InverseResponse, Observation, RESPONSE_BINS};
 pub use load::{LoadedCapture, load_capture};
 pub use merge::hat_weight;
 pub use photo::{Photo, View};
-pub use response::{
-    InverseResponse, Observation, RESPONSE_BINS, equal_step_ratio, recover_response,
-};
+pub use response::{equal_step_ratio, recover_response};

@@ -13,7 +13,7 @@
 //! a bright source down (17% of a lamp's power lost in the same test). Robertson's weights
 //! give the first estimate.
 
-use crate::response::InverseResponse;
+use crate::inverse_response::InverseResponse;
 
 /// The hat weight of level `bin` of `bins`: 0 at both ends (clipped or black), 1 in the middle.
 pub fn hat_weight(bin: u16, bins: usize) -> f32 {

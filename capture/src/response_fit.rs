@@ -30,7 +30,7 @@
 //! misregistered observation does not bend the curve.
 
 use crate::emor::{COMPONENTS, Emor};
-use crate::response::RESPONSE_BINS;
+use crate::inverse_response::RESPONSE_BINS;
 
 /// Noise of one level (sensor noise and JPEG), in levels.
 const LEVEL_NOISE: f64 = 1.0;

@@ -7,7 +7,15 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
 /// The crates whose imports are checked, each with its source folder.
-const CRATES: [&str; 5] = ["foundation", "precompute", "reference", "runtime", "."];
+const CRATES: [&str; 7] = [
+    "foundation",
+    "precompute",
+    "reference",
+    "runtime",
+    "capture",
+    "python",
+    ".",
+];
 /// Folders whose files are only size-checked: tests and benchmarks.
 const OTHER_FOLDERS: [&str; 3] = ["tests", "runtime/benches", "precompute/benches"];
 

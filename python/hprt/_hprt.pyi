@@ -1,0 +1,150 @@
+"""Type stubs of the compiled module (python/src/*.rs)."""
+
+import os
+from pathlib import Path
+from typing import Literal, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+Image = npt.NDArray[np.float32]
+MapArgument = Union[str, "os.PathLike[str]", npt.NDArray[np.float32]]
+DecomposeMode = Literal["consistent", "thesis"]
+RenderMode = Literal["hybrid", "prt", "lights", "unshadowed", "median-cut", "sh-sun"]
+Backend = Literal["auto", "vulkan", "gl"]
+
+class HprtError(Exception):
+    """An hprt library call failed; the message says what and where."""
+
+class Light:
+    """One directional light of a decomposition."""
+
+    @property
+    def direction(self) -> tuple[float, float, float]:
+        """Unit direction the light arrives from (+Y up)."""
+    @property
+    def power(self) -> tuple[float, float, float]:
+        """RGB power: the irradiance on a surface facing it."""
+    @property
+    def radius_deg(self) -> float:
+        """Angular radius of the source, degrees."""
+    @property
+    def cap_radius_deg(self) -> float:
+        """Radius of the cap it was taken from, degrees."""
+    @property
+    def share(self) -> float:
+        """Share of the map's total luminous power."""
+
+class Decomposition:
+    """SH coefficients plus lights."""
+
+    @property
+    def sh(self) -> npt.NDArray[np.float32]:
+        """``(order**2, 3)`` RGB coefficients, index ``l*(l+1)+m``."""
+    @property
+    def lights(self) -> list[Light]:
+        """The lights, strongest first."""
+    @property
+    def total_power(self) -> npt.NDArray[np.float32]:
+        """The map's total RGB power."""
+
+class Scene:
+    """A scene file or a model placed in a default scene."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def path(self) -> Path: ...
+    @property
+    def objects(self) -> list[str]: ...
+    @property
+    def vertex_count(self) -> int: ...
+    @property
+    def triangle_count(self) -> int: ...
+    @property
+    def environment(self) -> Optional[Path]:
+        """The map the scene names, if any."""
+
+class Bake:
+    """Per-vertex SH transfer of a scene."""
+
+    @property
+    def order(self) -> int: ...
+    @property
+    def samples(self) -> int: ...
+    @property
+    def bounces(self) -> int: ...
+    @property
+    def direct(self) -> npt.NDArray[np.float32]:
+        """``(vertices, 3, order**2)`` shadowed transfer."""
+    @property
+    def indirect(self) -> npt.NDArray[np.float32]:
+        """``(vertices, 3, order**2)`` interreflected transfer."""
+    @property
+    def transfer(self) -> npt.NDArray[np.float32]:
+        """Direct plus interreflected."""
+    def save(self, path: Union[str, "os.PathLike[str]"]) -> None:
+        """Writes a ``.bake`` file that ``hprt render --bake`` reads."""
+
+class Renderer:
+    """The real-time renderer of one scene and bake, reused across frames."""
+
+    def __init__(
+        self,
+        scene: Scene,
+        bake: Bake,
+        backend: Backend = "auto",
+        width: Optional[int] = None,
+        height: Optional[int] = None,
+    ) -> None: ...
+    @property
+    def adapter(self) -> str:
+        """The graphics adapter it draws with."""
+    def render(
+        self,
+        map: MapArgument,
+        mode: RenderMode = "hybrid",
+        rotation_deg: float = 0.0,
+        decompose_mode: DecomposeMode = "consistent",
+    ) -> Image:
+        """The linear radiance image, ``(height, width, 3) float32``."""
+
+def load_map(path: Union[str, "os.PathLike[str]"]) -> Image:
+    """An environment map file as an ``(H, W, 3) float32`` equirectangular array."""
+
+def decompose(
+    map: MapArgument,
+    mode: DecomposeMode = "consistent",
+    threshold: Optional[float] = None,
+    order: Optional[int] = None,
+    rotation_deg: float = 0.0,
+) -> Decomposition:
+    """The map as SH plus lights, as ``hprt decompose`` gives it."""
+
+def load_scene(path: Union[str, "os.PathLike[str]"]) -> Scene:
+    """Loads a scene file (TOML) or a model (glTF, OBJ, PLY, BPT)."""
+
+def bake(
+    scene: Scene,
+    samples: Optional[int] = None,
+    bounces: Optional[int] = None,
+    order: Optional[int] = None,
+    seed: Optional[int] = None,
+    threads: Optional[int] = None,
+) -> Bake:
+    """Bakes the scene; its ``[bake]`` settings where an argument is not given."""
+
+def load_bake(scene: Scene, path: Union[str, "os.PathLike[str]"]) -> Bake:
+    """Loads a ``.bake`` file of ``scene``."""
+
+def reference(
+    scene: Scene,
+    map: MapArgument,
+    spp: int = 64,
+    bounces: int = 4,
+    seed: int = 0,
+    rotation_deg: float = 0.0,
+    width: Optional[int] = None,
+    height: Optional[int] = None,
+) -> Image:
+    """The path-traced image, ``(height, width, 3) float32``."""

@@ -1,0 +1,134 @@
+//! `hprt.decompose`: a map into low-order SH plus directional lights at its peaks, the same
+//! numbers as `hprt decompose` with the same settings.
+
+use crate::maps::map_argument;
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::prelude::*;
+use runtime::{DecomposeMode, DecomposeSettings, DirectionalLight, EnvironmentLighting};
+
+/// One directional light of a decomposition.
+#[pyclass(module = "hprt", frozen, get_all)]
+#[derive(Clone)]
+pub(crate) struct Light {
+    /// Unit direction the light arrives from (x, y, z; +Y up).
+    direction: [f32; 3],
+    /// RGB power: the irradiance on a surface facing it.
+    power: [f32; 3],
+    /// Angular radius of the source, in degrees (sizes its soft shadows).
+    radius_deg: f32,
+    /// Radius of the cap it was taken from, in degrees.
+    cap_radius_deg: f32,
+    /// Share of the map's total luminous power.
+    share: f32,
+}
+
+impl From<&DirectionalLight> for Light {
+    fn from(l: &DirectionalLight) -> Self {
+        Self {
+            direction: l.direction.to_array(),
+            power: l.power.to_array(),
+            radius_deg: l.angular_radius.to_degrees(),
+            cap_radius_deg: l.cap_radius.to_degrees(),
+            share: l.share,
+        }
+    }
+}
+
+#[pymethods]
+impl Light {
+    fn __repr__(&self) -> String {
+        let [x, y, z] = self.direction;
+        format!(
+            "Light(direction=({x:.4}, {y:.4}, {z:.4}), power={:?}, radius_deg={:.2}, share={:.3})",
+            self.power, self.radius_deg, self.share
+        )
+    }
+}
+
+/// A map's decomposition: SH coefficients (index `l(l+1)+m`, CONVENTIONS.md) plus lights.
+#[pyclass(module = "hprt", frozen)]
+pub(crate) struct Decomposition {
+    sh: Array2<f32>,
+    lights: Vec<Light>,
+    total_power: [f32; 3],
+}
+
+#[pymethods]
+impl Decomposition {
+    /// The SH part, `(order², 3)` RGB coefficients.
+    #[getter]
+    fn sh<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f32>> {
+        self.sh.clone().into_pyarray(py)
+    }
+
+    /// The lights, strongest first.
+    #[getter]
+    fn lights(&self) -> Vec<Light> {
+        self.lights.clone()
+    }
+
+    /// The map's total power (RGB), which SH part and lights add up to in `consistent` mode.
+    #[getter]
+    fn total_power<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
+        Array1::from(self.total_power.to_vec()).into_pyarray(py)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Decomposition(order={}, lights={})",
+            (self.sh.nrows() as f64).sqrt() as usize,
+            self.lights.len()
+        )
+    }
+}
+
+/// Decomposes `map` (a path or an `(H, W, 3) float32` array) as `hprt decompose` does.
+#[pyfunction]
+#[pyo3(signature = (map, mode = "consistent", threshold = None, order = None, rotation_deg = 0.0))]
+pub(crate) fn decompose(
+    py: Python<'_>,
+    map: &Bound<'_, PyAny>,
+    mode: &str,
+    threshold: Option<f32>,
+    order: Option<usize>,
+    rotation_deg: f32,
+) -> PyResult<Decomposition> {
+    let mode: DecomposeMode = crate::errors::parse_choice("mode", mode)?;
+    let settings = settings(mode, threshold, order);
+    settings.validate().map_err(crate::errors::hprt_error)?;
+    let map = map_argument(map)?;
+    let result = py.detach(|| {
+        let mut lighting = EnvironmentLighting::new(&map, settings)?;
+        lighting.set_rotation(rotation_deg);
+        Ok::<_, runtime::DecomposeError>(lighting.decompose())
+    });
+    let result = result.map_err(crate::errors::hprt_error)?;
+    let coefficients = result.sh.as_slice();
+    let sh = Array2::from_shape_fn((coefficients.len(), 3), |(k, c)| coefficients[k][c]);
+    Ok(Decomposition {
+        sh,
+        lights: result.lights.iter().map(Light::from).collect(),
+        total_power: result.total_power.to_array(),
+    })
+}
+
+/// The command line's settings: its defaults, `threshold` and `order` where given.
+pub(crate) fn settings(
+    mode: DecomposeMode,
+    threshold: Option<f32>,
+    order: Option<usize>,
+) -> DecomposeSettings {
+    let defaults = DecomposeSettings::default();
+    DecomposeSettings {
+        radius_deg: DecomposeSettings::default_radius(mode, defaults.smoothing_deg),
+        threshold: threshold.unwrap_or(defaults.threshold),
+        face_size: defaults.face_size,
+        ico_level: defaults.ico_level,
+        smoothing_deg: defaults.smoothing_deg,
+        max_lights: defaults.max_lights,
+        min_contrast: defaults.min_contrast,
+        window: None,
+        ..DecomposeSettings::for_mode(mode, order.unwrap_or(defaults.order))
+    }
+}

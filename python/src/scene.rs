@@ -1,0 +1,204 @@
+//! Scenes and their bakes: `hprt.load_scene`, `hprt.bake`, `hprt.load_bake`, and the bake's
+//! transfer as arrays.
+
+use foundation::bvh::SceneBvh;
+use foundation::infra::progress::NoProgress;
+use foundation::scene::Scene as SceneData;
+use numpy::ndarray::Array3;
+use numpy::{IntoPyArray, PyArray3};
+use precompute::bake::{Transfer, TransferVectors};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// A scene: a scene file (TOML) or a model (glTF, OBJ, PLY, BPT) placed in a default scene.
+#[pyclass(module = "hprt", frozen)]
+pub(crate) struct Scene {
+    pub(crate) data: Arc<SceneData>,
+}
+
+#[pymethods]
+impl Scene {
+    #[getter]
+    fn name(&self) -> String {
+        self.data.name.clone()
+    }
+
+    /// The file it was loaded from.
+    #[getter]
+    fn path(&self) -> PathBuf {
+        self.data.path.clone()
+    }
+
+    /// Its objects' names, in order.
+    #[getter]
+    fn objects(&self) -> Vec<String> {
+        self.data
+            .geometry
+            .objects
+            .iter()
+            .map(|o| o.name.clone())
+            .collect()
+    }
+
+    #[getter]
+    fn vertex_count(&self) -> usize {
+        self.data.geometry.mesh.positions.len()
+    }
+
+    #[getter]
+    fn triangle_count(&self) -> usize {
+        self.data.geometry.mesh.triangles.len()
+    }
+
+    /// The environment map the scene names, if any.
+    #[getter]
+    fn environment(&self) -> Option<PathBuf> {
+        self.data.environment.as_ref().map(|e| e.map.clone())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Scene({:?}, objects={}, triangles={})",
+            self.data.name,
+            self.data.geometry.objects.len(),
+            self.triangle_count()
+        )
+    }
+}
+
+/// Loads a scene file or a model.
+#[pyfunction]
+pub(crate) fn load_scene(path: PathBuf) -> PyResult<Scene> {
+    let data = SceneData::open(&path).map_err(crate::errors::hprt_error)?;
+    Ok(Scene {
+        data: Arc::new(data),
+    })
+}
+
+/// A scene's bake: per-vertex SH transfer, direct and interreflected.
+#[pyclass(module = "hprt", frozen)]
+pub(crate) struct Bake {
+    pub(crate) transfer: Arc<Transfer>,
+    mesh_hash: [u8; 32],
+}
+
+#[pymethods]
+impl Bake {
+    #[getter]
+    fn order(&self) -> usize {
+        self.transfer.settings.order
+    }
+
+    #[getter]
+    fn samples(&self) -> u32 {
+        self.transfer.settings.samples
+    }
+
+    #[getter]
+    fn bounces(&self) -> u32 {
+        self.transfer.settings.bounces
+    }
+
+    /// Direct (shadowed) transfer, `(vertices, 3, order²)`: row `[v, c]` dotted with channel
+    /// `c` of a map's SH coefficients is vertex `v`'s outgoing radiance.
+    #[getter]
+    fn direct<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f32>> {
+        vectors_array(&self.transfer.direct).into_pyarray(py)
+    }
+
+    /// Interreflected transfer (the bounces), same layout.
+    #[getter]
+    fn indirect<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f32>> {
+        vectors_array(&self.transfer.indirect).into_pyarray(py)
+    }
+
+    /// Direct plus interreflected.
+    #[getter]
+    fn transfer<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f32>> {
+        vectors_array(&self.transfer.full()).into_pyarray(py)
+    }
+
+    /// Writes the bake as a `.bake` file (`hprt render --bake` reads it).
+    fn save(&self, path: PathBuf) -> PyResult<()> {
+        precompute::bakefile::write(&path, &self.transfer, &self.mesh_hash)
+            .map_err(crate::errors::hprt_error)
+    }
+
+    fn __repr__(&self) -> String {
+        let s = &self.transfer.settings;
+        format!(
+            "Bake(order={}, samples={}, bounces={}, vertices={})",
+            s.order,
+            s.samples,
+            s.bounces,
+            self.transfer.direct.vertex_count()
+        )
+    }
+}
+
+fn vectors_array(vectors: &TransferVectors) -> Array3<f32> {
+    let n = vectors.order() * vectors.order();
+    Array3::from_shape_vec((vectors.vertex_count(), 3, n), vectors.as_slice().to_vec())
+        .expect("vertices × 3 × order² coefficients")
+}
+
+/// Bakes `scene` (its `[bake]` settings, each overridden where given) on `threads` threads
+/// (all cores when `None`); the same bits whatever the thread count.
+#[pyfunction]
+#[pyo3(signature = (scene, samples = None, bounces = None, order = None, seed = None, threads = None))]
+pub(crate) fn bake(
+    py: Python<'_>,
+    scene: &Scene,
+    samples: Option<u32>,
+    bounces: Option<u32>,
+    order: Option<usize>,
+    seed: Option<u64>,
+    threads: Option<usize>,
+) -> PyResult<Bake> {
+    let defaults = scene.data.bake;
+    let settings = foundation::bake_settings::BakeSettings {
+        samples: samples.unwrap_or(defaults.samples),
+        bounces: bounces.unwrap_or(defaults.bounces),
+        order: order.unwrap_or(defaults.order),
+        seed: seed.unwrap_or(defaults.seed),
+    };
+    settings.validate().map_err(crate::errors::hprt_error)?;
+    if threads == Some(0) {
+        return Err(PyValueError::new_err("threads must be at least 1"));
+    }
+    let data = Arc::clone(&scene.data);
+    let result = py.detach(move || {
+        let run = || {
+            let bvh = SceneBvh::build(&data.geometry.mesh);
+            precompute::bake::bake(&data.geometry, &bvh, &settings, &NoProgress)
+        };
+        match threads {
+            None => Ok(run()),
+            Some(n) => rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map(|pool| pool.install(run)),
+        }
+    });
+    let (transfer, _) = result
+        .map_err(crate::errors::hprt_error)?
+        .map_err(crate::errors::hprt_error)?;
+    Ok(Bake {
+        transfer: Arc::new(transfer),
+        mesh_hash: scene.data.geometry.content_hash(),
+    })
+}
+
+/// Loads a `.bake` file of `scene` (refused if it was baked from other geometry).
+#[pyfunction]
+pub(crate) fn load_bake(scene: &Scene, path: PathBuf) -> PyResult<Bake> {
+    let mesh_hash = scene.data.geometry.content_hash();
+    let transfer = precompute::bakefile::read_for_mesh(&path, &mesh_hash)
+        .map_err(crate::errors::hprt_error)?;
+    Ok(Bake {
+        transfer: Arc::new(transfer),
+        mesh_hash,
+    })
+}

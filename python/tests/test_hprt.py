@@ -1,0 +1,142 @@
+"""The Python module against the command line and the path tracer.
+
+Run by tests/python.rs (after ``pip install ./python``), which sets ``HPRT_BIN`` to the
+``hprt`` program of the same checkout; checked by ``mypy --strict``.
+"""
+
+import json
+import os
+import subprocess
+import tempfile
+import unittest
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+import hprt
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENES = ROOT / "scenes"
+INTERIOR = SCENES / "env" / "interior.exr"
+TEAPOT = SCENES / "teapot.toml"
+
+
+def hprt_program(*args: str) -> None:
+    """Runs the command line of this checkout."""
+    program = os.environ.get("HPRT_BIN", "hprt")
+    subprocess.run([program, *args], check=True, capture_output=True)
+
+
+class Decompose(unittest.TestCase):
+    def test_same_numbers_as_the_command_line(self) -> None:
+        # The defaults, and settings that change the answer (8 lights instead of 3).
+        cases: list[tuple[list[str], hprt.Decomposition]] = [
+            (["--rotate", "30"], hprt.decompose(INTERIOR, rotation_deg=30.0)),
+            (
+                ["--threshold", "0.02", "--order", "4"],
+                hprt.decompose(INTERIOR, threshold=0.02, order=4),
+            ),
+            (["--mode", "thesis"], hprt.decompose(INTERIOR, mode="thesis")),
+        ]
+        self.assertGreater(len(cases[1][1].lights), len(cases[0][1].lights))
+        for args, got in cases:
+            with tempfile.TemporaryDirectory() as folder:
+                out = Path(folder) / "lights.json"
+                hprt_program("decompose", str(INTERIOR), *args, "-o", str(out))
+                expected = json.loads(out.read_text())
+            np.testing.assert_allclose(got.sh, np.array(expected["sh"]), rtol=1e-5, atol=1e-7)
+            self.assertEqual(len(got.lights), len(expected["lights"]))
+            for light, want in zip(got.lights, expected["lights"]):
+                np.testing.assert_allclose(light.direction, want["direction"], atol=1e-6)
+                np.testing.assert_allclose(light.power, want["power"], rtol=1e-5)
+            np.testing.assert_allclose(got.total_power, expected["total_power"], rtol=1e-5)
+
+    def test_an_array_decomposes_as_its_file(self) -> None:
+        array = hprt.load_map(INTERIOR)
+        self.assertEqual(array.dtype, np.float32)
+        self.assertEqual(array.shape[2], 3)
+        self.assertEqual(array.shape[1], 2 * array.shape[0])
+        from_file = hprt.decompose(INTERIOR, order=3)
+        from_array = hprt.decompose(array, order=3)
+        np.testing.assert_array_equal(from_file.sh, from_array.sh)
+        self.assertEqual(from_file.sh.shape, (9, 3))
+
+    def test_consistent_mode_adds_up_to_the_map(self) -> None:
+        result = hprt.decompose(INTERIOR)
+        # The SH part's DC term holds the power the lights do not: 4π · Y00 · c00 = √(4π) c00.
+        sh_power = np.sqrt(4.0 * np.pi) * result.sh[0]
+        lights = sum((np.array(l.power) for l in result.lights), np.zeros(3))
+        np.testing.assert_allclose(sh_power + lights, result.total_power, rtol=1e-3)
+
+    def test_bad_arguments_are_refused(self) -> None:
+        with self.assertRaises(ValueError):
+            hprt.decompose(np.zeros((4, 4, 3), dtype=np.float32))
+        with self.assertRaises(ValueError):
+            hprt.decompose(INTERIOR, mode="nonsense")  # type: ignore[arg-type]
+        bad = np.ones((8, 16, 3), dtype=np.float32)
+        bad[2, 3, 1] = np.nan
+        with self.assertRaisesRegex(ValueError, "finite"):
+            hprt.decompose(bad)
+        with self.assertRaisesRegex(hprt.HprtError, "missing.exr"):
+            hprt.decompose("missing.exr")
+
+
+class BakeAndRender(unittest.TestCase):
+    scene: hprt.Scene
+    bake: hprt.Bake
+
+    @classmethod
+    def setUpClass(cls) -> None:
+        cls.scene = hprt.load_scene(TEAPOT)
+        cls.bake = hprt.bake(cls.scene, samples=64, bounces=1, order=4)
+
+    def test_the_transfer_is_direct_plus_indirect(self) -> None:
+        direct, indirect = self.bake.direct, self.bake.indirect
+        self.assertEqual(direct.shape, (self.scene.vertex_count, 3, 16))
+        np.testing.assert_allclose(self.bake.transfer, direct + indirect, rtol=1e-6, atol=1e-7)
+        # Under a uniform map of radiance 1 (SH DC term √(4π)) a vertex reflects at most what a
+        # white unshadowed one does, 1: its DC transfer is at most 1/√(4π).
+        self.assertTrue(np.all(direct[:, :, 0] >= 0.0))
+        self.assertTrue(np.all(direct[:, :, 0] <= 1.0 / np.sqrt(4.0 * np.pi) + 1e-4))
+
+    def test_the_bits_do_not_depend_on_threads_and_survive_a_file(self) -> None:
+        one = hprt.bake(self.scene, samples=16, bounces=1, order=3, threads=1)
+        two = hprt.bake(self.scene, samples=16, bounces=1, order=3, threads=2)
+        np.testing.assert_array_equal(one.transfer, two.transfer)
+        with tempfile.TemporaryDirectory() as folder:
+            path = Path(folder) / "teapot.bake"
+            one.save(path)
+            again = hprt.load_bake(self.scene, path)
+            np.testing.assert_array_equal(again.transfer, one.transfer)
+            other = hprt.load_scene(SCENES / "thin.toml")
+            with self.assertRaisesRegex(hprt.HprtError, "teapot.bake"):
+                hprt.load_bake(other, path)
+
+    def test_the_hybrid_agrees_with_the_path_tracer(self) -> None:
+        renderer = hprt.Renderer(self.scene, self.bake, width=80, height=60)
+        hybrid = renderer.render(INTERIOR, mode="hybrid")
+        again = renderer.render(INTERIOR, mode="hybrid")
+        np.testing.assert_array_equal(hybrid, again)
+        self.assertEqual(hybrid.shape, (60, 80, 3))
+        prt = renderer.render(INTERIOR, mode="prt")
+        truth = hprt.reference(self.scene, INTERIOR, spp=64, bounces=1, width=80, height=60)
+        self.assertEqual(truth.shape, (60, 80, 3))
+
+        def error(image: npt.NDArray[np.float32]) -> float:
+            return float(np.abs(image - truth).sum() / truth.sum())
+
+        # Relative L1 over the image: 0.036 for the hybrid, 0.046 for the plain projection
+        # (whose order-4 SH blurs the lamps' shadows) when written.
+        self.assertLess(error(hybrid), 0.06)
+        self.assertLess(error(hybrid), error(prt))
+        turned = renderer.render(INTERIOR, mode="hybrid", rotation_deg=90.0)
+        self.assertGreater(float(np.abs(turned - hybrid).mean()), 1e-3 * float(hybrid.mean()))
+
+    def test_a_missing_scene_names_its_file(self) -> None:
+        with self.assertRaisesRegex(hprt.HprtError, "no_such_scene.toml"):
+            hprt.load_scene("no_such_scene.toml")
+
+
+if __name__ == "__main__":
+    unittest.main()
