@@ -14,12 +14,15 @@ the ``hprt`` command line, with the same numbers::
 
 from ._hprt import (
     Bake,
+    Camera,
+    Captured,
     Decomposition,
     HprtError,
     Light,
     Renderer,
     Scene,
     bake,
+    capture,
     decompose,
     load_bake,
     load_map,
@@ -29,12 +32,15 @@ from ._hprt import (
 
 __all__ = [
     "Bake",
+    "Camera",
+    "Captured",
     "Decomposition",
     "HprtError",
     "Light",
     "Renderer",
     "Scene",
     "bake",
+    "capture",
     "decompose",
     "load_bake",
     "load_map",

@@ -2,7 +2,7 @@
 
 import os
 from pathlib import Path
-from typing import Literal, Optional, Union
+from typing import Callable, Literal, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -12,6 +12,8 @@ MapArgument = Union[str, "os.PathLike[str]", npt.NDArray[np.float32]]
 DecomposeMode = Literal["consistent", "thesis"]
 RenderMode = Literal["hybrid", "prt", "lights", "unshadowed", "median-cut", "sh-sun"]
 Backend = Literal["auto", "vulkan", "gl"]
+Progress = Callable[[str, int, int], object]
+"""``progress(stage, done, total)``: called at most once per percent of each stage."""
 
 class HprtError(Exception):
     """An hprt library call failed; the message says what and where."""
@@ -48,9 +50,34 @@ class Decomposition:
     def total_power(self) -> npt.NDArray[np.float32]:
         """The map's total RGB power."""
 
+class Camera:
+    """A pinhole camera: position, target, vertical field of view (degrees), up."""
+
+    def __init__(
+        self,
+        position: tuple[float, float, float],
+        target: tuple[float, float, float],
+        fov_deg: float = 40.0,
+        up: tuple[float, float, float] = (0.0, 1.0, 0.0),
+    ) -> None: ...
+    @property
+    def position(self) -> tuple[float, float, float]: ...
+    @property
+    def target(self) -> tuple[float, float, float]: ...
+    @property
+    def fov_deg(self) -> float: ...
+    @property
+    def up(self) -> tuple[float, float, float]: ...
+
 class Scene:
     """A scene file or a model placed in a default scene."""
 
+    @property
+    def camera(self) -> Camera:
+        """The scene's camera."""
+    @property
+    def image_size(self) -> tuple[int, int]:
+        """The scene camera's (width, height)."""
     @property
     def name(self) -> str: ...
     @property
@@ -106,6 +133,7 @@ class Renderer:
         mode: RenderMode = "hybrid",
         rotation_deg: float = 0.0,
         decompose_mode: DecomposeMode = "consistent",
+        camera: Optional[Camera] = None,
     ) -> Image:
         """The linear radiance image, ``(height, width, 3) float32``."""
 
@@ -131,6 +159,7 @@ def bake(
     order: Optional[int] = None,
     seed: Optional[int] = None,
     threads: Optional[int] = None,
+    progress: Optional[Progress] = None,
 ) -> Bake:
     """Bakes the scene; its ``[bake]`` settings where an argument is not given."""
 
@@ -146,5 +175,32 @@ def reference(
     rotation_deg: float = 0.0,
     width: Optional[int] = None,
     height: Optional[int] = None,
+    camera: Optional[Camera] = None,
+    progress: Optional[Progress] = None,
 ) -> Image:
     """The path-traced image, ``(height, width, 3) float32``."""
+
+class Captured:
+    """A map captured from photographs."""
+
+    @property
+    def map(self) -> Image:
+        """``(width / 2, width, 3) float32``, linear, in the camera's units."""
+    @property
+    def response(self) -> npt.NDArray[np.float32]:
+        """The inverse response used, ``(256, 3)``."""
+    @property
+    def spread(self) -> Optional[float]:
+        """The median texel's readings across exposures (RMS log), or None if unknown."""
+    @property
+    def covered(self) -> float:
+        """Share of the sphere some exposure resolved."""
+    @property
+    def warnings(self) -> list[str]: ...
+
+def capture(
+    description: Union[str, "os.PathLike[str]"],
+    width: int = 1024,
+    response: Optional[npt.NDArray[np.float32]] = None,
+) -> Captured:
+    """The map a capture description's photographs see (as ``hprt capture``)."""

@@ -9,9 +9,12 @@
 use errors::HprtError;
 use pyo3::prelude::*;
 
+mod camera;
+mod capture;
 mod decompose;
 mod errors;
 mod maps;
+mod progress;
 mod reference;
 mod render;
 mod scene;
@@ -30,5 +33,8 @@ fn _hprt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::Bake>()?;
     m.add_class::<render::Renderer>()?;
     m.add_function(wrap_pyfunction!(reference::reference, m)?)?;
+    m.add_class::<camera::Camera>()?;
+    m.add_function(wrap_pyfunction!(capture::capture, m)?)?;
+    m.add_class::<capture::Captured>()?;
     Ok(())
 }

@@ -62,7 +62,7 @@ fn map_from_array(array: &PyReadonlyArray3<'_, f32>) -> PyResult<EnvMap> {
     Ok(EnvMap::new(width, height, texels))
 }
 
-fn map_array(map: &EnvMap) -> Array3<f32> {
+pub(crate) fn map_array(map: &EnvMap) -> Array3<f32> {
     rgb_array(map.width(), map.height(), map.texels())
 }
 

@@ -1,11 +1,11 @@
 //! `hprt.Renderer`: the real-time renderer (PRT pass plus shadow-mapped lights) on a headless
 //! GPU, made once per scene and bake and reused across frames.
 
+use crate::camera::{Camera, resolve};
 use crate::decompose::settings;
 use crate::maps::{image_array, map_argument};
 use crate::scene::{Bake, Scene};
 use numpy::{IntoPyArray, PyArray3};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use runtime::render::{Backend, GpuContext, Renderer as GpuRenderer, ShadowSettings};
 use runtime::{DecomposeMode, EnvironmentLighting, RenderMode};
@@ -17,6 +17,8 @@ pub(crate) struct Renderer {
     renderer: GpuRenderer,
     scene: Arc<foundation::scene::Scene>,
     order: usize,
+    /// The image size, fixed when made.
+    size: (u32, u32),
     adapter: String,
     // Declared last: the device outlives the renderer's resources.
     _gpu: GpuContext,
@@ -37,13 +39,7 @@ impl Renderer {
     ) -> PyResult<Self> {
         let backend: Backend = crate::errors::parse_choice("backend", backend)?;
         let data = Arc::clone(&scene.data);
-        let camera = data.camera.with_size(
-            width.unwrap_or(data.camera.width),
-            height.unwrap_or(data.camera.height),
-        );
-        camera
-            .validate()
-            .map_err(|e| PyValueError::new_err(format!("width, height: {e}")))?;
+        let camera = resolve(&data.camera, None, width, height)?;
         let gpu = GpuContext::headless(backend).map_err(crate::errors::hprt_error)?;
         let renderer = GpuRenderer::new(
             &gpu,
@@ -57,6 +53,7 @@ impl Renderer {
             renderer,
             scene: data,
             order: bake.transfer.settings.order,
+            size: (camera.width, camera.height),
             adapter: gpu.description().to_string(),
             _gpu: gpu,
         })
@@ -71,8 +68,9 @@ impl Renderer {
     /// Renders the scene lit by `map` (a path or an `(H, W, 3) float32` array) turned by
     /// `rotation_deg` about +Y: `mode` "hybrid" (SH part plus shadow-mapped lights), "prt"
     /// (the whole map through the transfer), or a peer ("median-cut", "sh-sun"). Returns the
-    /// linear radiance image, `(height, width, 3) float32`.
-    #[pyo3(signature = (map, mode = "hybrid", rotation_deg = 0.0, decompose_mode = "consistent"))]
+    /// linear radiance image, `(height, width, 3) float32`, seen by `camera` (the scene's
+    /// when not given).
+    #[pyo3(signature = (map, mode = "hybrid", rotation_deg = 0.0, decompose_mode = "consistent", camera = None))]
     fn render<'py>(
         &mut self,
         py: Python<'py>,
@@ -80,7 +78,18 @@ impl Renderer {
         mode: &str,
         rotation_deg: f32,
         decompose_mode: &str,
+        camera: Option<Camera>,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
+        let (width, height) = self.size;
+        let view = resolve(
+            &self.scene.camera,
+            camera.as_ref(),
+            Some(width),
+            Some(height),
+        )?;
+        self.renderer
+            .set_camera(&view)
+            .map_err(crate::errors::hprt_error)?;
         let mode: RenderMode = crate::errors::parse_choice("mode", mode)?;
         let decompose_mode: DecomposeMode =
             crate::errors::parse_choice("decompose_mode", decompose_mode)?;

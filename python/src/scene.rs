@@ -1,8 +1,8 @@
 //! Scenes and their bakes: `hprt.load_scene`, `hprt.bake`, `hprt.load_bake`, and the bake's
 //! transfer as arrays.
 
+use crate::progress::with_progress;
 use foundation::bvh::SceneBvh;
-use foundation::infra::progress::NoProgress;
 use foundation::scene::Scene as SceneData;
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray3};
@@ -50,6 +50,18 @@ impl Scene {
     #[getter]
     fn triangle_count(&self) -> usize {
         self.data.geometry.mesh.triangles.len()
+    }
+
+    /// The scene's camera (its image size is a render's own).
+    #[getter]
+    fn camera(&self) -> crate::camera::Camera {
+        crate::camera::Camera::from(&self.data.camera)
+    }
+
+    /// The scene camera's image size, (width, height).
+    #[getter]
+    fn image_size(&self) -> (u32, u32) {
+        (self.data.camera.width, self.data.camera.height)
     }
 
     /// The environment map the scene names, if any.
@@ -145,9 +157,11 @@ fn vectors_array(vectors: &TransferVectors) -> Array3<f32> {
 }
 
 /// Bakes `scene` (its `[bake]` settings, each overridden where given) on `threads` threads
-/// (all cores when `None`); the same bits whatever the thread count.
+/// (all cores when `None`); the same bits whatever the thread count. `progress(stage, done,
+/// total)` is called at most once per percent of each stage.
 #[pyfunction]
-#[pyo3(signature = (scene, samples = None, bounces = None, order = None, seed = None, threads = None))]
+#[pyo3(signature = (scene, samples = None, bounces = None, order = None, seed = None, threads = None, progress = None))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn bake(
     py: Python<'_>,
     scene: &Scene,
@@ -156,6 +170,7 @@ pub(crate) fn bake(
     order: Option<usize>,
     seed: Option<u64>,
     threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bake> {
     let defaults = scene.data.bake;
     let settings = foundation::bake_settings::BakeSettings {
@@ -170,19 +185,21 @@ pub(crate) fn bake(
     }
     let data = Arc::clone(&scene.data);
     let result = py.detach(move || {
-        let run = || {
-            let bvh = SceneBvh::build(&data.geometry.mesh);
-            precompute::bake::bake(&data.geometry, &bvh, &settings, &NoProgress)
-        };
-        match threads {
-            None => Ok(run()),
-            Some(n) => rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map(|pool| pool.install(run)),
-        }
+        with_progress(progress, "bake", |progress| {
+            let run = || {
+                let bvh = SceneBvh::build(&data.geometry.mesh);
+                precompute::bake::bake(&data.geometry, &bvh, &settings, progress)
+            };
+            match threads {
+                None => Ok(run()),
+                Some(n) => rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .map(|pool| pool.install(run)),
+            }
+        })
     });
-    let (transfer, _) = result
+    let (transfer, _) = result?
         .map_err(crate::errors::hprt_error)?
         .map_err(crate::errors::hprt_error)?;
     Ok(Bake {
