@@ -19,8 +19,14 @@ class HprtError(Exception):
     """An hprt library call failed; the message says what and where."""
 
 class Light:
-    """One directional light of a decomposition."""
+    """One directional light of a decomposition, or of your own."""
 
+    def __init__(
+        self,
+        direction: tuple[float, float, float],
+        power: tuple[float, float, float],
+        radius_deg: float = 0.5,
+    ) -> None: ...
     @property
     def direction(self) -> tuple[float, float, float]:
         """Unit direction the light arrives from (+Y up)."""
@@ -36,10 +42,17 @@ class Light:
     @property
     def share(self) -> float:
         """Share of the map's total luminous power."""
+    @property
+    def halo_radius_deg(self) -> float:
+        """Radius of the glow around the source, degrees."""
+    @property
+    def core_fraction(self) -> float:
+        """Fraction of the power from the source itself."""
 
 class Decomposition:
-    """SH coefficients plus lights."""
+    """SH coefficients plus lights: ``hprt.decompose``'s, or lighting of your own."""
 
+    def __init__(self, sh: npt.NDArray[np.float32], lights: list[Light] = ...) -> None: ...
     @property
     def sh(self) -> npt.NDArray[np.float32]:
         """``(order**2, 3)`` RGB coefficients, index ``l*(l+1)+m``."""
@@ -129,13 +142,15 @@ class Renderer:
         """The graphics adapter it draws with."""
     def render(
         self,
-        map: MapArgument,
+        lighting: Union[MapArgument, Decomposition],
         mode: RenderMode = "hybrid",
         rotation_deg: float = 0.0,
         decompose_mode: DecomposeMode = "consistent",
         camera: Optional[Camera] = None,
+        background: Optional[MapArgument] = None,
     ) -> Image:
-        """The linear radiance image, ``(height, width, 3) float32``."""
+        """The linear radiance image, ``(height, width, 3) float32``: lit by a map, or by a
+        Decomposition drawn over ``background`` (black when not given)."""
 
 def load_map(path: Union[str, "os.PathLike[str]"]) -> Image:
     """An environment map file as an ``(H, W, 3) float32`` equirectangular array."""

@@ -2,13 +2,19 @@
 //! GPU, made once per scene and bake and reused across frames.
 
 use crate::camera::{Camera, resolve};
-use crate::decompose::settings;
+use crate::decompose::{Decomposition, settings};
 use crate::maps::{image_array, map_argument};
 use crate::scene::{Bake, Scene};
+use foundation::Rgb;
+use foundation::envmap::EnvMap;
 use numpy::{IntoPyArray, PyArray3};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use runtime::render::{Backend, GpuContext, Renderer as GpuRenderer, ShadowSettings};
-use runtime::{DecomposeMode, EnvironmentLighting, RenderMode};
+use runtime::{
+    DecomposeMode, EnvironmentLighting, FrameLighting, ReflectedEnvironment, RenderMode,
+    lights_indirect_default,
+};
 use std::sync::Arc;
 
 /// The scene's renderer: its GPU buffers and pipelines, kept between `render` calls.
@@ -65,20 +71,24 @@ impl Renderer {
         self.adapter.clone()
     }
 
-    /// Renders the scene lit by `map` (a path or an `(H, W, 3) float32` array) turned by
-    /// `rotation_deg` about +Y: `mode` "hybrid" (SH part plus shadow-mapped lights), "prt"
-    /// (the whole map through the transfer), or a peer ("median-cut", "sh-sun"). Returns the
-    /// linear radiance image, `(height, width, 3) float32`, seen by `camera` (the scene's
-    /// when not given).
-    #[pyo3(signature = (map, mode = "hybrid", rotation_deg = 0.0, decompose_mode = "consistent", camera = None))]
+    /// Renders the scene lit by `lighting`, turned by `rotation_deg` about +Y, seen by
+    /// `camera` (the scene's when not given). `lighting` is a map (a path or an `(H, W, 3)
+    /// float32` array), decomposed here, or a `Decomposition` (one of `hprt.decompose`'s, or
+    /// SH and lights of your own, drawn over `background`, a map, black when not given).
+    /// `mode`: "hybrid" (SH part plus shadow-mapped lights), "prt" (the whole map through
+    /// the transfer), "unshadowed", "lights", or a peer ("median-cut", "sh-sun"; a map only).
+    /// Returns the linear radiance image, `(height, width, 3) float32`.
+    #[pyo3(signature = (lighting, mode = "hybrid", rotation_deg = 0.0, decompose_mode = "consistent", camera = None, background = None))]
+    #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &mut self,
         py: Python<'py>,
-        map: &Bound<'py, PyAny>,
+        lighting: &Bound<'py, PyAny>,
         mode: &str,
         rotation_deg: f32,
         decompose_mode: &str,
         camera: Option<Camera>,
+        background: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         let (width, height) = self.size;
         let view = resolve(
@@ -93,18 +103,32 @@ impl Renderer {
         let mode: RenderMode = crate::errors::parse_choice("mode", mode)?;
         let decompose_mode: DecomposeMode =
             crate::errors::parse_choice("decompose_mode", decompose_mode)?;
-        let map = map_argument(map)?;
-        let mut lighting =
-            EnvironmentLighting::new(&map, settings(decompose_mode, None, Some(self.order)))
+        let (frame, environment) = match lighting.cast::<Decomposition>() {
+            Ok(given) => {
+                let frame = self.given_lighting(&given.borrow(), mode, decompose_mode)?;
+                let environment = match background {
+                    Some(map) => map_argument(map)?,
+                    None => EnvMap::uniform(2, 1, Rgb::ZERO),
+                };
+                (frame, environment)
+            }
+            Err(_) => {
+                let map = map_argument(lighting)?;
+                let mut decomposer = EnvironmentLighting::new(
+                    &map,
+                    settings(decompose_mode, None, Some(self.order)),
+                )
                 .map_err(crate::errors::hprt_error)?;
-        lighting.set_rotation(rotation_deg);
-        if self.scene.geometry.is_glossy() {
-            lighting.enable_reflections(Some(runtime::render::DEFAULT_REFLECTION_SIZE));
-        }
-        let frame = lighting.frame(mode, None);
-        self.renderer.set_environment(lighting.map(), rotation_deg);
+                decomposer.set_rotation(rotation_deg);
+                if self.scene.geometry.is_glossy() {
+                    decomposer.enable_reflections(Some(runtime::render::DEFAULT_REFLECTION_SIZE));
+                }
+                (decomposer.frame(mode, None).lighting, map)
+            }
+        };
+        self.renderer.set_environment(&environment, rotation_deg);
         self.renderer
-            .set_lighting(&frame.lighting)
+            .set_lighting(&frame)
             .map_err(crate::errors::hprt_error)?;
         self.renderer.render().map_err(crate::errors::hprt_error)?;
         let image = self
@@ -112,5 +136,38 @@ impl Renderer {
             .read_back()
             .map_err(crate::errors::hprt_error)?;
         Ok(image_array(&image).into_pyarray(py))
+    }
+}
+
+impl Renderer {
+    /// A frame of given SH and lights, in the modes that draw a decomposition as it is.
+    fn given_lighting(
+        &self,
+        given: &Decomposition,
+        mode: RenderMode,
+        decompose_mode: DecomposeMode,
+    ) -> PyResult<FrameLighting> {
+        let (sh, lights) = given.parts(self.order)?;
+        let indirect = lights_indirect_default(decompose_mode);
+        let mut frame = match mode {
+            RenderMode::Hybrid | RenderMode::Unshadowed | RenderMode::Lights => {
+                let decomposition = runtime::Decomposition {
+                    total_power: Rgb::ZERO,
+                    candidates: lights.len(),
+                    sh: sh.clone(),
+                    lights,
+                };
+                FrameLighting::for_mode(mode, &sh, &decomposition, indirect)
+            }
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "mode {mode}: a Decomposition is drawn in hybrid, unshadowed or lights mode \
+                     (prt and the peers start from a map)"
+                )));
+            }
+        };
+        // Glossy surfaces reflect the SH part where no map is decomposed here.
+        frame.reflections = ReflectedEnvironment::Sh(frame.sh.clone());
+        Ok(frame)
     }
 }

@@ -133,6 +133,33 @@ class BakeAndRender(unittest.TestCase):
         turned = renderer.render(INTERIOR, mode="hybrid", rotation_deg=90.0)
         self.assertGreater(float(np.abs(turned - hybrid).mean()), 1e-3 * float(hybrid.mean()))
 
+    def test_a_decomposition_renders_as_its_map(self) -> None:
+        renderer = hprt.Renderer(self.scene, self.bake, width=80, height=60)
+        from_map = renderer.render(INTERIOR, rotation_deg=40.0)
+        lighting = hprt.decompose(INTERIOR, order=self.bake.order, rotation_deg=40.0)
+        given = renderer.render(lighting, background=INTERIOR, rotation_deg=40.0)
+        np.testing.assert_array_equal(given, from_map)
+        with self.assertRaisesRegex(ValueError, "order"):
+            renderer.render(hprt.decompose(INTERIOR, order=self.bake.order + 1))
+        with self.assertRaisesRegex(ValueError, "prt"):
+            renderer.render(lighting, mode="prt")
+
+    def test_lighting_of_your_own_is_linear_in_its_power(self) -> None:
+        renderer = hprt.Renderer(self.scene, self.bake, width=80, height=60)
+        sun = hprt.Light((0.3, 1.0, 0.2), (2.0, 1.5, 1.0), radius_deg=1.0)
+        brighter = hprt.Light((0.3, 1.0, 0.2), (6.0, 4.5, 3.0), radius_deg=1.0)
+        self.assertAlmostEqual(float(np.linalg.norm(sun.direction)), 1.0, places=6)
+        sky = np.zeros((16, 3), dtype=np.float32)
+        sky[0] = 0.2
+        one = renderer.render(hprt.Decomposition(sky, [sun]))
+        three = renderer.render(hprt.Decomposition(3.0 * sky, [brighter]))
+        self.assertGreater(float(one.mean()), 0.0)
+        np.testing.assert_allclose(three, 3.0 * one, rtol=2e-3, atol=1e-4)
+        with self.assertRaises(ValueError):
+            hprt.Decomposition(np.zeros((5, 3), dtype=np.float32))
+        with self.assertRaises(ValueError):
+            hprt.Light((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
+
     def test_a_camera_is_the_same_for_the_renderer_and_the_path_tracer(self) -> None:
         renderer = hprt.Renderer(self.scene, self.bake, width=80, height=60)
         own = self.scene.camera
