@@ -48,6 +48,8 @@ class Light:
     @property
     def core_fraction(self) -> float:
         """Fraction of the power from the source itself."""
+    def sh(self, order: int = 3) -> npt.NDArray[np.float32]:
+        """The light's SH projection as a point source, ``(order**2, 3)``."""
 
 class Decomposition:
     """SH coefficients plus lights: ``hprt.decompose``'s, or lighting of your own."""
@@ -116,10 +118,10 @@ class Bake:
     def bounces(self) -> int: ...
     @property
     def direct(self) -> npt.NDArray[np.float32]:
-        """``(vertices, 3, order**2)`` shadowed transfer."""
+        """``(vertices, 3, order**2)`` shadowed transfer: a read-only view, no copy."""
     @property
     def indirect(self) -> npt.NDArray[np.float32]:
-        """``(vertices, 3, order**2)`` interreflected transfer."""
+        """``(vertices, 3, order**2)`` interreflected transfer: a read-only view, no copy."""
     @property
     def transfer(self) -> npt.NDArray[np.float32]:
         """Direct plus interreflected."""

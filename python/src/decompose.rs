@@ -95,6 +95,22 @@ impl Light {
         })
     }
 
+    /// The light's SH projection as a point source, `(order², 3)`: its power times the basis
+    /// at its direction (what the SH part would hold had the light stayed in it, before any
+    /// band-limiting window).
+    #[pyo3(signature = (order = 3))]
+    fn sh<'py>(&self, py: Python<'py>, order: usize) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        foundation::sh::check_order(order)
+            .map_err(|e| PyValueError::new_err(format!("order: {e}")))?;
+        let mut sh = ShCoeffs::<Rgb>::zeros(order);
+        sh.add_delta(
+            Vec3::from_array(self.direction),
+            Rgb::from_array(self.power),
+        );
+        let c = sh.as_slice();
+        Ok(Array2::from_shape_fn((c.len(), 3), |(k, ch)| c[k][ch]).into_pyarray(py))
+    }
+
     fn __repr__(&self) -> String {
         let [x, y, z] = self.direction;
         format!(

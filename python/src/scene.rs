@@ -4,11 +4,12 @@
 use crate::progress::with_progress;
 use foundation::bvh::SceneBvh;
 use foundation::scene::Scene as SceneData;
-use numpy::ndarray::Array3;
+use numpy::ndarray::{Array3, ArrayView3};
 use numpy::{IntoPyArray, PyArray3};
 use precompute::bake::{Transfer, TransferVectors};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::IntoPyDict;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -114,16 +115,19 @@ impl Bake {
     }
 
     /// Direct (shadowed) transfer, `(vertices, 3, order²)`: row `[v, c]` dotted with channel
-    /// `c` of a map's SH coefficients is vertex `v`'s outgoing radiance.
+    /// `c` of a map's SH coefficients is vertex `v`'s outgoing radiance. A read-only view of
+    /// the bake's own memory (no copy), which it keeps alive.
     #[getter]
-    fn direct<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f32>> {
-        vectors_array(&self.transfer.direct).into_pyarray(py)
+    fn direct<'py>(this: Bound<'py, Self>) -> PyResult<Bound<'py, PyArray3<f32>>> {
+        let transfer = Arc::clone(&this.get().transfer);
+        shared_view(&transfer.direct, this.into_any())
     }
 
-    /// Interreflected transfer (the bounces), same layout.
+    /// Interreflected transfer (the bounces), same layout and also a read-only view.
     #[getter]
-    fn indirect<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f32>> {
-        vectors_array(&self.transfer.indirect).into_pyarray(py)
+    fn indirect<'py>(this: Bound<'py, Self>) -> PyResult<Bound<'py, PyArray3<f32>>> {
+        let transfer = Arc::clone(&this.get().transfer);
+        shared_view(&transfer.indirect, this.into_any())
     }
 
     /// Direct plus interreflected.
@@ -148,6 +152,26 @@ impl Bake {
             self.transfer.direct.vertex_count()
         )
     }
+}
+
+/// `vectors` as a read-only numpy array over their own memory, `owner` (the `Bake` holding
+/// them, immutable) kept alive by the array.
+fn shared_view<'py>(
+    vectors: &TransferVectors,
+    owner: Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let n = vectors.order() * vectors.order();
+    let view = ArrayView3::from_shape((vectors.vertex_count(), 3, n), vectors.as_slice())
+        .expect("vertices × 3 × order² coefficients");
+    // SAFETY: the memory belongs to the `Transfer` behind the frozen `Bake` `owner`, which
+    // never changes it and which the array keeps alive; the array is made read-only below.
+    let array = unsafe { PyArray3::borrow_from_array(&view, owner) };
+    array.call_method(
+        "setflags",
+        (),
+        Some(&[("write", false)].into_py_dict(array.py())?),
+    )?;
+    Ok(array)
 }
 
 fn vectors_array(vectors: &TransferVectors) -> Array3<f32> {

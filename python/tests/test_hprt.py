@@ -4,6 +4,7 @@ Run by tests/python.rs (after ``pip install ./python``), which sets ``HPRT_BIN``
 ``hprt`` program of the same checkout; checked by ``mypy --strict``.
 """
 
+import gc
 import json
 import os
 import subprocess
@@ -69,6 +70,15 @@ class Decompose(unittest.TestCase):
         lights = sum((np.array(l.power) for l in result.lights), np.zeros(3))
         np.testing.assert_allclose(sh_power + lights, result.total_power, rtol=1e-3)
 
+    def test_a_lights_sh_is_its_power_at_its_direction(self) -> None:
+        light = hprt.Light((1.0, 2.0, 3.0), (2.0, 1.0, 0.5))
+        sh = light.sh(3)
+        self.assertEqual(sh.shape, (9, 3))
+        # Y00 = 1/√(4π); band 1 = √(3/4π) (x, y, z) (CONVENTIONS.md, "Spherical harmonics").
+        np.testing.assert_allclose(sh[0], np.array(light.power) / np.sqrt(4 * np.pi), rtol=1e-6)
+        band1 = np.sqrt(3 / (4 * np.pi)) * np.outer(light.direction, light.power)
+        np.testing.assert_allclose(sh[1:4], band1, rtol=1e-5)
+
     def test_bad_arguments_are_refused(self) -> None:
         with self.assertRaises(ValueError):
             hprt.decompose(np.zeros((4, 4, 3), dtype=np.float32))
@@ -99,6 +109,18 @@ class BakeAndRender(unittest.TestCase):
         # white unshadowed one does, 1: its DC transfer is at most 1/√(4π).
         self.assertTrue(np.all(direct[:, :, 0] >= 0.0))
         self.assertTrue(np.all(direct[:, :, 0] <= 1.0 / np.sqrt(4.0 * np.pi) + 1e-4))
+
+    def test_the_transfer_is_shared_not_copied(self) -> None:
+        direct = self.bake.direct
+        self.assertTrue(np.shares_memory(direct, self.bake.direct))
+        self.assertFalse(direct.flags.writeable)
+        with self.assertRaises(ValueError):
+            direct[0, 0, 0] = 1.0
+        # The array keeps its bake alive.
+        orphan = hprt.bake(self.scene, samples=4, bounces=0, order=2).indirect
+        gc.collect()
+        self.assertEqual(float(np.abs(orphan).sum()), 0.0)  # no bounces: nothing indirect
+        self.assertEqual(orphan.shape, (self.scene.vertex_count, 3, 4))
 
     def test_the_bits_do_not_depend_on_threads_and_survive_a_file(self) -> None:
         one = hprt.bake(self.scene, samples=16, bounces=1, order=3, threads=1)
