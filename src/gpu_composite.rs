@@ -54,10 +54,8 @@ pub struct CompositeInputs<'a> {
 /// bake is cached like any scene's).
 fn proxies_scene(scene: &Scene, whole: &Transfer) -> Scene {
     Scene {
-        name: format!("{}-proxies", scene.name),
-        geometry: scene.geometry.subset(|o| o.role == ObjectRole::Proxy),
         bake: whole.settings,
-        ..scene.clone()
+        ..scene.of_role(ObjectRole::Proxy).renamed("proxies")
     }
 }
 
@@ -210,7 +208,7 @@ fn ambient_occlusion(scene: &Scene, hits: &PrimaryHits, kinds: &[PixelKind]) -> 
     use foundation::sampling::{
         Frame, cosine_hemisphere, cranley_patterson, hammersley, hash_to_unit2, mix64,
     };
-    let objects_geometry = scene.geometry.subset(|o| o.role == ObjectRole::Object);
+    let objects_geometry = scene.geometry.of_role(ObjectRole::Object);
     let objects = SceneBvh::build(&objects_geometry.mesh);
     let offset = 1e-4 * scene.geometry.diagonal();
     (0..kinds.len())

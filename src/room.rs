@@ -58,11 +58,7 @@ impl RoomModel {
             "{}: a model moves through a room lit by its [[probe]] entries, and it has none",
             scene.path.display()
         );
-        let part = |role: ObjectRole, suffix: &str| Scene {
-            name: format!("{}-{suffix}", scene.name),
-            geometry: scene.geometry.subset(|o| o.role == role),
-            ..scene.clone()
-        };
+        let part = |role: ObjectRole, suffix: &str| scene.of_role(role).renamed(suffix);
         let (model, room) = (
             part(ObjectRole::Object, "model"),
             part(ObjectRole::Proxy, "room"),
@@ -76,11 +72,7 @@ impl RoomModel {
         // draws the same rows, so the composite's ratio is one but for the model's shadows.
         let mut collapsed = scene.geometry.clone();
         collapsed.collapse_objects(centre);
-        let empty = Scene {
-            name: format!("{}-room", scene.name),
-            geometry: collapsed,
-            ..scene.clone()
-        };
+        let empty = scene.with_geometry(collapsed).renamed("room");
         let (_, empty) = bake_for(&empty, None).context("cannot bake the room alone")?;
         let transfer = with_objects_alone(&scene.geometry, &empty, &model_transfer)?;
         let room_transfer = rows_of(&scene.geometry, ObjectRole::Proxy, &empty)?;

@@ -75,9 +75,7 @@ fn renders_probes_that_the_scene_then_loads() {
 fn the_bundled_room_has_its_probes() {
     let scene = foundation::scene::Scene::load(&scene("room.toml")).unwrap();
     assert_eq!(scene.probes.len(), 3);
-    let room = scene
-        .geometry
-        .subset(|o| o.role == foundation::scene::ObjectRole::Proxy);
+    let room = scene.geometry.of_role(foundation::scene::ObjectRole::Proxy);
     let proxies = foundation::bvh::SceneBvh::build(&room.mesh);
     for source in &scene.probes {
         let probe = source.load(&proxies).unwrap();

@@ -33,7 +33,7 @@ fn a_balls_shadow_and_bounce_on_the_floor_match_the_path_tracer() {
     );
     geometry.push_object("floor".into(), &floor, Rgb::splat(0.5));
     geometry.objects[1].role = ObjectRole::Proxy;
-    let empty = geometry.subset(|o| o.role == ObjectRole::Proxy);
+    let empty = geometry.of_role(ObjectRole::Proxy);
     let sky = EnvMap::uniform(64, 32, Rgb::ONE);
     let light = reference::EnvironmentLight::new(&sky, 0.0);
     let settings = reference::ReferenceSettings::new(64, 4, 0);
@@ -77,7 +77,7 @@ fn a_balls_shadow_and_bounce_on_the_floor_match_the_path_tracer() {
 /// The scene's transfer with the ball baked alone on its own vertices (it comes first) and
 /// nothing on the floor's, which the shadow's factors scale and never read.
 fn alone_then_zeros(geometry: &SceneMesh, order: usize) -> Transfer {
-    let ball = geometry.subset(|o| o.role == ObjectRole::Object);
+    let ball = geometry.of_role(ObjectRole::Object);
     let alone = bake_of(&ball, order, 1024, 2);
     let n = geometry.mesh.vertex_count();
     let pad = |t: &TransferVectors| {

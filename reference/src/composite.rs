@@ -171,7 +171,7 @@ pub fn render_composite_rows(
     rows: &[usize],
     progress: &dyn Progress,
 ) -> [ReferenceImage; 2] {
-    let proxies = geometry.subset(|o| o.role == ObjectRole::Proxy);
+    let proxies = geometry.of_role(ObjectRole::Proxy);
     let trace = |scene: &SceneMesh| {
         let bvh = SceneBvh::build(&scene.mesh);
         crate::render_rows(scene, &bvh, light, camera, settings, rows, progress)

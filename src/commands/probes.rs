@@ -48,7 +48,7 @@ struct Target {
 
 pub fn run(args: ProbesArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
-    let room = scene.geometry.subset(|o| o.role == ObjectRole::Proxy);
+    let room = scene.geometry.of_role(ObjectRole::Proxy);
     let Some((lo, hi)) = room.mesh.bounds() else {
         anyhow::bail!(
             "{}: no room to capture probes in: give its surfaces role = \"proxy\"",

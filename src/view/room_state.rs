@@ -40,11 +40,7 @@ impl RoomState {
         settings: DecomposeSettings,
     ) -> anyhow::Result<Self> {
         let model = RoomModel::open(scene, map.rotated(rotation_deg), settings)?;
-        let room = Scene {
-            geometry: scene.geometry.subset(|o| o.role == ObjectRole::Proxy),
-            backplate: None,
-            ..scene.clone()
-        };
+        let room = scene.of_role(ObjectRole::Proxy).without_backplate();
         let pose = (model.path.as_ref())
             .and_then(|p| p.poses().first().copied())
             .unwrap_or(Pose::at(model.centre));

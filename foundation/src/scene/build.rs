@@ -153,7 +153,7 @@ fn check_probes(geometry: &SceneMesh, probes: &[ProbeSource]) -> Result<(), Stri
     if probes.is_empty() {
         return Ok(());
     }
-    let room = geometry.subset(|o| o.role == ObjectRole::Proxy);
+    let room = geometry.of_role(ObjectRole::Proxy);
     let Some((lo, hi)) = room.mesh.bounds() else {
         return Err("[[probe]] needs the room the probes light: objects with \
                     role = \"proxy\""

@@ -157,6 +157,12 @@ impl SceneMesh {
         self.objects.iter().any(|o| o.role == ObjectRole::Proxy)
     }
 
+    /// The objects of `role` alone (the room's proxies, the virtual objects), as
+    /// [`Self::subset`] keeps them.
+    pub fn of_role(&self, role: ObjectRole) -> SceneMesh {
+        self.subset(|o| o.role == role)
+    }
+
     /// The objects `keep` accepts, as a scene mesh of their own (their names, albedos,
     /// textures, materials and roles kept; triangles in the same order).
     pub fn subset(&self, keep: impl Fn(&SceneObject) -> bool) -> SceneMesh {
@@ -341,11 +347,7 @@ mod tests {
             rotation: Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
         };
         geometry.pose_objects(centre, pose);
-        let (lo, hi) = geometry
-            .subset(|o| o.role == ObjectRole::Object)
-            .mesh
-            .bounds()
-            .unwrap();
+        let (lo, hi) = geometry.of_role(ObjectRole::Object).mesh.bounds().unwrap();
         // 2 × 1 × 1 along x turns into 1 × 1 × 2 along z, about the new centre.
         assert!(lo.distance(Vec3::new(-0.5, 0.0, -1.0)) < 1e-5, "{lo}");
         assert!(hi.distance(Vec3::new(0.5, 1.0, 1.0)) < 1e-5, "{hi}");

@@ -65,6 +65,43 @@ pub struct Scene {
     pub sources: Vec<PathBuf>,
 }
 
+/// Variants of a scene: a part of its geometry (the room, the model) or geometry changed
+/// (the model collapsed), the rest of the scene kept.
+impl Scene {
+    /// This scene with `geometry` in place of its own (its own is not copied).
+    pub fn with_geometry(&self, geometry: SceneMesh) -> Scene {
+        Scene {
+            name: self.name.clone(),
+            path: self.path.clone(),
+            geometry,
+            camera: self.camera,
+            environment: self.environment.clone(),
+            bake: self.bake,
+            backplate: self.backplate.clone(),
+            probes: self.probes.clone(),
+            model_path: self.model_path.clone(),
+            sources: self.sources.clone(),
+        }
+    }
+
+    /// This scene's objects of `role` alone, the rest of the scene kept.
+    pub fn of_role(&self, role: ObjectRole) -> Scene {
+        self.with_geometry(self.geometry.of_role(role))
+    }
+
+    /// Named `name-suffix` (a part's bake is cached apart from the whole's).
+    pub fn renamed(mut self, suffix: &str) -> Scene {
+        self.name = format!("{}-{suffix}", self.name);
+        self
+    }
+
+    /// Not composited into its backplate: its proxies drawn as surfaces of their own.
+    pub fn without_backplate(mut self) -> Scene {
+        self.backplate = None;
+        self
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::build::transform_mesh;
@@ -175,10 +212,18 @@ mod tests {
         assert_eq!(scene.backplate, Some(Backplate::Environment));
         let roles: Vec<ObjectRole> = scene.geometry.objects.iter().map(|o| o.role).collect();
         assert_eq!(roles, [ObjectRole::Object, ObjectRole::Proxy]);
-        let proxies = scene.geometry.subset(|o| o.role == ObjectRole::Proxy);
+        let proxies = scene.geometry.of_role(ObjectRole::Proxy);
         assert_eq!(proxies.objects.len(), 1);
         assert_eq!(proxies.objects[0].name, "floor");
         assert_eq!(proxies.mesh.triangle_count(), 12);
+        // The room as a scene of its own: the rest kept, then renamed and not composited.
+        let room = scene.of_role(ObjectRole::Proxy);
+        assert_eq!(room.geometry.content_hash(), proxies.content_hash());
+        assert_eq!((&room.name, &room.backplate), (&scene.name, &scene.backplate));
+        assert_eq!((room.camera, room.bake), (scene.camera, scene.bake));
+        let room = room.renamed("room").without_backplate();
+        assert_eq!(room.name, format!("{}-room", scene.name));
+        assert_eq!(room.backplate, None);
 
         // A photograph resolves against the scene's folder and counts as an input.
         let scene = load(format!(

@@ -79,7 +79,7 @@ impl RoomShadow {
                 })),
             }
         }
-        let model = geometry.subset(|o| o.role == ObjectRole::Object).mesh;
+        let model = geometry.of_role(ObjectRole::Object).mesh;
         let radius = (model.positions.iter())
             .map(|p| p.distance(rest_centre))
             .fold(0.0, f32::max);

@@ -100,7 +100,7 @@ fn bakes(scene: &Scene, samples: u32) -> anyhow::Result<(Transfer, Transfer)> {
         let bvh = SceneBvh::build(&geometry.mesh);
         bake::bake(geometry, &bvh, &settings, &NoProgress).map(|(t, _)| t)
     };
-    let proxies = scene.geometry.subset(|o| o.role == ObjectRole::Proxy);
+    let proxies = scene.geometry.of_role(ObjectRole::Proxy);
     Ok((bake_of(&scene.geometry)?, bake_of(&proxies)?))
 }
 

@@ -52,7 +52,7 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
         scene.path.display(),
         scene.probes.len()
     );
-    let room = scene.geometry.subset(|o| o.role == ObjectRole::Proxy);
+    let room = scene.geometry.of_role(ObjectRole::Proxy);
     let proxies = SceneBvh::build(&room.mesh);
     let probes: Vec<Probe> = scene
         .probes
@@ -265,7 +265,7 @@ fn print_soft_shadow(scene: &Scene, frames: &[ProbeFrame]) {
     let Some(path) = &scene.model_path else {
         return;
     };
-    let model = scene.geometry.subset(|o| o.role == ObjectRole::Object);
+    let model = scene.geometry.of_role(ObjectRole::Object);
     let Some((lo, hi)) = model.mesh.bounds() else {
         return;
     };

@@ -153,7 +153,7 @@ impl PathRun {
         settings: &ReportSettings,
     ) -> anyhow::Result<Self> {
         let shadow = ShadowSettings::default();
-        let room_geometry = scene.geometry.subset(|o| o.role == ObjectRole::Proxy);
+        let room_geometry = scene.geometry.of_role(ObjectRole::Proxy);
         let mut whole = Renderer::new(gpu, &model.geometry, &model.transfer, camera, shadow)?;
         let mut room = Renderer::new(gpu, &room_geometry, &model.room_transfer, camera, shadow)?;
         whole.set_environment(map, rotation_deg);
@@ -172,11 +172,9 @@ impl PathRun {
             target_noise: None,
             ..settings.reference_request(exposure)
         };
-        let room_scene = Scene {
-            geometry: room_geometry.clone(),
-            backplate: None,
-            ..scene.clone()
-        };
+        let room_scene = scene
+            .with_geometry(room_geometry.clone())
+            .without_backplate();
         let no_limit = |_: &ReferenceImages| f64::INFINITY;
         let empty = reference_images(&room_scene, camera, map, rotation_deg, &request, &no_limit)
             .context("cannot render the empty room's truth")?;
@@ -246,7 +244,7 @@ impl PathRun {
             ys.push(y);
             images.push(image);
         }
-        let model_mesh = geometry.subset(|o| o.role == ObjectRole::Object).mesh;
+        let model_mesh = geometry.of_role(ObjectRole::Object).mesh;
         let position = PathPosition {
             frame,
             centre: centre.to_array(),
@@ -270,11 +268,9 @@ impl PathRun {
     }
 
     fn scene_with(&self, geometry: &SceneMesh) -> Scene {
-        Scene {
-            geometry: geometry.clone(),
-            backplate: None,
-            ..self.scene.clone()
-        }
+        self.scene
+            .with_geometry(geometry.clone())
+            .without_backplate()
     }
 
     /// The room path-traced with the model placed as in `geometry`.
