@@ -1,5 +1,6 @@
 //! The layout rules of the source tree (README, "Layout"), checked on every test run: no import
-//! cycle between files, no function over 100 lines outside tests, no source file over 600 lines.
+//! cycle between files, no function over 100 lines outside tests, no source file over 600 lines,
+//! no printing from a library (progress and warnings go through what the caller gives).
 //!
 //! The checks read the sources as text with a small tokenizer (strings, characters and comments
 //! skipped), which is all these rules need.
@@ -9,7 +10,7 @@ mod scan;
 #[path = "layout/tokens.rs"]
 mod tokens;
 
-use scan::{SourceTree, function_spans};
+use scan::{SourceTree, function_spans, prints_outside_tests};
 use std::path::Path;
 use tokens::tokens;
 
@@ -81,6 +82,24 @@ fn no_import_cycle_between_files() {
 }
 
 /// The checks themselves: each finds what it must on a small made-up crate.
+/// Libraries report through a `Progress` or the `log` facade the program (or the Python
+/// module) routes; only the program, `src/`, prints.
+#[test]
+fn libraries_never_print() {
+    let tree = tree();
+    let program = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut found = Vec::new();
+    for file in tree
+        .all_files()
+        .filter(|f| !f.is_test_file && !f.path.starts_with(&program))
+    {
+        for line in prints_outside_tests(&tokens(&file.text)) {
+            found.push(format!("{}:{line}", file.path.display()));
+        }
+    }
+    assert!(found.is_empty(), "a library prints:\n{}", found.join("\n"));
+}
+
 #[test]
 fn the_checks_find_what_they_look_for() {
     let dir = tempfile::tempdir().unwrap();
@@ -122,6 +141,9 @@ fn the_checks_find_what_they_look_for() {
     assert!(helper.lines > MAX_FUNCTION_LINES && !helper.in_test);
     assert!(spans.iter().find(|s| s.name == "long").unwrap().in_test);
     assert!(b.lines > 2 * MAX_FUNCTION_LINES);
+    let printing = "fn f() {\n    println!(\"x\");\n    log::info!(\"y\");\n}\n\
+                    // eprintln!(\"in a comment\")\n#[cfg(test)]\nmod tests {\n    fn g() { dbg!(1); }\n}\n";
+    assert_eq!(prints_outside_tests(&tokens(printing)), [2]);
 }
 
 /// Every path the documentation names (in backticks) exists, so the layout table and the

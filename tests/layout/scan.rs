@@ -126,6 +126,17 @@ pub fn function_spans(toks: &[Token]) -> Vec<FunctionSpan> {
     spans
 }
 
+/// The lines of `println!`, `print!`, `eprintln!`, `eprint!` and `dbg!` outside test code.
+pub fn prints_outside_tests(toks: &[Token]) -> Vec<usize> {
+    const PRINTS: [&str; 5] = ["println", "print", "eprintln", "eprint", "dbg"];
+    let tests = test_spans(toks);
+    (0..toks.len().saturating_sub(1))
+        .filter(|&i| PRINTS.iter().any(|p| is_ident(&toks[i], p)) && is_punct(&toks[i + 1], '!'))
+        .filter(|&i| !tests.iter().any(|&(s, e)| s <= i && i <= e))
+        .map(|i| toks[i].line)
+        .collect()
+}
+
 /// One path a file refers to, split into segments, and whether it is a re-export.
 struct PathRef {
     segments: Vec<String>,

@@ -219,7 +219,10 @@ mod tests {
         // The room as a scene of its own: the rest kept, then renamed and not composited.
         let room = scene.of_role(ObjectRole::Proxy);
         assert_eq!(room.geometry.content_hash(), proxies.content_hash());
-        assert_eq!((&room.name, &room.backplate), (&scene.name, &scene.backplate));
+        assert_eq!(
+            (&room.name, &room.backplate),
+            (&scene.name, &scene.backplate)
+        );
         assert_eq!((room.camera, room.bake), (scene.camera, scene.bake));
         let room = room.renamed("room").without_backplate();
         assert_eq!(room.name, format!("{}-room", scene.name));
