@@ -11,7 +11,7 @@ mod scan;
 mod tokens;
 
 use scan::{SourceTree, function_spans, prints_outside_tests};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use tokens::tokens;
 
 const MAX_FUNCTION_LINES: usize = 100;
@@ -152,13 +152,20 @@ fn the_checks_find_what_they_look_for() {
 fn the_documentation_names_paths_that_exist() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut missing = Vec::new();
-    for doc in [
-        "README.md",
-        "CONVENTIONS.md",
-        "scenes/README.md",
-        "docs/shadows.md",
-    ] {
+    let mut docs: Vec<PathBuf> = ["README.md", "CONVENTIONS.md", "scenes/README.md"]
+        .iter()
+        .map(PathBuf::from)
+        .collect();
+    docs.extend(
+        std::fs::read_dir(root.join("docs"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "md"))
+            .map(|p| PathBuf::from("docs").join(p.file_name().unwrap())),
+    );
+    for doc in &docs {
         let text = std::fs::read_to_string(root.join(doc)).unwrap();
+        let doc = doc.display();
         let mut in_rooms = false;
         for line in text.lines() {
             if line.starts_with("Rooms for the work now being built") {
@@ -183,10 +190,79 @@ fn the_documentation_names_paths_that_exist() {
     );
 }
 
+/// Every folder of source (each crate's `src/`, the Python module's, the shaders) is in the
+/// README's Layout tables: named in full, or by its own name in the row of its parent folder.
+#[test]
+fn the_layout_table_names_every_source_folder() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let layout = readme
+        .split("\n## Layout")
+        .nth(1)
+        .and_then(|rest| rest.split("\n## ").next())
+        .expect("README has a Layout section");
+    let rows: Vec<Vec<&str>> = layout
+        .lines()
+        .filter(|l| l.starts_with('|'))
+        .map(|l| l.split('`').skip(1).step_by(2).collect())
+        .collect();
+    let named = |path: &str| rows.iter().any(|r| r.contains(&path));
+    let mut folders = Vec::new();
+    for top in [
+        "foundation",
+        "precompute",
+        "reference",
+        "runtime",
+        "capture",
+        "python",
+        ".",
+    ] {
+        folders.extend(source_folders(&root.join(top).join("src"), root));
+    }
+    let missing: Vec<String> = folders
+        .into_iter()
+        .filter(|f| {
+            let (parent, name) = f.rsplit_once('/').unwrap_or(("", f));
+            let in_parent_row = rows.iter().any(|r| {
+                r.contains(&format!("{parent}/").as_str())
+                    && (r.contains(&name) || r.contains(&format!("{name}/").as_str()))
+            });
+            // A crate's `src/` is its row in the crates' table.
+            let crate_row = name == "src" && named(&format!("{parent}/"));
+            !named(&format!("{f}/")) && !in_parent_row && !crate_row
+        })
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "source folders the README's Layout does not name:\n{}",
+        missing.join("\n")
+    );
+}
+
+/// `dir` and every folder below it, relative to `root`, `/`-separated.
+fn source_folders(dir: &Path, root: &Path) -> Vec<String> {
+    let mut out = vec![
+        dir.strip_prefix(root)
+            .unwrap()
+            .to_string_lossy()
+            .trim_start_matches("./")
+            .to_owned(),
+    ];
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            out.extend(source_folders(&path, root));
+        }
+    }
+    out
+}
+
 /// Paths in backticks that start at one of the repository's top-level folders.
 fn backticked_repo_paths(line: &str) -> Vec<String> {
-    const TOP: [&str; 9] = [
+    const TOP: [&str; 11] = [
         "foundation/",
+        "capture/",
+        "python/",
         "precompute/",
         "reference/",
         "runtime/",
