@@ -84,6 +84,28 @@ class Camera:
     @property
     def up(self) -> tuple[float, float, float]: ...
 
+class SceneObject:
+    """One object of a scene: its role and its (Phong) material."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def role(self) -> Literal["object", "proxy"]: ...
+    @property
+    def albedo(self) -> tuple[float, float, float]:
+        """Diffuse albedo, or a textured object's texture factor."""
+    @property
+    def textured(self) -> bool: ...
+    @property
+    def specular(self) -> tuple[float, float, float]:
+        """Phong k_s per channel (zero: diffuse)."""
+    @property
+    def shininess(self) -> float: ...
+    @property
+    def vertex_count(self) -> int: ...
+    @property
+    def triangle_count(self) -> int: ...
+
 class Scene:
     """A scene file or a model placed in a default scene."""
 
@@ -98,7 +120,8 @@ class Scene:
     @property
     def path(self) -> Path: ...
     @property
-    def objects(self) -> list[str]: ...
+    def objects(self) -> list[SceneObject]:
+        """Its objects, in order, with their materials."""
     @property
     def vertex_count(self) -> int: ...
     @property

@@ -30,6 +30,7 @@ fn _hprt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::bake, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_bake, m)?)?;
     m.add_class::<scene::Scene>()?;
+    m.add_class::<scene::SceneObject>()?;
     m.add_class::<scene::Bake>()?;
     m.add_class::<render::Renderer>()?;
     m.add_function(wrap_pyfunction!(reference::reference, m)?)?;

@@ -3,7 +3,7 @@
 
 use crate::progress::with_progress;
 use foundation::bvh::SceneBvh;
-use foundation::scene::Scene as SceneData;
+use foundation::scene::{ObjectRole, Scene as SceneData};
 use numpy::ndarray::{Array3, ArrayView3};
 use numpy::{IntoPyArray, PyArray3};
 use precompute::bake::{Transfer, TransferVectors};
@@ -32,14 +32,14 @@ impl Scene {
         self.data.path.clone()
     }
 
-    /// Its objects' names, in order.
+    /// Its objects, in order, with their materials.
     #[getter]
-    fn objects(&self) -> Vec<String> {
+    fn objects(&self) -> Vec<SceneObject> {
         self.data
             .geometry
             .objects
             .iter()
-            .map(|o| o.name.clone())
+            .map(SceneObject::from)
             .collect()
     }
 
@@ -77,6 +77,52 @@ impl Scene {
             self.data.name,
             self.data.geometry.objects.len(),
             self.triangle_count()
+        )
+    }
+}
+
+/// One object of a scene: its part of the mesh, its role and its material (the Phong
+/// material: a diffuse albedo, or texture factor, plus a specular lobe).
+#[pyclass(module = "hprt", frozen, get_all)]
+#[derive(Clone)]
+pub(crate) struct SceneObject {
+    name: String,
+    /// "object" (a virtual object) or "proxy" (a stand-in for a real surface).
+    role: &'static str,
+    /// Diffuse albedo `k_d`, or for a textured object the factor its texture is multiplied by.
+    albedo: [f32; 3],
+    textured: bool,
+    /// Phong `k_s` per channel (zero: diffuse) and exponent.
+    specular: [f32; 3],
+    shininess: f32,
+    vertex_count: u32,
+    triangle_count: u32,
+}
+
+impl From<&foundation::scene::SceneObject> for SceneObject {
+    fn from(o: &foundation::scene::SceneObject) -> Self {
+        Self {
+            name: o.name.clone(),
+            role: match o.role {
+                ObjectRole::Object => "object",
+                ObjectRole::Proxy => "proxy",
+            },
+            albedo: o.albedo.to_array(),
+            textured: o.texture.is_some(),
+            specular: o.material.specular.to_array(),
+            shininess: o.material.shininess,
+            vertex_count: o.vertices.end - o.vertices.start,
+            triangle_count: o.triangles.end - o.triangles.start,
+        }
+    }
+}
+
+#[pymethods]
+impl SceneObject {
+    fn __repr__(&self) -> String {
+        format!(
+            "SceneObject({:?}, role={}, albedo={:?}, triangles={})",
+            self.name, self.role, self.albedo, self.triangle_count
         )
     }
 }

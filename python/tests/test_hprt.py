@@ -220,6 +220,17 @@ class BakeAndRender(unittest.TestCase):
         with self.assertRaises(KeyboardInterrupt):
             hprt.reference(self.scene, INTERIOR, spp=1, width=16, height=12, progress=fail)
 
+    def test_objects_carry_their_roles_and_materials(self) -> None:
+        objects = self.scene.objects
+        self.assertEqual(sum(o.vertex_count for o in objects), self.scene.vertex_count)
+        self.assertEqual(sum(o.triangle_count for o in objects), self.scene.triangle_count)
+        self.assertTrue(all(o.role == "object" for o in objects))
+        composite = hprt.load_scene(SCENES / "teapot_composite.toml")
+        self.assertIn("proxy", {o.role for o in composite.objects})
+        glossy = hprt.load_scene(SCENES / "teapot_glossy.toml")
+        shiny = [o for o in glossy.objects if max(o.specular) > 0.0]
+        self.assertTrue(shiny and all(o.shininess > 1.0 for o in shiny))
+
     def test_a_missing_scene_names_its_file(self) -> None:
         with self.assertRaisesRegex(hprt.HprtError, "no_such_scene.toml"):
             hprt.load_scene("no_such_scene.toml")
