@@ -32,6 +32,9 @@ pub(crate) fn reference<'py>(
     camera: Option<Camera>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    if spp == 0 {
+        return Err(PyValueError::new_err("spp must be at least 1"));
+    }
     let settings = ReferenceSettings::new(spp, bounces, seed);
     settings
         .validate()

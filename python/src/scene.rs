@@ -226,6 +226,9 @@ fn vectors_array(vectors: &TransferVectors) -> Array3<f32> {
         .expect("vertices × 3 × order² coefficients")
 }
 
+/// Most threads a bake may be asked for: each is a real thread of this process.
+const MAX_THREADS: usize = 1024;
+
 /// Bakes `scene` (its `[bake]` settings, each overridden where given) on `threads` threads
 /// (all cores when `None`); the same bits whatever the thread count. `progress(stage, done,
 /// total)` is called at most once per percent of each stage.
@@ -250,8 +253,10 @@ pub(crate) fn bake(
         seed: seed.unwrap_or(defaults.seed),
     };
     settings.validate().map_err(crate::errors::hprt_error)?;
-    if threads == Some(0) {
-        return Err(PyValueError::new_err("threads must be at least 1"));
+    if let Some(n) = threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
+        return Err(PyValueError::new_err(format!(
+            "threads {n}: from 1 to {MAX_THREADS}"
+        )));
     }
     let data = Arc::clone(&scene.data);
     let result = py.detach(move || {

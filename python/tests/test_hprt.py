@@ -220,6 +220,24 @@ class BakeAndRender(unittest.TestCase):
         with self.assertRaises(KeyboardInterrupt):
             hprt.reference(self.scene, INTERIOR, spp=1, width=16, height=12, progress=fail)
 
+    def test_hostile_arguments_are_refused_before_any_work(self) -> None:
+        with self.assertRaisesRegex(ValueError, "threads"):
+            hprt.bake(self.scene, samples=1, threads=10**6)
+        with self.assertRaisesRegex(ValueError, "spp"):
+            hprt.reference(self.scene, INTERIOR, spp=0, width=4, height=3)
+        with self.assertRaisesRegex(ValueError, "over the limit"):
+            hprt.reference(self.scene, INTERIOR, width=100000, height=100000)
+        with self.assertRaisesRegex(ValueError, "coincide"):
+            hprt.reference(
+                self.scene, INTERIOR, width=4, height=3, camera=hprt.Camera((0, 0, 0), (0, 0, 0))
+            )
+        with self.assertRaisesRegex(hprt.HprtError, "samples"):
+            hprt.bake(self.scene, samples=0)
+        with self.assertRaisesRegex(hprt.HprtError, "bad magic"):
+            hprt.load_bake(self.scene, ROOT / "README.md")
+        with self.assertRaisesRegex(ValueError, "order"):
+            hprt.Light((0.0, 1.0, 0.0), (1.0, 1.0, 1.0)).sh(1000)
+
     def test_objects_carry_their_roles_and_materials(self) -> None:
         objects = self.scene.objects
         self.assertEqual(sum(o.vertex_count for o in objects), self.scene.vertex_count)
