@@ -1,38 +1,16 @@
-//! Bakes for the commands: reading a given bake (checked against the scene), and bakes cached
-//! per scene and settings, so the viewer, the reports and the demo reuse them.
+//! Bakes for the commands: reading a given bake (checked against the scene), and the bake
+//! cache (`precompute::cache`, shared with the viewer and the Python module) as the command
+//! line shows it.
 
 use crate::support::TerminalProgress;
 use anyhow::Context;
-use foundation::bvh::SceneBvh;
-use foundation::infra::progress::Progress;
 use foundation::scene::Scene;
-use precompute::bake::{BakeSettings, BakeStats, Transfer};
+use precompute::bake::{BakeStats, Transfer};
 use precompute::bakefile;
+pub use precompute::cache::{
+    bake_into_cache, bake_path, cache_dir, create_cache_folder, load_cached,
+};
 use std::path::{Path, PathBuf};
-
-/// The cache folder: `$HPRT_CACHE`, else `$XDG_CACHE_HOME/hprt`, else `~/.cache/hprt`.
-pub fn cache_dir() -> PathBuf {
-    if let Some(dir) = std::env::var_os("HPRT_CACHE") {
-        return PathBuf::from(dir);
-    }
-    if let Some(dir) = std::env::var_os("XDG_CACHE_HOME") {
-        return PathBuf::from(dir).join("hprt");
-    }
-    std::env::var_os("HOME")
-        .map(|home| PathBuf::from(home).join(".cache").join("hprt"))
-        .unwrap_or_else(|| std::env::temp_dir().join("hprt-cache"))
-}
-
-/// Creates a folder of the cache, naming the variables that chose it when that fails.
-pub fn create_cache_folder(dir: &Path) -> anyhow::Result<()> {
-    crate::support::create_folder(dir).with_context(|| {
-        format!(
-            "cannot use the cache folder {} (chosen by HPRT_CACHE, else XDG_CACHE_HOME, else \
-             HOME)",
-            cache_dir().display()
-        )
-    })
-}
 
 /// Reads the scene's bake, refusing one of another mesh, or one whose SH order is below the
 /// lighting order asked (a lower lighting order than the bake's just drops bands).
@@ -50,46 +28,6 @@ pub fn load_bake(scene: &Scene, path: &Path, order: Option<usize>) -> anyhow::Re
         );
     }
     Ok(transfer)
-}
-
-/// Where the bake of `scene` with `settings` is cached: the name carries the scene's mesh hash
-/// and the settings, so any change of either misses the cache.
-pub fn bake_path(scene: &Scene, settings: &BakeSettings) -> PathBuf {
-    let hash: String = scene.geometry.content_hash()[..8]
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    cache_dir().join(format!(
-        "{}-{hash}-o{}-s{}-b{}-seed{}.bake",
-        foundation::infra::names::as_file_name(&scene.name),
-        settings.order,
-        settings.samples,
-        settings.bounces,
-        settings.seed
-    ))
-}
-
-/// The cached bake of `scene` with `settings`, if there is a usable one.
-pub fn load_cached(scene: &Scene, settings: &BakeSettings) -> Option<(PathBuf, Transfer)> {
-    let path = bake_path(scene, settings);
-    let transfer = load_bake(scene, &path, None).ok()?;
-    Some((path, transfer))
-}
-
-/// Bakes `scene` with `settings` into the cache (atomically), reporting on `progress`.
-pub fn bake_into_cache(
-    scene: &Scene,
-    settings: &BakeSettings,
-    progress: &dyn Progress,
-) -> anyhow::Result<(PathBuf, Transfer, BakeStats)> {
-    let path = bake_path(scene, settings);
-    let bvh = SceneBvh::build(&scene.geometry.mesh);
-    let (transfer, stats) = precompute::bake::bake(&scene.geometry, &bvh, settings, progress)?;
-    if let Some(dir) = path.parent() {
-        create_cache_folder(dir)?;
-    }
-    precompute::bakefile::write(&path, &transfer, &scene.geometry.content_hash())?;
-    Ok((path, transfer, stats))
 }
 
 /// `bake` if given, else the cached bake of the scene's settings, baking it if missing.

@@ -10,4 +10,5 @@
 
 pub mod bake;
 pub mod bakefile;
+pub mod cache;
 pub mod shardfile;

@@ -200,8 +200,10 @@ def bake(
     seed: Optional[int] = None,
     threads: Optional[int] = None,
     progress: Optional[Progress] = None,
+    cache: bool = False,
 ) -> Bake:
-    """Bakes the scene; its ``[bake]`` settings where an argument is not given."""
+    """Bakes the scene; its ``[bake]`` settings where an argument is not given. With
+    ``cache``, reads the bake from (or writes it to) the cache the command line shares."""
 
 def load_bake(scene: Scene, path: Union[str, "os.PathLike[str]"]) -> Bake:
     """Loads a ``.bake`` file of ``scene``."""

@@ -1,12 +1,15 @@
 //! Scenes and their bakes: `hprt.load_scene`, `hprt.bake`, `hprt.load_bake`, and the bake's
 //! transfer as arrays.
 
+use crate::errors::HprtError;
 use crate::progress::with_progress;
+use foundation::bake_settings::BakeSettings;
 use foundation::bvh::SceneBvh;
 use foundation::scene::{ObjectRole, Scene as SceneData};
 use numpy::ndarray::{Array3, ArrayView3};
 use numpy::{IntoPyArray, PyArray3};
 use precompute::bake::{Transfer, TransferVectors};
+use precompute::cache;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::IntoPyDict;
@@ -231,9 +234,12 @@ const MAX_THREADS: usize = 1024;
 
 /// Bakes `scene` (its `[bake]` settings, each overridden where given) on `threads` threads
 /// (all cores when `None`); the same bits whatever the thread count. `progress(stage, done,
-/// total)` is called at most once per percent of each stage.
+/// total)` is called at most once per percent of each stage. With `cache`, the bake is read
+/// from the cache the command line and the viewer share (`$HPRT_CACHE`, else
+/// `$XDG_CACHE_HOME/hprt`, else `~/.cache/hprt`) when it holds this geometry and these
+/// settings, and written there when not.
 #[pyfunction]
-#[pyo3(signature = (scene, samples = None, bounces = None, order = None, seed = None, threads = None, progress = None))]
+#[pyo3(signature = (scene, samples = None, bounces = None, order = None, seed = None, threads = None, progress = None, cache = false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn bake(
     py: Python<'_>,
@@ -244,9 +250,10 @@ pub(crate) fn bake(
     seed: Option<u64>,
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
+    cache: bool,
 ) -> PyResult<Bake> {
     let defaults = scene.data.bake;
-    let settings = foundation::bake_settings::BakeSettings {
+    let settings = BakeSettings {
         samples: samples.unwrap_or(defaults.samples),
         bounces: bounces.unwrap_or(defaults.bounces),
         order: order.unwrap_or(defaults.order),
@@ -258,28 +265,36 @@ pub(crate) fn bake(
             "threads {n}: from 1 to {MAX_THREADS}"
         )));
     }
+    let mesh_hash = scene.data.geometry.content_hash();
     let data = Arc::clone(&scene.data);
-    let result = py.detach(move || {
+    let transfer = py.detach(move || {
+        if cache && let Some((_, transfer)) = cache::load_cached(&data, &settings) {
+            return Ok(transfer);
+        }
         with_progress(progress, "bake", |progress| {
-            let run = || {
+            let run = || -> Result<Transfer, String> {
+                if cache {
+                    let baked = cache::bake_into_cache(&data, &settings, progress);
+                    return baked.map(|(_, t, _)| t).map_err(|e| e.to_string());
+                }
                 let bvh = SceneBvh::build(&data.geometry.mesh);
-                precompute::bake::bake(&data.geometry, &bvh, &settings, progress)
+                let baked = precompute::bake::bake(&data.geometry, &bvh, &settings, progress);
+                baked.map(|(t, _)| t).map_err(|e| e.to_string())
             };
             match threads {
-                None => Ok(run()),
+                None => run(),
                 Some(n) => rayon::ThreadPoolBuilder::new()
                     .num_threads(n)
                     .build()
-                    .map(|pool| pool.install(run)),
+                    .map_err(|e| e.to_string())
+                    .and_then(|pool| pool.install(run)),
             }
-        })
-    });
-    let (transfer, _) = result?
-        .map_err(crate::errors::hprt_error)?
-        .map_err(crate::errors::hprt_error)?;
+        })?
+        .map_err(HprtError::new_err)
+    })?;
     Ok(Bake {
         transfer: Arc::new(transfer),
-        mesh_hash: scene.data.geometry.content_hash(),
+        mesh_hash,
     })
 }
 

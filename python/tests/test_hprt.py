@@ -122,6 +122,31 @@ class BakeAndRender(unittest.TestCase):
         self.assertEqual(float(np.abs(orphan).sum()), 0.0)  # no bounces: nothing indirect
         self.assertEqual(orphan.shape, (self.scene.vertex_count, 3, 4))
 
+    def test_a_cached_bake_is_read_back_not_baked_again(self) -> None:
+        calls: list[tuple[str, int, int]] = []
+
+        def record(stage: str, done: int, total: int) -> None:
+            calls.append((stage, done, total))
+
+        with tempfile.TemporaryDirectory() as folder:
+            previous = os.environ.get("HPRT_CACHE")
+            os.environ["HPRT_CACHE"] = folder
+            try:
+                first = hprt.bake(self.scene, samples=8, bounces=0, order=2, cache=True, progress=record)
+                self.assertGreater(len(calls), 0)
+                self.assertEqual(len(list(Path(folder).glob("teapot-*-o2-s8-b0-seed*.bake"))), 1)
+                calls.clear()
+                second = hprt.bake(self.scene, samples=8, bounces=0, order=2, cache=True, progress=record)
+                self.assertEqual(calls, [])
+            finally:
+                if previous is None:
+                    del os.environ["HPRT_CACHE"]
+                else:
+                    os.environ["HPRT_CACHE"] = previous
+        np.testing.assert_array_equal(second.transfer, first.transfer)
+        fresh = hprt.bake(self.scene, samples=8, bounces=0, order=2)
+        np.testing.assert_array_equal(fresh.transfer, first.transfer)
+
     def test_the_bits_do_not_depend_on_threads_and_survive_a_file(self) -> None:
         one = hprt.bake(self.scene, samples=16, bounces=1, order=3, threads=1)
         two = hprt.bake(self.scene, samples=16, bounces=1, order=3, threads=2)

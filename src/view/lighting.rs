@@ -74,7 +74,8 @@ impl App {
         let (sender, receiver) = std::sync::mpsc::channel();
         std::thread::spawn(move || {
             let result = bake_cache::bake_into_cache(&scene, &scene.bake, shared.as_ref())
-                .map(|(_, transfer, _)| transfer);
+                .map(|(_, transfer, _)| transfer)
+                .map_err(anyhow::Error::from);
             let _ = sender.send(result);
         });
         self.bake.job = Some(BakeJob {
