@@ -16,6 +16,7 @@ from ._hprt import (
     Bake,
     Camera,
     Captured,
+    Composite,
     Decomposition,
     HprtError,
     Light,
@@ -29,12 +30,14 @@ from ._hprt import (
     load_map,
     load_scene,
     reference,
+    reference_composite,
 )
 
 __all__ = [
     "Bake",
     "Camera",
     "Captured",
+    "Composite",
     "Decomposition",
     "HprtError",
     "Light",
@@ -48,4 +51,5 @@ __all__ = [
     "load_map",
     "load_scene",
     "reference",
+    "reference_composite",
 ]

@@ -127,6 +127,9 @@ class Scene:
     @property
     def triangle_count(self) -> int: ...
     @property
+    def rotation_deg(self) -> float:
+        """The map's rotation renders and references use when given none."""
+    @property
     def environment(self) -> Optional[Path]:
         """The map the scene names, if any."""
 
@@ -169,7 +172,7 @@ class Renderer:
         self,
         lighting: Union[MapArgument, Decomposition],
         mode: RenderMode = "hybrid",
-        rotation_deg: float = 0.0,
+        rotation_deg: Optional[float] = None,
         decompose_mode: DecomposeMode = "consistent",
         camera: Optional[Camera] = None,
         background: Optional[MapArgument] = None,
@@ -214,13 +217,46 @@ def reference(
     spp: int = 64,
     bounces: int = 4,
     seed: int = 0,
-    rotation_deg: float = 0.0,
+    rotation_deg: Optional[float] = None,
     width: Optional[int] = None,
     height: Optional[int] = None,
     camera: Optional[Camera] = None,
     progress: Optional[Progress] = None,
 ) -> Image:
-    """The path-traced image, ``(height, width, 3) float32``."""
+    """The path-traced image, ``(height, width, 3) float32``; the map turned by the scene's
+    rotation when ``rotation_deg`` is not given."""
+
+class Composite:
+    """A composite into the scene's backplate and its layers."""
+
+    @property
+    def image(self) -> Image: ...
+    @property
+    def objects(self) -> Image:
+        """The objects' radiance on object pixels, zero elsewhere."""
+    @property
+    def ratio(self) -> Image:
+        """The shadow ratio on proxy pixels, one elsewhere."""
+    @property
+    def kinds(self) -> npt.NDArray[np.uint8]:
+        """Per pixel: 0 object, 1 proxy, 2 backplate."""
+    @property
+    def changed(self) -> npt.NDArray[np.bool_]:
+        """Proxy pixels the objects change by more than 2%."""
+
+def reference_composite(
+    scene: Scene,
+    map: MapArgument,
+    spp: int = 64,
+    bounces: int = 4,
+    seed: int = 0,
+    rotation_deg: Optional[float] = None,
+    width: Optional[int] = None,
+    height: Optional[int] = None,
+    camera: Optional[Camera] = None,
+    progress: Optional[Progress] = None,
+) -> Composite:
+    """The path-traced true composite of a scene with a ``[backplate]``."""
 
 class Captured:
     """A map captured from photographs."""

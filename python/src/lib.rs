@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 
 mod camera;
 mod capture;
+mod composite;
 mod decompose;
 mod errors;
 mod maps;
@@ -37,5 +38,7 @@ fn _hprt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<camera::Camera>()?;
     m.add_function(wrap_pyfunction!(capture::capture, m)?)?;
     m.add_class::<capture::Captured>()?;
+    m.add_function(wrap_pyfunction!(composite::reference_composite, m)?)?;
+    m.add_class::<composite::Composite>()?;
     Ok(())
 }

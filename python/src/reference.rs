@@ -12,12 +12,12 @@ use pyo3::prelude::*;
 use std::sync::Arc;
 
 /// Path-traces `scene` under `map` (a path or an `(H, W, 3) float32` array) turned by
-/// `rotation_deg`: `spp` samples per pixel, `bounces` interreflections, `seed`. The image is
+/// `rotation_deg` (the scene's when not given, as on the command line): `spp` samples per pixel, `bounces` interreflections, `seed`. The image is
 /// `width` × `height` (the scene camera's size when not given), seen by `camera` (the scene's
 /// when not given); the same bits whatever the thread count. `progress(stage, done, total)`
 /// counts image rows.
 #[pyfunction]
-#[pyo3(signature = (scene, map, spp = 64, bounces = 4, seed = 0, rotation_deg = 0.0, width = None, height = None, camera = None, progress = None))]
+#[pyo3(signature = (scene, map, spp = 64, bounces = 4, seed = 0, rotation_deg = None, width = None, height = None, camera = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn reference<'py>(
     py: Python<'py>,
@@ -26,7 +26,7 @@ pub(crate) fn reference<'py>(
     spp: u32,
     bounces: u32,
     seed: u64,
-    rotation_deg: f32,
+    rotation_deg: Option<f32>,
     width: Option<u32>,
     height: Option<u32>,
     camera: Option<Camera>,
@@ -39,6 +39,7 @@ pub(crate) fn reference<'py>(
     settings
         .validate()
         .map_err(|e| PyValueError::new_err(format!("spp: {e}")))?;
+    let rotation_deg = crate::scene::map_rotation(&scene.data, rotation_deg);
     let data = Arc::clone(&scene.data);
     let camera = resolve(&data.camera, camera.as_ref(), width, height)?;
     let map = map_argument(map)?;

@@ -71,25 +71,28 @@ impl Renderer {
         self.adapter.clone()
     }
 
-    /// Renders the scene lit by `lighting`, turned by `rotation_deg` about +Y, seen by
+    /// Renders the scene lit by `lighting`, turned by `rotation_deg` about +Y (the scene's
+    /// `rotation_deg` when not given, as on the command line; a `Decomposition` is already
+    /// turned, and only its background is), seen by
     /// `camera` (the scene's when not given). `lighting` is a map (a path or an `(H, W, 3)
     /// float32` array), decomposed here, or a `Decomposition` (one of `hprt.decompose`'s, or
     /// SH and lights of your own, drawn over `background`, a map, black when not given).
     /// `mode`: "hybrid" (SH part plus shadow-mapped lights), "prt" (the whole map through
     /// the transfer), "unshadowed", "lights", or a peer ("median-cut", "sh-sun"; a map only).
     /// Returns the linear radiance image, `(height, width, 3) float32`.
-    #[pyo3(signature = (lighting, mode = "hybrid", rotation_deg = 0.0, decompose_mode = "consistent", camera = None, background = None))]
+    #[pyo3(signature = (lighting, mode = "hybrid", rotation_deg = None, decompose_mode = "consistent", camera = None, background = None))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &mut self,
         py: Python<'py>,
         lighting: &Bound<'py, PyAny>,
         mode: &str,
-        rotation_deg: f32,
+        rotation_deg: Option<f32>,
         decompose_mode: &str,
         camera: Option<Camera>,
         background: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
+        let rotation_deg = crate::scene::map_rotation(&self.scene, rotation_deg);
         let (width, height) = self.size;
         let view = resolve(
             &self.scene.camera,

@@ -68,6 +68,13 @@ impl Scene {
         (self.data.camera.width, self.data.camera.height)
     }
 
+    /// The rotation of its map about +Y, degrees: what renders and references use when
+    /// given none (decompose a map with it to light the scene as they do).
+    #[getter]
+    fn rotation_deg(&self) -> f32 {
+        map_rotation(&self.data, None)
+    }
+
     /// The environment map the scene names, if any.
     #[getter]
     fn environment(&self) -> Option<PathBuf> {
@@ -128,6 +135,15 @@ impl SceneObject {
             self.name, self.role, self.albedo, self.triangle_count
         )
     }
+}
+
+/// The rotation of the map about +Y: the one asked for, else the scene's (CONVENTIONS.md,
+/// "Environment rotation").
+pub(crate) fn map_rotation(scene: &SceneData, requested_deg: Option<f32>) -> f32 {
+    runtime::map_rotation(
+        scene.environment.as_ref().map(|e| e.rotation_deg),
+        requested_deg,
+    )
 }
 
 /// Loads a scene file or a model.

@@ -280,6 +280,33 @@ class BakeAndRender(unittest.TestCase):
 
 
 
+class Composite(unittest.TestCase):
+    def test_the_true_composite_is_the_command_lines(self) -> None:
+        scene = hprt.load_scene(SCENES / "teapot_composite.toml")
+        environment = scene.environment
+        assert environment is not None
+        composite = hprt.reference_composite(
+            scene, environment, spp=4, bounces=1, width=96, height=48
+        )
+        with tempfile.TemporaryDirectory() as folder:
+            out = Path(folder) / "composite.exr"
+            args = ["--width", "96", "--height", "48", "--spp", "4", "--bounces", "1"]
+            hprt_program("reference", str(SCENES / "teapot_composite.toml"), "-o", str(out), *args)
+            # A 96 × 48 image has a map's 2:1 shape: load_map reads its pixels as they are.
+            expected = hprt.load_map(out)
+        np.testing.assert_array_equal(composite.image, expected)
+        kinds = composite.kinds
+        self.assertEqual(set(np.unique(kinds)), {0, 1, 2})
+        # The layers redo the composite: objects as rendered, the ratio only on proxies.
+        np.testing.assert_array_equal(composite.image[kinds == 0], composite.objects[kinds == 0])
+        self.assertTrue(np.all(composite.objects[kinds != 0] == 0.0))
+        self.assertTrue(np.all(composite.ratio[kinds != 1] == 1.0))
+        self.assertTrue(np.all(composite.changed <= (kinds == 1)))
+        self.assertGreater(int(composite.changed.sum()), 0)
+        with self.assertRaisesRegex(ValueError, "backplate"):
+            hprt.reference_composite(hprt.load_scene(TEAPOT), INTERIOR, spp=1, width=8, height=6)
+
+
 class Capture(unittest.TestCase):
     def test_the_bundled_photographs_give_the_command_lines_map(self) -> None:
         description = SCENES / "capture" / "capture.toml"
