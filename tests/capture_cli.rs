@@ -125,6 +125,37 @@ fn a_ball_capture_becomes_a_map_hprt_reads() {
     }
 }
 
+/// The library's errors are values a caller can match on, each naming the file at fault.
+#[test]
+fn capture_errors_are_typed() {
+    use capture::{CaptureError, EntryKind, EntryProblem};
+    let dir = tempfile::tempdir().unwrap();
+    let good = write_ball_capture(dir.path(), &TIMES[..2]);
+    let path = dir.path().join("capture.toml");
+    let second_ball_fov = good.replace(
+        "[[ball]]\nimage = \"ball0_1.png\"\nexposure = 0.00013\ncentre = [48.0, 48.0]\n\
+         radius = 40.0\nfov = 25",
+        "[[ball]]\nimage = \"ball0_1.png\"\nexposure = 0.00013\ncentre = [48.0, 48.0]\n\
+         radius = 40.0\nfov = 200",
+    );
+    assert_ne!(second_ball_fov, good);
+    std::fs::write(&path, &second_ball_fov).unwrap();
+    match capture::load_capture(&path) {
+        Err(CaptureError::Entry {
+            path: at,
+            entry: EntryKind::Ball,
+            index: 2,
+            problem: EntryProblem::FieldOfView(fov),
+        }) => assert_eq!((at, fov), (path.clone(), 200.0)),
+        other => panic!("{other:?}"),
+    }
+    std::fs::write(&path, "").unwrap();
+    assert!(matches!(
+        capture::load_capture(&path),
+        Err(CaptureError::NoPhotographs { path: at }) if at == path
+    ));
+}
+
 /// Exposures in equal steps leave the response's shape within a step to the priors: the
 /// capture still succeeds, and says so.
 #[test]

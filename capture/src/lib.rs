@@ -39,7 +39,7 @@ pub use ball::MirrorBall;
 pub use ball_finder::{Circle, FoundBall, find_ball};
 pub use camera::ShotCamera;
 pub use description::{BallDescription, CaptureDescription, ShotDescription};
-pub use error::CaptureError;
+pub use error::{CaptureError, EntryKind, EntryProblem};
 pub use exif::{ExifExposure, exif_block, read_exposure};
 pub use inverse_response::{InverseResponse, Observation, RESPONSE_BINS};
 pub use load::{LoadedCapture, load_capture};

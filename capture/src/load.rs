@@ -5,7 +5,7 @@ use crate::ball::MirrorBall;
 use crate::ball_finder::{FoundBall, find_ball};
 use crate::camera::ShotCamera;
 use crate::description::{BallDescription, CaptureDescription, ShotDescription};
-use crate::error::CaptureError;
+use crate::error::{CaptureError, EntryKind, EntryProblem};
 use crate::exif::{ExifExposure, read_exposure};
 use crate::photo::{Photo, View};
 use foundation::infra::limits::{
@@ -34,30 +34,38 @@ struct Read {
 /// image's EXIF when it records one, else from the description); balls without a given
 /// outline are found in their photographs.
 pub fn load_capture(path: &Path) -> Result<LoadedCapture, CaptureError> {
-    let invalid = |message: String| CaptureError::Photo {
+    let text = read_text_file(path).map_err(|cause| CaptureError::Read {
         path: path.to_path_buf(),
-        message,
-    };
-    let text = read_text_file(path).map_err(|e| invalid(e.to_string()))?;
+        cause,
+    })?;
     let description: CaptureDescription =
-        toml::from_str(&text).map_err(|e| invalid(format!("not a capture description: {e}")))?;
+        toml::from_str(&text).map_err(|cause| CaptureError::Description {
+            path: path.to_path_buf(),
+            cause,
+        })?;
     if description.shot.is_empty() && description.ball.is_empty() {
-        return Err(invalid(
-            "names no photographs: give [[shot]] or [[ball]] entries".into(),
-        ));
+        return Err(CaptureError::NoPhotographs {
+            path: path.to_path_buf(),
+        });
     }
     let count = description.shot.len() + description.ball.len();
     if count > MAX_CAPTURE_PHOTOS {
-        return Err(invalid(format!(
-            "names {count} photographs; hprt reads at most {MAX_CAPTURE_PHOTOS} in one capture"
-        )));
+        return Err(CaptureError::TooManyPhotographs {
+            path: path.to_path_buf(),
+            count,
+        });
     }
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut notes = Vec::new();
     let mut photos = Vec::new();
     let mut given = Vec::new();
     for (i, shot) in description.shot.iter().enumerate() {
-        check_shot(shot).map_err(|m| invalid(format!("shot {}: {m}", i + 1)))?;
+        check_shot(shot).map_err(|problem| CaptureError::Entry {
+            path: path.to_path_buf(),
+            entry: EntryKind::Shot,
+            index: i + 1,
+            problem,
+        })?;
         let read = read_photo(&folder.join(&shot.image), count, &mut notes)?;
         let (_, width, height) = read.levels;
         let camera = ShotCamera::new(
@@ -76,9 +84,9 @@ pub fn load_capture(path: &Path) -> Result<LoadedCapture, CaptureError> {
     }
     let times = exposures(&photos, &given, &mut notes)?;
     for ((read, _), time) in photos.iter().zip(&times) {
-        check_exposure_range(*time).map_err(|message| CaptureError::Photo {
+        check_exposure_range(*time).map_err(|_| CaptureError::ExposureOutOfRange {
             path: read.file.clone(),
-            message: format!("{message} (from its EXIF or its entry)"),
+            exposure: *time,
         })?;
     }
     let photos: Vec<Photo> = photos
@@ -102,9 +110,11 @@ fn load_balls(
 ) -> Result<Vec<(Read, View)>, CaptureError> {
     let mut out: Vec<(Read, Option<MirrorBall>, ShotCamera)> = Vec::new();
     for (i, ball) in balls.iter().enumerate() {
-        check_ball(ball).map_err(|message| CaptureError::Photo {
+        check_ball(ball).map_err(|problem| CaptureError::Entry {
             path: description.to_path_buf(),
-            message: format!("ball {}: {message}", i + 1),
+            entry: EntryKind::Ball,
+            index: i + 1,
+            problem,
         })?;
         let read = read_photo(&folder.join(&ball.image), count, notes)?;
         let (_, width, height) = read.levels;
@@ -142,12 +152,8 @@ fn load_balls(
             .collect();
         let best =
             find_ball(&exposures, (read.levels.1, read.levels.2), camera).ok_or_else(|| {
-                CaptureError::Photo {
+                CaptureError::NoBallFound {
                     path: read.file.clone(),
-                    message: "no mirror ball found in this photograph or its other exposures (a \
-                          ball's outline must be clear, at least a tenth of the picture across): \
-                          give the ball's centre and radius in pixels"
-                        .into(),
                 }
             })?;
         found.push((*camera, best));
@@ -175,13 +181,12 @@ fn check_ball_inside(
     i: usize,
 ) -> Result<(), CaptureError> {
     if cx - r < 0.0 || cy - r < 0.0 || cx + r > width as f32 || cy + r > height as f32 {
-        return Err(CaptureError::Photo {
+        return Err(CaptureError::BallOutside {
             path: file.to_path_buf(),
-            message: format!(
-                "the ball (centre {cx}, {cy}, radius {r} pixels) is not inside the \
-                 {width}x{height} picture: check [[ball]] {}'s centre and radius",
-                i + 1
-            ),
+            centre: (cx, cy),
+            radius: r,
+            size: (width, height),
+            index: i + 1,
         });
     }
     Ok(())
@@ -228,11 +233,8 @@ fn exposures(
             }
             (Some(exif), None) => Ok(exif.time),
             (None, Some(given)) => Ok(*given),
-            (None, None) => Err(CaptureError::Photo {
+            (None, None) => Err(CaptureError::NoExposure {
                 path: read.file.clone(),
-                message: "has no exposure time: its EXIF records none and the description \
-                          gives none (add `exposure = SECONDS` to its entry)"
-                    .into(),
             }),
         })
         .collect()
@@ -249,12 +251,12 @@ fn photo(path: PathBuf, (levels, width, height): Levels, time: f32, view: View) 
     }
 }
 
-fn check_exposure(exposure: Option<f32>) -> Result<(), String> {
+fn check_exposure(exposure: Option<f32>) -> Result<(), EntryProblem> {
     let Some(exposure) = exposure else {
         return Ok(());
     };
     if !(exposure.is_finite() && exposure > 0.0) {
-        return Err(format!("exposure {exposure} s is not a positive time"));
+        return Err(EntryProblem::ExposureNotPositive(exposure));
     }
     check_exposure_range(exposure)
 }
@@ -264,24 +266,22 @@ fn check_exposure(exposure: Option<f32>) -> Result<(), String> {
 /// beyond them a reading divided by its exposure overflows or vanishes in f32.
 pub(crate) const EXPOSURE_RANGE: (f32, f32) = (1e-9, 1e6);
 
-fn check_exposure_range(exposure: f32) -> Result<(), String> {
+fn check_exposure_range(exposure: f32) -> Result<(), EntryProblem> {
     let (lo, hi) = EXPOSURE_RANGE;
     if !(lo..=hi).contains(&exposure) {
-        return Err(format!(
-            "exposure {exposure} s is outside the {lo} to {hi} s hprt takes"
-        ));
+        return Err(EntryProblem::ExposureOutOfRange(exposure));
     }
     Ok(())
 }
 
-fn check_fov(fov: f32) -> Result<(), String> {
+fn check_fov(fov: f32) -> Result<(), EntryProblem> {
     if !(fov > 0.0 && fov < 179.0) {
-        return Err(format!("field of view {fov}° is outside (0, 179)"));
+        return Err(EntryProblem::FieldOfView(fov));
     }
     Ok(())
 }
 
-fn check_shot(shot: &ShotDescription) -> Result<(), String> {
+fn check_shot(shot: &ShotDescription) -> Result<(), EntryProblem> {
     check_exposure(shot.exposure)?;
     check_fov(shot.fov)?;
     for (name, angle) in [
@@ -290,27 +290,27 @@ fn check_shot(shot: &ShotDescription) -> Result<(), String> {
         ("roll", shot.roll),
     ] {
         if !angle.is_finite() {
-            return Err(format!("{name} {angle} is not a number"));
+            return Err(EntryProblem::Angle { name, value: angle });
         }
     }
     if !(shot.k1.abs() <= 2.0 && shot.k2.abs() <= 2.0) {
-        return Err(format!(
-            "distortion k1 {}, k2 {} outside [-2, 2]",
-            shot.k1, shot.k2
-        ));
+        return Err(EntryProblem::Distortion {
+            k1: shot.k1,
+            k2: shot.k2,
+        });
     }
     Ok(())
 }
 
-fn check_ball(ball: &BallDescription) -> Result<(), String> {
+fn check_ball(ball: &BallDescription) -> Result<(), EntryProblem> {
     check_exposure(ball.exposure)?;
     check_fov(ball.fov)?;
     match (ball.centre, ball.radius) {
         (Some(_), None) | (None, Some(_)) => {
-            return Err("give both centre and radius, or neither (to find the ball)".into());
+            return Err(EntryProblem::HalfAnOutline);
         }
         (_, Some(r)) if !(r.is_finite() && r >= 4.0) => {
-            return Err(format!("radius {r} pixels: a ball needs at least 4"));
+            return Err(EntryProblem::BallRadius(r));
         }
         _ => {}
     }
@@ -321,13 +321,10 @@ fn check_ball(ball: &BallDescription) -> Result<(), String> {
         .chain(&[ball.yaw, ball.pitch])
         .all(|v| v.is_finite())
     {
-        return Err("centre, yaw and pitch must be numbers".into());
+        return Err(EntryProblem::NotNumbers);
     }
     if !ball.reflectance.iter().all(|r| *r >= 0.01 && *r <= 1.0) {
-        return Err(format!(
-            "reflectance {:?} outside [0.01, 1] (polished chrome reflects about 0.6)",
-            ball.reflectance
-        ));
+        return Err(EntryProblem::Reflectance(ball.reflectance));
     }
     Ok(())
 }
@@ -339,29 +336,41 @@ type Levels = (Vec<[u8; 3]>, usize, usize);
 /// is recovered at 256 levels), within the backplate's limits, and its EXIF exposure.
 /// `count` is how many photographs the capture holds (all of one size).
 fn read_photo(path: &Path, count: usize, notes: &mut Vec<String>) -> Result<Read, CaptureError> {
-    let fail = |message: String| CaptureError::Photo {
-        path: path.to_path_buf(),
-        message,
-    };
-    let bytes = read_regular_file(path, MAX_SIDE_FILE_BYTES).map_err(|e| fail(e.to_string()))?;
+    let path_buf = || path.to_path_buf();
+    let bytes =
+        read_regular_file(path, MAX_SIDE_FILE_BYTES).map_err(|cause| CaptureError::Read {
+            path: path_buf(),
+            cause,
+        })?;
     let image =
         foundation::texture::decode_image_within(&bytes, MAX_PHOTO_PIXELS, MAX_BACKPLATE_SIDE)
             .map_err(|e| match e {
-                TextureError::TooLarge { width, height } => fail(format!(
-                    "is {width}x{height}: hprt reads photographs of at most \
-                     {MAX_PHOTO_PIXELS} pixels and {MAX_BACKPLATE_SIDE} per side \
-                     (downscale it)"
-                )),
-                other => fail(format!("cannot be read as a photograph: {other}")),
+                TextureError::TooLarge { width, height } => CaptureError::PhotoTooLarge {
+                    path: path_buf(),
+                    width,
+                    height,
+                },
+                cause => CaptureError::Undecodable {
+                    path: path_buf(),
+                    cause,
+                },
             })?
             .into_rgb8();
     let (width, height) = (image.width() as usize, image.height() as usize);
     if width < 8 || height < 8 {
-        return Err(fail(format!(
-            "is {width}x{height}: too small to be a photograph"
-        )));
+        return Err(CaptureError::PhotoTooSmall {
+            path: path_buf(),
+            width,
+            height,
+        });
     }
-    check_total(count, width, height).map_err(fail)?;
+    if too_many_pixels(count, width, height) {
+        return Err(CaptureError::CaptureTooLarge {
+            path: path_buf(),
+            count,
+            size: (width, height),
+        });
+    }
     let exif = read_exposure(&bytes).unwrap_or_else(|message| {
         notes.push(format!(
             "{}: {message}; its exposure is taken from the description",
@@ -377,21 +386,10 @@ fn read_photo(path: &Path, count: usize, notes: &mut Vec<String>) -> Result<Read
     })
 }
 
-/// Refuses a capture whose `count` photographs of `width × height` (they share one size)
-/// would hold more than [`MAX_CAPTURE_PIXELS`]: checked at the first photograph, before the
-/// others are decoded.
-fn check_total(count: usize, width: usize, height: usize) -> Result<(), String> {
-    let total = (count as u64).saturating_mul(width as u64 * height as u64);
-    if total > MAX_CAPTURE_PIXELS {
-        return Err(format!(
-            "{count} photographs of {width}x{height} pixels ({:.1} G pixels in all) are more \
-             than the {:.1} G pixels hprt holds for one capture (downscale them, or capture \
-             fewer)",
-            total as f64 / 1e9,
-            MAX_CAPTURE_PIXELS as f64 / 1e9
-        ));
-    }
-    Ok(())
+/// Whether `count` photographs of `width × height` (they share one size) would hold more than
+/// [`MAX_CAPTURE_PIXELS`]: checked at the first photograph, before the others are decoded.
+fn too_many_pixels(count: usize, width: usize, height: usize) -> bool {
+    (count as u64).saturating_mul(width as u64 * height as u64) > MAX_CAPTURE_PIXELS
 }
 
 /// Refuses photographs of different sizes.
@@ -399,16 +397,11 @@ fn check_sizes(photos: &[Photo]) -> Result<(), CaptureError> {
     let first = &photos[0];
     for photo in &photos[1..] {
         if (photo.width, photo.height) != (first.width, first.height) {
-            return Err(CaptureError::Photo {
+            return Err(CaptureError::SizeMismatch {
                 path: photo.path.clone(),
-                message: format!(
-                    "is {}x{}, but {} is {}x{}: every photograph of a capture must have one size",
-                    photo.width,
-                    photo.height,
-                    first.path.display(),
-                    first.width,
-                    first.height
-                ),
+                size: (photo.width, photo.height),
+                first: first.path.clone(),
+                first_size: (first.width, first.height),
             });
         }
     }
