@@ -1,9 +1,9 @@
 //! Why a capture cannot be assembled, as values a caller can match on (the command line prints
 //! them; the Python module raises them): each names the file at fault.
 
-use crate::load::EXPOSURE_RANGE;
 use foundation::infra::limits::{
-    MAX_BACKPLATE_SIDE, MAX_CAPTURE_PHOTOS, MAX_CAPTURE_PIXELS, MAX_PHOTO_PIXELS, ReadError,
+    EXPOSURE_RANGE, MAX_BACKPLATE_SIDE, MAX_CAPTURE_PHOTOS, MAX_CAPTURE_PIXELS, MAX_PHOTO_PIXELS,
+    ReadError,
 };
 use foundation::texture::TextureError;
 use std::path::PathBuf;

@@ -9,7 +9,7 @@ use crate::error::{CaptureError, EntryKind, EntryProblem};
 use crate::exif::{ExifExposure, read_exposure};
 use crate::photo::{Photo, View};
 use foundation::infra::limits::{
-    MAX_BACKPLATE_SIDE, MAX_CAPTURE_PHOTOS, MAX_CAPTURE_PIXELS, MAX_PHOTO_PIXELS,
+    EXPOSURE_RANGE, MAX_BACKPLATE_SIDE, MAX_CAPTURE_PHOTOS, MAX_CAPTURE_PIXELS, MAX_PHOTO_PIXELS,
     MAX_SIDE_FILE_BYTES, read_regular_file, read_text_file,
 };
 use foundation::texture::TextureError;
@@ -260,11 +260,6 @@ fn check_exposure(exposure: Option<f32>) -> Result<(), EntryProblem> {
     }
     check_exposure_range(exposure)
 }
-
-/// Shortest and longest exposure hprt takes (seconds, after ISO and aperture): a billionth of
-/// a second is past any shutter behind the darkest filter, a million seconds past any night;
-/// beyond them a reading divided by its exposure overflows or vanishes in f32.
-pub(crate) const EXPOSURE_RANGE: (f32, f32) = (1e-9, 1e6);
 
 fn check_exposure_range(exposure: f32) -> Result<(), EntryProblem> {
     let (lo, hi) = EXPOSURE_RANGE;

@@ -155,6 +155,11 @@ pub fn gunzip_limited(bytes: &[u8], max: u64) -> Result<Vec<u8>, ReadError> {
     Ok(out)
 }
 
+/// Shortest and longest exposure hprt takes (seconds, after ISO and aperture): a billionth of
+/// a second is past any shutter behind the darkest filter, a million seconds past any night;
+/// beyond them a reading divided by its exposure overflows or vanishes in f32.
+pub const EXPOSURE_RANGE: (f32, f32) = (1e-9, 1e6);
+
 #[cfg(test)]
 mod tests {
     use super::*;
