@@ -45,4 +45,4 @@ pub use inverse_response::{InverseResponse, Observation, RESPONSE_BINS};
 pub use load::{LoadedCapture, load_capture};
 pub use merge::hat_weight;
 pub use photo::{Photo, View};
-pub use response::{equal_step_ratio, recover_response};
+pub use response::{equal_step_ratio, equal_steps_warning, recover_response};

@@ -107,6 +107,22 @@ pub fn equal_step_ratio(times: &[f32]) -> Option<f32> {
     (hi <= 1.05 * lo).then(|| (steps.iter().sum::<f64>() / steps.len() as f64).exp() as f32)
 }
 
+/// What a user whose response is recovered from exposures at `times` should hear when they
+/// step by one ratio (`None` for unequal steps or a single exposure): the response's shape
+/// within a step is then the priors' guess, and no spread can show it wrong.
+pub fn equal_steps_warning(times: &[f32]) -> Option<String> {
+    let ratio = equal_step_ratio(times).filter(|r| *r > 1.0)?;
+    Some(format!(
+        "the exposures step by one ratio (x{ratio:.1}, {:.1} stops): equal steps fix a camera's \
+         response only up to a factor that repeats every step, so its shape within a step is a \
+         guess from measured cameras, and the response's spread cannot show it wrong. Where the \
+         camera's tone curve is unlike theirs (a strong S-curve), the map's radiances can be off \
+         by tens of percent. Bracket in unequal steps (x3 and x4.5 by turns, as phones do) or \
+         give the camera's response",
+        ratio.log2()
+    ))
+}
+
 /// How much lower the free-form curve's spread must be for it to be kept: equal-step brackets
 /// leave both equally consistent, and the model's curve is the camera-like one.
 const FREE_FORM_MARGIN: f64 = 0.8;

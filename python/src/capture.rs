@@ -57,6 +57,7 @@ pub(crate) fn capture(
         )));
     }
     let given = response.map(|r| response_from_array(&r)).transpose()?;
+    let response_given = given.is_some();
     let loaded = ::capture::load_capture(&description).map_err(crate::errors::hprt_error)?;
     let mut warnings = loaded.notes;
     let settings = AssemblySettings {
@@ -78,11 +79,9 @@ pub(crate) fn capture(
         })
         .map_err(crate::errors::hprt_error)?;
     let times: Vec<f32> = photos.iter().map(|p| p.time).collect();
-    if let Some(ratio) = ::capture::equal_step_ratio(&times).filter(|r| *r > 1.0) {
-        warnings.push(format!(
-            "the exposures step by one ratio (x{ratio:.1}): the response's shape within a step \
-             is a guess from measured cameras"
-        ));
+    // A response given is no guess, whatever the steps.
+    if !response_given && let Some(warning) = ::capture::equal_steps_warning(&times) {
+        warnings.push(warning);
     }
     Ok(Captured {
         map: map_array(&captured.map),

@@ -177,22 +177,9 @@ fn report(description: &Path, captured: &Assembled, photos: usize) {
 /// priors' guess within one step, and no figure printed here can show it wrong.
 fn warn_of_equal_steps(description: &Path, photos: &[capture::Photo]) {
     let times: Vec<f32> = photos.iter().map(|p| p.time).collect();
-    let Some(ratio) = capture::equal_step_ratio(&times) else {
-        return;
-    };
-    if ratio <= 1.0 {
-        return;
+    if let Some(warning) = capture::equal_steps_warning(&times) {
+        log::warn!("{}: {warning} with --response", description.display());
     }
-    log::warn!(
-        "{}: the exposures step by one ratio (x{ratio:.1}, {:.1} stops): equal steps fix a \
-         camera's response only up to a factor that repeats every step, so its shape within a \
-         step is a guess from measured cameras, and the response's spread cannot show it \
-         wrong. Where the camera's tone curve is unlike theirs (a strong S-curve), the map's \
-         radiances can be off by tens of percent. Bracket in unequal steps (x3 and x4.5 by \
-         turns, as phones do) or give the camera's response with --response",
-        description.display(),
-        ratio.log2()
-    );
 }
 
 /// A response spread above this (the median texel's readings scattering by more than 10% in
