@@ -5,9 +5,10 @@
 use crate::camera::{Camera, resolve};
 use crate::maps::{image_array, map_argument};
 use crate::progress::with_progress;
+use crate::reference::path_settings;
 use crate::scene::{Scene, map_rotation};
+use ::reference::EnvironmentLight;
 use ::reference::composite::{Composite as CompositeData, PixelKind, render_composite};
-use ::reference::{EnvironmentLight, ReferenceSettings};
 use foundation::scene::{Backplate, load_backplate_image};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2, PyArray3};
@@ -83,13 +84,7 @@ pub(crate) fn reference_composite(
             data.path.display()
         )));
     };
-    if spp == 0 {
-        return Err(PyValueError::new_err("spp must be at least 1"));
-    }
-    let settings = ReferenceSettings::new(spp, bounces, seed);
-    settings
-        .validate()
-        .map_err(|e| PyValueError::new_err(format!("spp: {e}")))?;
+    let settings = path_settings(spp, bounces, seed)?;
     let rotation_deg = map_rotation(&data, rotation_deg);
     let camera = resolve(&data.camera, camera.as_ref(), width, height)?;
     let plate = match backplate {

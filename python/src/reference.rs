@@ -32,13 +32,7 @@ pub(crate) fn reference<'py>(
     camera: Option<Camera>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    if spp == 0 {
-        return Err(PyValueError::new_err("spp must be at least 1"));
-    }
-    let settings = ReferenceSettings::new(spp, bounces, seed);
-    settings
-        .validate()
-        .map_err(|e| PyValueError::new_err(format!("spp: {e}")))?;
+    let settings = path_settings(spp, bounces, seed)?;
     let rotation_deg = crate::scene::map_rotation(&scene.data, rotation_deg);
     let data = Arc::clone(&scene.data);
     let camera = resolve(&data.camera, camera.as_ref(), width, height)?;
@@ -51,4 +45,16 @@ pub(crate) fn reference<'py>(
         })
     })?;
     Ok(image_array(&image.radiance).into_pyarray(py))
+}
+
+/// The path tracer's settings, checked as the command line checks them.
+pub(crate) fn path_settings(spp: u32, bounces: u32, seed: u64) -> PyResult<ReferenceSettings> {
+    if spp == 0 {
+        return Err(PyValueError::new_err("spp must be at least 1"));
+    }
+    let settings = ReferenceSettings::new(spp, bounces, seed);
+    settings
+        .validate()
+        .map_err(|e| PyValueError::new_err(format!("spp: {e}")))?;
+    Ok(settings)
 }

@@ -1,7 +1,7 @@
 //! Scenes and their bakes: `hprt.load_scene`, `hprt.bake`, `hprt.load_bake`, and the bake's
 //! transfer as arrays.
 
-use crate::errors::HprtError;
+use crate::errors::hprt_error;
 use crate::progress::with_progress;
 use foundation::bake_settings::BakeSettings;
 use foundation::bvh::SceneBvh;
@@ -9,7 +9,7 @@ use foundation::scene::{ObjectRole, Scene as SceneData};
 use numpy::ndarray::{Array3, ArrayView3};
 use numpy::{IntoPyArray, PyArray3};
 use precompute::bake::{Transfer, TransferVectors};
-use precompute::cache;
+use precompute::cache::{self, CacheError};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::IntoPyDict;
@@ -149,7 +149,7 @@ pub(crate) fn map_rotation(scene: &SceneData, requested_deg: Option<f32>) -> f32
 /// Loads a scene file or a model.
 #[pyfunction]
 pub(crate) fn load_scene(path: PathBuf) -> PyResult<Scene> {
-    let data = SceneData::open(&path).map_err(crate::errors::hprt_error)?;
+    let data = SceneData::open(&path).map_err(hprt_error)?;
     Ok(Scene {
         data: Arc::new(data),
     })
@@ -203,8 +203,7 @@ impl Bake {
 
     /// Writes the bake as a `.bake` file (`hprt render --bake` reads it).
     fn save(&self, path: PathBuf) -> PyResult<()> {
-        precompute::bakefile::write(&path, &self.transfer, &self.mesh_hash)
-            .map_err(crate::errors::hprt_error)
+        precompute::bakefile::write(&path, &self.transfer, &self.mesh_hash).map_err(hprt_error)
     }
 
     fn __repr__(&self) -> String {
@@ -275,7 +274,7 @@ pub(crate) fn bake(
         order: order.unwrap_or(defaults.order),
         seed: seed.unwrap_or(defaults.seed),
     };
-    settings.validate().map_err(crate::errors::hprt_error)?;
+    settings.validate().map_err(hprt_error)?;
     if let Some(n) = threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
         return Err(PyValueError::new_err(format!(
             "threads {n}: from 1 to {MAX_THREADS}"
@@ -283,30 +282,28 @@ pub(crate) fn bake(
     }
     let mesh_hash = scene.data.geometry.content_hash();
     let data = Arc::clone(&scene.data);
-    let transfer = py.detach(move || {
+    let transfer = py.detach(move || -> PyResult<Transfer> {
         if cache && let Some((_, transfer)) = cache::load_cached(&data, &settings) {
             return Ok(transfer);
         }
         with_progress(progress, "bake", |progress| {
-            let run = || -> Result<Transfer, String> {
+            let run = || -> Result<Transfer, CacheError> {
                 if cache {
-                    let baked = cache::bake_into_cache(&data, &settings, progress);
-                    return baked.map(|(_, t, _)| t).map_err(|e| e.to_string());
+                    return Ok(cache::bake_into_cache(&data, &settings, progress)?.1);
                 }
                 let bvh = SceneBvh::build(&data.geometry.mesh);
-                let baked = precompute::bake::bake(&data.geometry, &bvh, &settings, progress);
-                baked.map(|(t, _)| t).map_err(|e| e.to_string())
+                Ok(precompute::bake::bake(&data.geometry, &bvh, &settings, progress)?.0)
             };
             match threads {
-                None => run(),
+                None => run().map_err(hprt_error),
                 Some(n) => rayon::ThreadPoolBuilder::new()
                     .num_threads(n)
                     .build()
-                    .map_err(|e| e.to_string())
-                    .and_then(|pool| pool.install(run)),
+                    .map_err(hprt_error)?
+                    .install(run)
+                    .map_err(hprt_error),
             }
         })?
-        .map_err(HprtError::new_err)
     })?;
     Ok(Bake {
         transfer: Arc::new(transfer),
@@ -318,8 +315,7 @@ pub(crate) fn bake(
 #[pyfunction]
 pub(crate) fn load_bake(scene: &Scene, path: PathBuf) -> PyResult<Bake> {
     let mesh_hash = scene.data.geometry.content_hash();
-    let transfer = precompute::bakefile::read_for_mesh(&path, &mesh_hash)
-        .map_err(crate::errors::hprt_error)?;
+    let transfer = precompute::bakefile::read_for_mesh(&path, &mesh_hash).map_err(hprt_error)?;
     Ok(Bake {
         transfer: Arc::new(transfer),
         mesh_hash,
