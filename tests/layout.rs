@@ -10,7 +10,7 @@ mod scan;
 #[path = "layout/tokens.rs"]
 mod tokens;
 
-use scan::{SourceTree, function_spans, prints_outside_tests};
+use scan::{CRATES, SourceTree, function_spans, prints_outside_tests};
 use std::path::{Path, PathBuf};
 use tokens::tokens;
 
@@ -208,15 +208,7 @@ fn the_layout_table_names_every_source_folder() {
         .collect();
     let named = |path: &str| rows.iter().any(|r| r.contains(&path));
     let mut folders = Vec::new();
-    for top in [
-        "foundation",
-        "precompute",
-        "reference",
-        "runtime",
-        "capture",
-        "python",
-        ".",
-    ] {
+    for top in CRATES {
         folders.extend(source_folders(&root.join(top).join("src"), root));
     }
     let missing: Vec<String> = folders

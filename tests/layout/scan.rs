@@ -7,7 +7,7 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
 /// The crates whose imports are checked, each with its source folder.
-const CRATES: [&str; 7] = [
+pub const CRATES: [&str; 7] = [
     "foundation",
     "precompute",
     "reference",
