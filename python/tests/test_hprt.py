@@ -175,6 +175,7 @@ class BakeAndRender(unittest.TestCase):
 
         # Relative L1 over the image: 0.036 for the hybrid, 0.046 for the plain projection
         # (whose order-4 SH blurs the lamps' shadows) when written.
+        print(f"teapot 80x60, relative L1 to the path tracer: hybrid {error(hybrid):.3f}, prt {error(prt):.3f}")
         self.assertLess(error(hybrid), 0.06)
         self.assertLess(error(hybrid), error(prt))
         turned = renderer.render(INTERIOR, mode="hybrid", rotation_deg=90.0)
@@ -223,8 +224,10 @@ class BakeAndRender(unittest.TestCase):
         )
         front = renderer.render(INTERIOR)
         # Measured when written: 0.058 from this side, 0.71 for the scene's own view.
-        self.assertLess(float(np.abs(image - truth).sum() / truth.sum()), 0.08)
-        self.assertGreater(float(np.abs(front - truth).sum() / truth.sum()), 0.3)
+        same, mismatched = (float(np.abs(a - truth).sum() / truth.sum()) for a in (image, front))
+        print(f"moved camera, relative L1: same view {same:.3f}, mismatched {mismatched:.3f}")
+        self.assertLess(same, 0.08)
+        self.assertGreater(mismatched, 0.3)
 
     def test_progress_reaches_its_end_and_a_raising_callback_raises(self) -> None:
         calls: list[tuple[str, int, int]] = []
