@@ -173,7 +173,7 @@ class BakeAndRender(unittest.TestCase):
         def error(image: npt.NDArray[np.float32]) -> float:
             return float(np.abs(image - truth).sum() / truth.sum())
 
-        # Relative L1 over the image: 0.036 for the hybrid, 0.046 for the plain projection
+        # Relative L1 over the image: 0.047 for the hybrid, 0.053 for the plain projection
         # (whose order-4 SH blurs the lamps' shadows) when written.
         print(f"teapot 80x60, relative L1 to the path tracer: hybrid {error(hybrid):.3f}, prt {error(prt):.3f}")
         self.assertLess(error(hybrid), 0.06)
@@ -223,7 +223,7 @@ class BakeAndRender(unittest.TestCase):
             self.scene, INTERIOR, spp=64, bounces=1, width=80, height=60, camera=moved
         )
         front = renderer.render(INTERIOR)
-        # Measured when written: 0.058 from this side, 0.71 for the scene's own view.
+        # Measured when written: 0.039 from this side, 1.7 for the scene's own view (the map turned by the scene's rotation).
         same, mismatched = (float(np.abs(a - truth).sum() / truth.sum()) for a in (image, front))
         print(f"moved camera, relative L1: same view {same:.3f}, mismatched {mismatched:.3f}")
         self.assertLess(same, 0.08)
