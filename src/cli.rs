@@ -2,10 +2,10 @@
 //! settings. Each command's own arguments live with the command.
 
 use crate::maps::{self, ChosenEnvironment};
-use crate::report::{NoiseTarget, ReportSettings};
 use clap::{Args, ValueEnum};
 use foundation::envmap::Layout;
 use foundation::scene::Scene;
+use report::{NoiseTarget, ReportSettings};
 use runtime::render::{Backend, RenderMode, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings, Window};
 use std::path::PathBuf;

@@ -4,13 +4,9 @@
 mod bake_cache;
 mod cli;
 mod commands;
-mod env_sequence;
-mod gpu_composite;
 mod maps;
 mod outputs;
 mod recorded;
-mod report;
-mod room;
 mod support;
 mod view;
 

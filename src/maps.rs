@@ -1,8 +1,9 @@
 //! Which environment map lights a scene, loaded with context, and what follows from the map
 //! (its default exposure, the maps beside it).
 
-use foundation::envmap::{self, EnvMap, Layout, LoadedEnvMap};
+use foundation::envmap::{self, Layout, LoadedEnvMap};
 use foundation::scene::Scene;
+pub use report::maps::{default_exposure, scene_rotation};
 use std::path::{Path, PathBuf};
 
 /// Loads a map with the file named in any error (and the option that names a layout, when
@@ -50,18 +51,6 @@ pub fn choose(
         loaded,
         rotation_deg: scene_rotation(scene, rotate),
     })
-}
-
-/// The rotation a map gets in `scene`: `rotate` if given, else the scene's.
-pub fn scene_rotation(scene: &Scene, rotate: Option<f32>) -> f32 {
-    runtime::map_rotation(scene.environment.as_ref().map(|e| e.rotation_deg), rotate)
-}
-
-/// The default tone-mapping exposure for a map: a white Lambertian surface seeing the whole
-/// environment (radiance = the map's mean luminance) maps to `1 - e^(-1/2)` (about 0.39
-/// linear, 0.66 after sRGB encoding), leaving headroom for sunlit surfaces.
-pub fn default_exposure(map: &EnvMap) -> f32 {
-    0.5 / map.mean_luminance().max(1e-6)
 }
 
 /// The maps next to `map` (its folder's `.exr` and `.hdr` files), sorted: the choices the

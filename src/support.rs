@@ -120,6 +120,18 @@ impl TerminalProgress {
     }
 }
 
+/// A report's lines printed on stdout, its long steps as terminal progress bars.
+pub struct TerminalObserver;
+
+impl report::Observer for TerminalObserver {
+    fn line(&self, text: &str) {
+        println!("{text}");
+    }
+    fn progress(&self, what: &str) -> Box<dyn Progress + '_> {
+        Box::new(TerminalProgress::new(what))
+    }
+}
+
 impl Progress for TerminalProgress {
     fn start(&self, total: u64) {
         self.0.set_length(total);

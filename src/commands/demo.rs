@@ -25,7 +25,7 @@ pub struct DemoArgs {
     /// share of the best method's mean error (the default, 20%: the statistics then measure
     /// the methods, not the reference).
     #[arg(long, default_value = "20%")]
-    pub target_noise: crate::report::NoiseTarget,
+    pub target_noise: report::NoiseTarget,
     /// Stop at --spp (no noise target): a quick look in a few minutes, with the noise floors
     /// stated and warned about.
     #[arg(long)]
@@ -196,7 +196,7 @@ fn demo_room(output: &Path, options: &ReportOptions) -> anyhow::Result<()> {
         frames: 1,
         ..options.clone()
     };
-    let path = crate::report::path::PathOptions {
+    let path = report::path::PathOptions {
         positions: ROOM_POSITIONS,
         probe_spp: ROOM_PROBE_SPP,
     };

@@ -4,15 +4,15 @@ use crate::bake_cache::load_bake;
 use crate::cli::{
     DecomposeOptions, EnvironmentArgs, ImageSizeArgs, RenderOptions, parse_positive, parse_vec3,
 };
-use crate::env_sequence::{Sequence, lighting_at_frame};
-use crate::gpu_composite;
 use crate::maps::{default_exposure, scene_rotation};
 use crate::outputs::{check_outputs, open_outputs, scene_inputs, write_outputs};
-use crate::support::open_scene;
+use crate::support::{TerminalObserver, open_scene};
 use anyhow::Context;
 use clap::Args;
 use foundation::image_io::{RgbImageF32, check_finite, exr_bytes, png_bytes, to_display_rgb8};
 use reference::composite::PixelKind;
+use report::env_sequence::{Sequence, lighting_at_frame};
+use report::gpu_composite;
 use runtime::render::{GpuContext, Renderer};
 use runtime::{DecomposeMode, EnvironmentLighting};
 use std::path::PathBuf;
@@ -260,9 +260,22 @@ fn draw(
         form: args.composite,
     };
     if args.composite == gpu_composite::CompositeForm::Live {
-        let image = gpu_composite::live_composite_frame(&mut renderer, transfer, frame, &inputs)?;
+        let image = gpu_composite::live_composite_frame(
+            &mut renderer,
+            transfer,
+            frame,
+            &inputs,
+            &TerminalObserver,
+        )?;
         return Ok((image, None));
     }
-    let c = gpu_composite::composite_frame(gpu, &mut renderer, transfer, frame, &inputs)?;
+    let c = gpu_composite::composite_frame(
+        gpu,
+        &mut renderer,
+        transfer,
+        frame,
+        &inputs,
+        &TerminalObserver,
+    )?;
     Ok((c.image.clone(), Some(c)))
 }

@@ -3,18 +3,19 @@
 
 use crate::bake_cache;
 use crate::cli::ReportOptions;
-use crate::env_sequence::Sequence;
 use crate::maps::maps_beside;
 use crate::outputs::{check_folder_spares_inputs, scene_inputs};
-use crate::report;
-use crate::report::NoiseTarget;
-use crate::report::shard::ReportMaps;
+use report::env_sequence::Sequence;
+
+use crate::support::TerminalObserver;
 use crate::support::load_scene;
 use anyhow::Context;
 use clap::Args;
 use foundation::infra::atomic_file::AtomicFolder;
 use foundation::infra::shard::{ProcessEnvironment, ShardSpec};
 use foundation::scene::Scene;
+use report::NoiseTarget;
+use report::shard::ReportMaps;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -124,7 +125,8 @@ fn render_reference_share(scene: &Scene, args: &ReportArgs, spec: ShardSpec) -> 
             ReportMaps::Maps(&envs)
         }
     };
-    report::shard::render_share(scene, &maps, &camera, &settings, spec)
+    report::shard::render_share(scene, &maps, &camera, &settings, spec, &TerminalObserver)?;
+    Ok(())
 }
 
 /// Checks the options, bakes (or reuses) the transfer, writes the report and prints a summary.
@@ -154,8 +156,16 @@ pub(crate) fn write_report(
     // failed report leaves the previous one untouched, and nothing new.
     let folder = AtomicFolder::create(output)
         .with_context(|| format!("cannot write {}", output.display()))?;
-    let report = report::run_report(scene, &transfer, &bake_path, envs, &settings, folder.path())?;
-    report::print_summary(&report, scene.geometry.is_glossy());
+    let report = report::run_report(
+        scene,
+        &transfer,
+        &bake_path,
+        envs,
+        &settings,
+        folder.path(),
+        &TerminalObserver,
+    )?;
+    print_lines(report::summary_lines(&report, scene.geometry.is_glossy()));
     let failed = report
         .maps
         .iter()
@@ -180,9 +190,15 @@ fn write_composite_report(
     output: &Path,
 ) -> anyhow::Result<()> {
     write_atomically(output, |folder| {
-        let report =
-            report::composite::run_composite_report(scene, transfer, envs, settings, folder)?;
-        report::composite::print_composite_summary(&report);
+        let report = report::composite::run_composite_report(
+            scene,
+            transfer,
+            envs,
+            settings,
+            folder,
+            &TerminalObserver,
+        )?;
+        print_lines(report::composite::composite_summary_lines(&report));
         Ok(())
     })
 }
@@ -207,15 +223,17 @@ fn write_sequence_report(
         ..options.report_settings(&camera, transfer.settings.bounces)
     };
     write_atomically(out, |folder| {
-        report::sequence::write_sequence_report(
+        let report = report::sequence::write_sequence_report(
             scene,
-            &sequence,
-            sequence_path,
+            (sequence_path, &sequence),
             &transfer,
             camera,
             &settings,
             folder,
-        )
+            &TerminalObserver,
+        )?;
+        print_lines(report::sequence::summary_lines(&report));
+        Ok(())
     })
 }
 
@@ -261,13 +279,23 @@ pub(crate) fn write_path_report(
         ..options.report_settings(&camera, scene.bake.bounces)
     };
     write_atomically(out, |folder| {
-        report::path::write_path_report(
+        let report = report::path::write_path_report(
             scene,
             (&map, rotation),
             camera,
             &settings,
             path_options,
             folder,
-        )
+            &TerminalObserver,
+        )?;
+        print_lines(report::path::summary_lines(&report));
+        Ok(())
     })
+}
+
+/// Prints a report's summary, a line each.
+fn print_lines(lines: Vec<String>) {
+    for line in lines {
+        println!("{line}");
+    }
 }

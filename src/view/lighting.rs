@@ -14,7 +14,9 @@ impl App {
     pub(super) fn load_environment(&mut self) {
         // The map, and how many of its texels were invalid and set to 0.
         let loaded = match &self.lighting.sequence {
-            Some((sequence, _)) => sequence.frame(0).map(|map| (map, 0)),
+            Some((sequence, _)) => {
+                (sequence.frame(0).map(|map| (map, 0))).map_err(anyhow::Error::from)
+            }
             None => crate::maps::load_map(&self.settings.env, None)
                 .map(|loaded| (loaded.map, loaded.sanitized)),
         };
@@ -221,15 +223,18 @@ impl App {
                 let proxies = match &self.bake.proxies {
                     Some(p) => p.clone(),
                     None => {
-                        let p =
-                            Arc::new(crate::gpu_composite::proxies_bake(&self.scene, transfer)?);
+                        let p = Arc::new(report::gpu_composite::proxies_bake(
+                            &self.scene,
+                            transfer,
+                            &crate::support::TerminalObserver,
+                        )?);
                         self.bake.proxies = Some(p.clone());
                         p
                     }
                 };
                 let backplate = match room_backplate {
                     Some(photograph) => photograph,
-                    None => crate::gpu_composite::live_backplate(&self.scene)?,
+                    None => report::gpu_composite::live_backplate(&self.scene)?,
                 };
                 if let Err(e) =
                     renderer.enable_composite(&self.scene.geometry, &proxies, &backplate)

@@ -18,12 +18,12 @@ mod ui;
 mod window;
 
 use crate::bake_cache;
-use crate::env_sequence::Sequence;
 use crate::maps::{maps_beside, scene_rotation};
 use anyhow::Context;
 use clap::Args;
 use foundation::scene::Scene;
 use orbit::Orbit;
+use report::env_sequence::Sequence;
 use runtime::lights_indirect_default;
 use runtime::render::{Backend, RenderMode, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings};

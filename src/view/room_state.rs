@@ -1,12 +1,13 @@
 //! A room's state in the viewer: the room and the model's place in it (see `room.rs`).
 
-use crate::report::{ReferenceImages, ReferenceRequest, reference_images};
-use crate::room::RoomModel;
+use crate::support::TerminalObserver;
 use anyhow::Context;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::image_io::RgbImageF32;
 use foundation::scene::{ObjectRole, Pose, Scene};
+use report::room::RoomModel;
+use report::{ReferenceImages, ReferenceRequest, reference_images};
 use runtime::{DecomposeSettings, ProbeFrame};
 
 /// Paths per pixel of the empty room's picture (cached with the reports' references).
@@ -39,7 +40,12 @@ impl RoomState {
         rotation_deg: f32,
         settings: DecomposeSettings,
     ) -> anyhow::Result<Self> {
-        let model = RoomModel::open(scene, map.rotated(rotation_deg), settings)?;
+        let model = RoomModel::open(
+            scene,
+            map.rotated(rotation_deg),
+            settings,
+            &TerminalObserver,
+        )?;
         let room = scene.of_role(ObjectRole::Proxy).without_backplate();
         let pose = (model.path.as_ref())
             .and_then(|p| p.poses().first().copied())
@@ -72,11 +78,17 @@ impl RoomState {
         println!("path-tracing the empty room for the view (cached)");
         let no_limit = |_: &ReferenceImages| f64::INFINITY;
         let (map, rotation) = (&self.map, self.rotation_deg);
-        Ok(
-            reference_images(&self.room, camera, map, rotation, &request, &no_limit)
-                .context("cannot path-trace the empty room")?
-                .radiance,
+        Ok(reference_images(
+            &self.room,
+            camera,
+            map,
+            rotation,
+            &request,
+            &no_limit,
+            &TerminalObserver,
         )
+        .context("cannot path-trace the empty room")?
+        .radiance)
     }
 
     /// How far the model is turned from where the scene places it, in degrees (0 to 180),

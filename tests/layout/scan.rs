@@ -7,11 +7,12 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
 /// The crates whose imports are checked, each with its source folder.
-pub const CRATES: [&str; 7] = [
+pub const CRATES: [&str; 8] = [
     "foundation",
     "precompute",
     "reference",
     "runtime",
+    "report",
     "capture",
     "python",
     ".",

@@ -2,13 +2,13 @@
 //! most 20% over the same scene drawn whole).
 
 use super::render::time_frames;
-use crate::gpu_composite::live_backplate;
 use crate::support::{load_scene, median};
 use clap::Args;
 use foundation::bvh::SceneBvh;
 use foundation::infra::progress::NoProgress;
 use foundation::scene::{ObjectRole, Scene};
 use precompute::bake::{self, BakeSettings, Transfer};
+use report::gpu_composite::live_backplate;
 use runtime::render::{GpuContext, RenderMode, Renderer, ShadowSettings};
 use runtime::{DecomposeSettings, EnvironmentLighting};
 use std::path::PathBuf;

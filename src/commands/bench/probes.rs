@@ -59,7 +59,7 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
         .iter()
         .map(|p| p.load(&proxies))
         .collect::<Result<_, _>>()?;
-    crate::room::warn_of_mixed_sizes(&scene, &probes);
+    report::room::warn_of_mixed_sizes(&scene, &probes);
     let env = args.environment.choose(&scene)?;
     let sky = env.loaded.map.rotated(env.rotation_deg);
     let settings = DecomposeSettings {

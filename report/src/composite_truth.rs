@@ -2,32 +2,33 @@
 //! virtual objects in two independent halves, cached like the reports' references (so a
 //! second report, or one after `hprt report --shard`, reads it instead of rendering it).
 
-use super::ReportSettings;
-use crate::bake_cache::{cache_dir, create_cache_folder};
+use crate::ReportSettings;
+use crate::error::Result;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::image_io::{RgbImageF32, read_exr, write_exr};
 use foundation::infra::atomic_file::write_atomic;
 use foundation::infra::progress::NoProgress;
 use foundation::scene::{Backplate, Scene, load_backplate_image};
+use precompute::cache::{cache_dir, create_cache_folder};
 use reference::composite::{PixelKind, composite, render_composite};
 use reference::{EnvironmentLight, ReferenceSettings};
 use std::path::PathBuf;
 
 /// The regions' masks: object pixels, and the truth's changed region.
-pub(super) struct Regions {
-    pub(super) object: Vec<bool>,
-    pub(super) changed: Vec<bool>,
+pub(crate) struct Regions {
+    pub(crate) object: Vec<bool>,
+    pub(crate) changed: Vec<bool>,
 }
 
 /// The true composite from two independent halves (each half the paths): the composite of
 /// their mean renders, the regions, and the two halves' composites (for the noise).
-pub(super) struct Truth {
-    pub(super) image: RgbImageF32,
-    pub(super) regions: Regions,
-    pub(super) halves: [RgbImageF32; 2],
+pub(crate) struct Truth {
+    pub(crate) image: RgbImageF32,
+    pub(crate) regions: Regions,
+    pub(crate) halves: [RgbImageF32; 2],
     /// Read from the cache, not rendered.
-    pub(super) cached: bool,
+    pub(crate) cached: bool,
 }
 
 /// The path traces a truth is made of: per half, the scene and the proxies alone; and each
@@ -38,7 +39,7 @@ struct Renders {
     kinds: Vec<PixelKind>,
 }
 
-fn photograph(scene: &Scene, camera: &Camera) -> anyhow::Result<Option<RgbImageF32>> {
+fn photograph(scene: &Scene, camera: &Camera) -> Result<Option<RgbImageF32>> {
     Ok(match &scene.backplate {
         Some(Backplate::Image(path)) => {
             Some(load_backplate_image(path, camera.width, camera.height)?)
@@ -90,7 +91,7 @@ fn key(
     map: &EnvMap,
     rotation_deg: f32,
     settings: &ReportSettings,
-) -> anyhow::Result<String> {
+) -> Result<String> {
     let mut hasher = blake3::Hasher::new();
     hasher.update(b"hprt composite truth v1");
     super::truth::hash_view(&mut hasher, scene, camera, map, rotation_deg)?;
@@ -119,7 +120,7 @@ impl Entry {
         }
     }
 
-    fn load(&self) -> anyhow::Result<Renders> {
+    fn load(&self) -> Result<Renders> {
         let [w0, w1, o0, o1, kinds] = self.images.clone().map(|p| read_exr(&p));
         let kinds = kinds?
             .pixels
@@ -137,7 +138,7 @@ impl Entry {
         })
     }
 
-    fn store(&self, renders: &Renders) -> anyhow::Result<()> {
+    fn store(&self, renders: &Renders) -> Result<()> {
         create_cache_folder(self.done.parent().expect("a cache folder"))?;
         let (w, h) = (renders.with[0].width, renders.with[0].height);
         let kinds: Vec<f32> = renders
@@ -172,7 +173,7 @@ fn renders(
     map: &EnvMap,
     rotation_deg: f32,
     settings: &ReportSettings,
-) -> anyhow::Result<(Renders, bool)> {
+) -> Result<(Renders, bool)> {
     let entry = Entry::new(&key(scene, camera, map, rotation_deg, settings)?);
     if entry.done.exists() {
         match entry.load() {
@@ -189,13 +190,13 @@ fn renders(
 }
 
 /// The true composite of `scene` under `map` turned by `rotation_deg`, at `settings`' samples.
-pub(super) fn true_composite(
+pub(crate) fn true_composite(
     scene: &Scene,
     camera: &Camera,
     map: &EnvMap,
     rotation_deg: f32,
     settings: &ReportSettings,
-) -> anyhow::Result<Truth> {
+) -> Result<Truth> {
     let backplate = match photograph(scene, camera)? {
         Some(image) => image,
         None => {

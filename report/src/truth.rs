@@ -3,15 +3,16 @@
 //! stricter request continues them instead of starting over. (The path tracer itself is the
 //! `reference` crate; this module is the report's use of it.)
 
-use super::stats::{Masks, NoiseFloor, noise_floor};
-use crate::bake_cache::{self, cache_dir};
-use crate::support::TerminalProgress;
+use crate::error::Result;
+use crate::observer::Observer;
+use crate::stats::{Masks, NoiseFloor, noise_floor};
 use foundation::bvh::SceneBvh;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::image_io::{RgbImageF32, read_exr, write_exr};
 use foundation::infra::progress::Progress;
 use foundation::scene::Scene;
+use precompute::cache::{cache_dir, create_cache_folder};
 use reference::{
     self, EnvironmentLight, MAX_SOBOL_SAMPLES, ReferenceImage, ReferenceSettings, SamplerKind,
 };
@@ -63,30 +64,30 @@ pub struct ReferenceRequest {
 }
 
 /// The reference with its coverage, visibility and halves.
-pub(crate) struct ReferenceImages {
+pub struct ReferenceImages {
     /// The mean of the two halves.
-    pub(crate) radiance: RgbImageF32,
-    pub(crate) halves: [RgbImageF32; 2],
-    pub(crate) coverage: Vec<f32>,
-    pub(crate) visibility: Vec<f32>,
+    pub radiance: RgbImageF32,
+    pub halves: [RgbImageF32; 2],
+    pub coverage: Vec<f32>,
+    pub visibility: Vec<f32>,
     /// Glossy scenes: the part of `radiance` reflected by the first surface's specular lobe.
-    pub(crate) specular: Option<RgbImageF32>,
-    pub(crate) samples_per_half: u32,
+    pub specular: Option<RgbImageF32>,
+    pub samples_per_half: u32,
     /// Nothing had to be rendered.
-    pub(crate) cached: bool,
+    pub cached: bool,
     /// Seconds spent rendering now.
-    pub(crate) seconds: f64,
+    pub seconds: f64,
 }
 
 impl ReferenceImages {
     /// The noise floor of the statistics on this reference.
-    pub(crate) fn noise(&self, exposure: f32) -> NoiseFloor {
+    pub fn noise(&self, exposure: f32) -> NoiseFloor {
         noise_floor(&self.halves[0], &self.halves[1], &self.masks(), exposure)
     }
 
     /// The statistics' regions on this reference (the highlight region where it has a
     /// specular part).
-    pub(crate) fn masks(&self) -> Masks {
+    pub fn masks(&self) -> Masks {
         let masks = Masks::new(&self.coverage, &self.visibility);
         match &self.specular {
             Some(specular) => masks.with_highlight(&self.radiance, specular),
@@ -113,7 +114,7 @@ fn reference_key(
     map: &EnvMap,
     rotation_deg: f32,
     request: &ReferenceRequest,
-) -> anyhow::Result<String> {
+) -> Result<String> {
     let mut hasher = blake3::Hasher::new();
     hasher.update(b"hprt reference v4 (halves, files by sample count)");
     hash_view(&mut hasher, scene, camera, map, rotation_deg)?;
@@ -125,13 +126,13 @@ fn reference_key(
 
 /// Hashes what a path trace sees: the scene's mesh (and materials), the camera, the map's
 /// texels and its rotation.
-pub(super) fn hash_view(
+pub(crate) fn hash_view(
     hasher: &mut blake3::Hasher,
     scene: &Scene,
     camera: &Camera,
     map: &EnvMap,
     rotation_deg: f32,
-) -> anyhow::Result<()> {
+) -> Result<()> {
     hasher.update(&scene.geometry.content_hash());
     hasher.update(serde_json::to_string(camera)?.as_bytes());
     hasher.update(&(map.width() as u64).to_le_bytes());
@@ -189,11 +190,11 @@ impl CachePaths {
     }
 
     /// `glossy`: the entry must have its specular part.
-    fn load(&self, glossy: bool) -> anyhow::Result<ReferenceImages> {
+    fn load(&self, glossy: bool) -> Result<ReferenceImages> {
         let meta: CacheMeta = serde_json::from_slice(&std::fs::read(&self.meta)?)?;
         let files = self.files(meta.samples_per_half);
         let halves = [read_exr(&files.halves[0])?, read_exr(&files.halves[1])?];
-        let grey = |path: &PathBuf| -> anyhow::Result<Vec<f32>> {
+        let grey = |path: &PathBuf| -> Result<Vec<f32>> {
             Ok(read_exr(path)?.pixels.iter().map(|p| p.x).collect())
         };
         Ok(ReferenceImages {
@@ -214,8 +215,8 @@ impl CachePaths {
 
     /// Writes the images, then the sample count that makes them the entry, then removes the
     /// images of the count it replaced.
-    fn store(&self, images: &ReferenceImages, replaced: Option<u32>) -> anyhow::Result<()> {
-        bake_cache::create_cache_folder(&self.dir)?;
+    fn store(&self, images: &ReferenceImages, replaced: Option<u32>) -> Result<()> {
+        create_cache_folder(&self.dir)?;
         let (w, h) = (images.radiance.width, images.radiance.height);
         let files = self.files(images.samples_per_half);
         write_exr(&files.halves[0], &images.halves[0])?;
@@ -362,14 +363,15 @@ fn sample_limit(sampler: SamplerKind) -> u32 {
 /// The reference `request` asks for: from the cache, continued from it, or rendered (then
 /// cached). `best_error` gives the best method's mean error against a reference, for a
 /// target relative to it.
-pub(crate) fn reference_images(
+pub fn reference_images(
     scene: &Scene,
     camera: &Camera,
     map: &EnvMap,
     rotation_deg: f32,
     request: &ReferenceRequest,
     best_error: &dyn Fn(&ReferenceImages) -> f64,
-) -> anyhow::Result<ReferenceImages> {
+    observer: &dyn Observer,
+) -> Result<ReferenceImages> {
     let key = reference_key(scene, camera, map, rotation_deg, request)?;
     let paths = CachePaths::new(&key);
     let mut current = cached(&paths, &key, scene.geometry.is_glossy());
@@ -379,8 +381,8 @@ pub(crate) fn reference_images(
     let view = std::cell::OnceCell::new();
     // One pass of `count` more samples per half, and the seconds each took.
     let pass = |current: Option<ReferenceImages>, count: u32, label: String| {
-        println!("reference: {label}");
-        let progress = TerminalProgress::new("reference rows");
+        observer.line(&format!("reference: {label}"));
+        let progress = observer.progress("reference rows");
         progress.status(&label);
         let pass_start = Instant::now();
         let view = view.get_or_init(|| View {
@@ -389,7 +391,7 @@ pub(crate) fn reference_images(
             bvh: SceneBvh::build(&scene.geometry.mesh),
             light: EnvironmentLight::new(map, rotation_deg),
         });
-        let images = render_pass(view, request, current, count, &progress);
+        let images = render_pass(view, request, current, count, progress.as_ref());
         (
             images,
             pass_start.elapsed().as_secs_f64() / f64::from(count),

@@ -1,7 +1,7 @@
 //! What a sequence report found, per frame and per method.
 
-use super::super::settings::ReportSettings;
 use super::temporal::{POP_FLOOR, POP_SPIKE, mark_popping};
+use crate::settings::ReportSettings;
 use foundation::scene::Scene;
 use runtime::render::RenderMode;
 use std::path::Path;

@@ -4,10 +4,13 @@
 //! objects, over the changed region (proxy pixels the objects change by more than 2%) and over
 //! the whole frame, beside the truth's own noise there.
 
-use super::composite_truth::{Regions, true_composite};
-use super::{Method, ReportSettings, method_lighting};
+use crate::composite_truth::{Regions, true_composite};
+use crate::error::{ReportError, Result};
 use crate::gpu_composite::{CompositeForm, CompositeInputs, composite_frame};
 use crate::maps::{default_exposure, load_map, scene_rotation};
+use crate::observer::Observer;
+use crate::per_map::{method_lighting, report_renderer, unique_map_names};
+use crate::{Method, ReportSettings};
 use foundation::Rgb;
 use foundation::color::luminance;
 use foundation::image_io::{RgbImageF32, write_exr, write_png};
@@ -104,28 +107,36 @@ fn methods() -> Vec<(&'static str, &'static str, Method, CompositeForm)> {
     all
 }
 
+/// What every map's section of a composite's report shares.
+struct CompositeJob<'a> {
+    scene: &'a Scene,
+    gpu: &'a GpuContext,
+    renderer: &'a mut Renderer,
+    transfer: &'a Transfer,
+    settings: &'a ReportSettings,
+    observer: &'a dyn Observer,
+}
+
 /// One map's section, its images written into `dir`.
 fn report_map(
-    scene: &Scene,
-    gpu: &GpuContext,
-    renderer: &mut Renderer,
-    transfer: &Transfer,
+    job: &mut CompositeJob,
     (env, name): (&Path, &str),
-    settings: &ReportSettings,
     dir: &Path,
-) -> anyhow::Result<CompositeMapReport> {
-    crate::support::create_folder(dir)?;
+) -> Result<CompositeMapReport> {
+    let (scene, settings) = (job.scene, job.settings);
+    crate::maps::create_folder(dir)?;
     let map = load_map(env, None)?.map;
     let rotation = scene_rotation(scene, None);
     let exposure = default_exposure(&map);
     let camera = scene.camera.with_size(settings.width, settings.height);
-    println!(
+    job.observer.line(&format!(
         "{name}: the true composite ({}x{}, {} spp)",
         camera.width, camera.height, settings.spp
-    );
+    ));
     let truth = true_composite(scene, &camera, &map, rotation, settings)?;
     if truth.cached {
-        println!("{name}: the true composite from the cache");
+        job.observer
+            .line(&format!("{name}: the true composite from the cache"));
     }
     write_exr(&dir.join("truth.exr"), &truth.image)?;
     write_png(&dir.join("truth.png"), &truth.image, exposure)?;
@@ -156,7 +167,8 @@ fn report_map(
     let mut results = Vec::new();
     for (label, stem, method, form) in methods() {
         let threshold = DecomposeSettings::default().threshold;
-        let (frame, _, _) = method_lighting(&mut lighting, renderer.order(), method, threshold)?;
+        let order = job.renderer.order();
+        let (frame, _, _) = method_lighting(&mut lighting, order, method, threshold)?;
         let inputs = CompositeInputs {
             scene,
             camera: &camera,
@@ -165,7 +177,15 @@ fn report_map(
             shadow: ShadowSettings::default(),
             form,
         };
-        let image = composite_frame(gpu, renderer, transfer, &frame, &inputs)?.image;
+        let image = composite_frame(
+            job.gpu,
+            job.renderer,
+            job.transfer,
+            &frame,
+            &inputs,
+            job.observer,
+        )?
+        .image;
         write_exr(&dir.join(format!("{stem}.exr")), &image)?;
         write_png(&dir.join(format!("{stem}.png")), &image, exposure)?;
         results.push(CompositeMethodResult {
@@ -196,26 +216,25 @@ pub fn run_composite_report(
     envs: &[PathBuf],
     settings: &ReportSettings,
     out: &Path,
-) -> anyhow::Result<CompositeReport> {
-    anyhow::ensure!(
-        settings.target_noise.is_none(),
-        "--target-noise: a composite's report renders its truth at --spp paths per pixel"
-    );
-    crate::support::create_folder(out)?;
-    let (gpu, _, mut renderer) = super::report_renderer(scene, transfer, settings)?;
+    observer: &dyn Observer,
+) -> Result<CompositeReport> {
+    if settings.target_noise.is_some() {
+        return Err(ReportError::TargetNoiseInComposite);
+    }
+    crate::maps::create_folder(out)?;
+    let (gpu, _, mut renderer) = report_renderer(scene, transfer, settings, observer)?;
+    let mut job = CompositeJob {
+        scene,
+        gpu: &gpu,
+        renderer: &mut renderer,
+        transfer,
+        settings,
+        observer,
+    };
     let mut maps = Vec::new();
-    for (env, name) in envs.iter().zip(super::unique_map_names(envs)) {
+    for (env, name) in envs.iter().zip(unique_map_names(envs)) {
         let dir = out.join(&name);
-        let map = report_map(
-            scene,
-            &gpu,
-            &mut renderer,
-            transfer,
-            (env, &name),
-            settings,
-            &dir,
-        )?;
-        maps.push(map);
+        maps.push(report_map(&mut job, (env, &name), &dir)?);
     }
     let report = CompositeReport {
         scene: scene.path.display().to_string(),
@@ -231,29 +250,31 @@ pub fn run_composite_report(
     Ok(report)
 }
 
-/// Prints every map's table: each method's errors over the three regions, the truth's noise
-/// first.
-pub fn print_composite_summary(report: &CompositeReport) {
+/// Every map's table, a line each: each method's errors over the three regions, the truth's
+/// noise first.
+pub fn composite_summary_lines(report: &CompositeReport) -> Vec<String> {
+    let mut lines = Vec::new();
     for map in &report.maps {
-        println!(
+        lines.push(format!(
             "\n{} ({} spp; {} object, {} changed, {} pixels): relative luminance RMSE",
             map.name, map.reference_spp, map.pixels.object, map.pixels.changed, map.pixels.frame
-        );
-        println!(
+        ));
+        lines.push(format!(
             "{:<24} {:>8} {:>8} {:>8}",
             "method", "object", "changed", "frame"
-        );
+        ));
         let row = |name: &str, e: &RegionErrors| {
-            println!(
+            format!(
                 "{name:<24} {:>8.4} {:>8.4} {:>8.4}",
                 e.object, e.changed, e.frame
-            );
+            )
         };
-        row("(truth's noise)", &map.noise);
+        lines.push(row("(truth's noise)", &map.noise));
         for m in &map.methods {
-            row(&m.method, &m.errors);
+            lines.push(row(&m.method, &m.errors));
         }
     }
+    lines
 }
 
 /// A page of tables and images.

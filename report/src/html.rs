@@ -2,7 +2,7 @@
 //! it can be mailed or archived on its own.
 
 use super::{MapReport, MapStatus, Method, MethodResult, Report};
-use anyhow::Context;
+use crate::error::{ReportError, Result};
 use base64::Engine;
 use std::fmt::Write;
 use std::path::Path;
@@ -39,8 +39,8 @@ fn mean_std(mean: f64, std: f64) -> String {
     }
 }
 
-fn embedded_png(path: &Path) -> anyhow::Result<String> {
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+fn embedded_png(path: &Path) -> Result<String> {
+    let bytes = std::fs::read(path).map_err(ReportError::file("cannot read", path))?;
     Ok(format!(
         "data:image/png;base64,{}",
         base64::engine::general_purpose::STANDARD.encode(bytes)
@@ -205,7 +205,7 @@ fn sweep_table(html: &mut String, map: &MapReport) {
     html.push_str("</table>");
 }
 
-fn map_section(html: &mut String, map: &MapReport, out: &Path) -> anyhow::Result<()> {
+fn map_section(html: &mut String, map: &MapReport, out: &Path) -> Result<()> {
     let dir = out.join(&map.name);
     let _ = write!(
         html,
@@ -264,8 +264,8 @@ fn map_section(html: &mut String, map: &MapReport, out: &Path) -> anyhow::Result
     html.push_str("</div>");
     summary_table(html, &[map]);
     let svg_path = dir.join("threshold.svg");
-    let svg = std::fs::read_to_string(&svg_path)
-        .with_context(|| format!("cannot read {}", svg_path.display()))?;
+    let svg =
+        std::fs::read_to_string(&svg_path).map_err(ReportError::file("cannot read", &svg_path))?;
     let _ = write!(
         html,
         "<div class=\"row\"><div style=\"flex: 0 1 600px\">{svg}</div><div>"
@@ -276,7 +276,7 @@ fn map_section(html: &mut String, map: &MapReport, out: &Path) -> anyhow::Result
 }
 
 /// The page for `report`, whose images lie under `out`.
-pub fn page(report: &Report, out: &Path) -> anyhow::Result<String> {
+pub fn page(report: &Report, out: &Path) -> Result<String> {
     let mut html = String::new();
     let s = &report.settings;
     let _ = write!(
@@ -346,7 +346,7 @@ pub fn page(report: &Report, out: &Path) -> anyhow::Result<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::stats::ErrorStats;
+    use crate::stats::ErrorStats;
 
     #[test]
     fn escapes_markup() {

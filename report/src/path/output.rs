@@ -1,8 +1,9 @@
 //! The path report's files: `report.html`, `path.json`, `path.csv`, the plots along the path
 //! and the animated GIF; and its summary on the terminal.
 
-use super::super::figures;
 use super::results::{PathMethod, PathReport, PositionResult};
+use crate::error::{ReportError, Result};
+use crate::figures;
 use base64::Engine;
 use foundation::infra::atomic_file::write_atomic;
 use std::fmt::Write;
@@ -16,7 +17,7 @@ pub(super) fn write_outputs(
     gif_frames: &[Vec<u8>],
     (gif_width, gif_height): (u32, u32),
     out: &Path,
-) -> anyhow::Result<()> {
+) -> Result<()> {
     let series = |value: &dyn Fn(&PositionResult) -> Option<f64>| -> Vec<(String, Vec<f64>)> {
         (PathMethod::ALL.iter().enumerate())
             .map(|(m, method)| {
@@ -71,7 +72,7 @@ pub(super) fn write_outputs(
     Ok(())
 }
 
-fn csv_bytes(report: &PathReport) -> anyhow::Result<Vec<u8>> {
+fn csv_bytes(report: &PathReport) -> Result<Vec<u8>> {
     let mut csv = csv::Writer::from_writer(Vec::new());
     csv.write_record([
         "frame",
@@ -104,10 +105,11 @@ fn csv_bytes(report: &PathReport) -> anyhow::Result<Vec<u8>> {
             ])?;
         }
     }
-    csv.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
+    csv.into_inner()
+        .map_err(|e| ReportError::Csv(e.to_string()))
 }
 
-fn page(report: &PathReport, gif: &[u8], svgs: &[&str]) -> anyhow::Result<String> {
+fn page(report: &PathReport, gif: &[u8], svgs: &[&str]) -> Result<String> {
     let mut html = super::super::sequence::output::page_head("hprt path report");
     writeln!(
         html,
@@ -176,25 +178,27 @@ fn page(report: &PathReport, gif: &[u8], svgs: &[&str]) -> anyhow::Result<String
     Ok(html)
 }
 
-pub(super) fn print_summary(report: &PathReport) {
-    println!();
-    println!(
+/// The path report's table and verdict, a line each.
+pub fn summary_lines(report: &PathReport) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    lines.push(format!(
         "{:<20} {:>10} {:>10} {:>10} {:>9}",
         "method", "model", "changed", "temporal", "popping"
-    );
+    ));
     for m in &report.methods {
-        println!(
+        lines.push(format!(
             "{:<20} {:>10.4} {:>10.4} {:>10.4} {:>9}",
             m.method,
             m.mean_model_error,
             m.mean_changed_error,
             m.mean_temporal_error,
             m.popping_frames
-        );
+        ));
     }
-    println!(
+    lines.push(format!(
         "the fused map beats one probe and the nearest probe on the model at {} of {} positions; \
          its model error is {:.2}x the true probe's",
         report.fused_beats_probes, report.frames, report.fused_over_true
-    );
+    ));
+    lines
 }

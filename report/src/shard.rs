@@ -4,10 +4,12 @@
 //! renamed into place, which stays atomic on a shared file system (NFS renames within a
 //! folder atomically), so shards on many machines may share one cache folder.
 
-use super::composite_truth::true_composite;
-use super::{ReportSettings, reference_images};
+use crate::composite_truth::true_composite;
 use crate::env_sequence::Sequence;
+use crate::error::{ReportError, Result};
 use crate::maps::{default_exposure, load_map, scene_rotation};
+use crate::observer::Observer;
+use crate::{ReferenceImages, ReportSettings, reference_images};
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::infra::shard::ShardSpec;
@@ -32,7 +34,7 @@ impl ReportMaps<'_> {
 
     /// Pair `k`'s map and the exposure its reference's noise is measured at (a sequence's
     /// first frame's, as its report does).
-    fn map(&self, k: usize) -> anyhow::Result<(EnvMap, f32)> {
+    fn map(&self, k: usize) -> Result<(EnvMap, f32)> {
         Ok(match self {
             Self::Maps(maps) => {
                 let map = load_map(&maps[k], None)?.map;
@@ -68,24 +70,24 @@ pub fn render_share(
     camera: &Camera,
     settings: &ReportSettings,
     spec: ShardSpec,
-) -> anyhow::Result<()> {
+    observer: &dyn Observer,
+) -> Result<()> {
     let rotation = scene_rotation(scene, None);
     let pairs = share(spec, maps.len());
-    println!(
+    observer.line(&format!(
         "shard {spec}: {} of the report's {} references",
         pairs.len(),
         maps.len()
-    );
+    ));
     let composite = scene.backplate.is_some();
-    anyhow::ensure!(
-        !composite || settings.target_noise.is_none(),
-        "--target-noise: a composite's report renders its truth at --spp paths per pixel"
-    );
+    if composite && settings.target_noise.is_some() {
+        return Err(ReportError::TargetNoiseInComposite);
+    }
     for k in pairs {
         let (map, exposure) = maps.map(k)?;
         if composite {
             let truth = true_composite(scene, camera, &map, rotation, settings)?;
-            println!(
+            observer.line(&format!(
                 "{}: the true composite {}",
                 maps.name(k),
                 if truth.cached {
@@ -93,7 +95,7 @@ pub fn render_share(
                 } else {
                     "rendered"
                 }
-            );
+            ));
             continue;
         }
         let mut request = settings.reference_request(exposure);
@@ -101,9 +103,10 @@ pub fn render_share(
             // As the sequence report asks (its frames have no noise target).
             request.target_noise = None;
         }
+        let no_limit = |_: &ReferenceImages| f64::INFINITY;
         let reference =
-            reference_images(scene, camera, &map, rotation, &request, &|_| f64::INFINITY)?;
-        println!(
+            reference_images(scene, camera, &map, rotation, &request, &no_limit, observer)?;
+        observer.line(&format!(
             "{}: reference of 2 × {} spp {}",
             maps.name(k),
             reference.samples_per_half,
@@ -112,7 +115,7 @@ pub fn render_share(
             } else {
                 format!("rendered in {:.1} s", reference.seconds)
             }
-        );
+        ));
     }
     Ok(())
 }

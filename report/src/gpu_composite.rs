@@ -6,8 +6,9 @@
 //! them. The same formula as the truth, so a method's composite is measured against the
 //! truth's on equal terms; the viewer's live composite needs the ratio in a GPU pass.
 
-use crate::bake_cache::bake_for;
-use anyhow::Context;
+use crate::bake::cached_bake;
+use crate::error::{ReportError, Result};
+use crate::observer::Observer;
 use foundation::Rgb;
 use foundation::bvh::SceneBvh;
 use foundation::camera::Camera;
@@ -24,7 +25,8 @@ use runtime::FrameLighting;
 use runtime::render::{GpuContext, LiveBackplate, Renderer, ShadowSettings};
 
 /// How the objects' effect on the proxies is composited.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum CompositeForm {
     /// The ratio of the proxies with and without the objects (every light's shadow, the
     /// light the objects bounce onto them): the truth's form.
@@ -60,15 +62,18 @@ fn proxies_scene(scene: &Scene, whole: &Transfer) -> Scene {
 }
 
 /// The bake of the proxies alone (cached like any scene's), with the whole scene's settings.
-pub fn proxies_bake(scene: &Scene, whole: &Transfer) -> anyhow::Result<Transfer> {
+pub fn proxies_bake(scene: &Scene, whole: &Transfer, observer: &dyn Observer) -> Result<Transfer> {
     let proxies = proxies_scene(scene, whole);
-    let (_, transfer) = bake_for(&proxies, None).context("cannot bake the proxies alone")?;
+    let (_, transfer) = cached_bake(&proxies, observer).map_err(|e| ReportError::Bake {
+        what: "the proxies alone",
+        source: Box::new(e),
+    })?;
     Ok(transfer)
 }
 
 /// The backplate of the live composite: the environment, or the scene's photograph at its
 /// camera's size.
-pub fn live_backplate(scene: &Scene) -> anyhow::Result<LiveBackplate> {
+pub fn live_backplate(scene: &Scene) -> Result<LiveBackplate> {
     Ok(match &scene.backplate {
         Some(Backplate::Image(path)) => LiveBackplate::Photograph(load_backplate_image(
             path,
@@ -85,8 +90,9 @@ pub fn live_composite_frame(
     transfer: &Transfer,
     lighting: &FrameLighting,
     inputs: &CompositeInputs,
-) -> anyhow::Result<RgbImageF32> {
-    let proxies_transfer = proxies_bake(inputs.scene, transfer)?;
+    observer: &dyn Observer,
+) -> Result<RgbImageF32> {
+    let proxies_transfer = proxies_bake(inputs.scene, transfer, observer)?;
     whole.enable_composite(
         &inputs.scene.geometry,
         &proxies_transfer,
@@ -102,7 +108,7 @@ pub fn live_composite_frame(
 }
 
 /// The picture composited into, at the camera's size.
-fn backplate_image(inputs: &CompositeInputs) -> anyhow::Result<RgbImageF32> {
+fn backplate_image(inputs: &CompositeInputs) -> Result<RgbImageF32> {
     match &inputs.scene.backplate {
         Some(Backplate::Image(path)) => Ok(load_backplate_image(
             path,
@@ -159,8 +165,9 @@ pub fn composite_frame(
     transfer: &Transfer,
     lighting: &FrameLighting,
     inputs: &CompositeInputs,
-) -> anyhow::Result<Composite> {
-    let draw = |renderer: &mut Renderer| -> anyhow::Result<RgbImageF32> {
+    observer: &dyn Observer,
+) -> Result<Composite> {
+    let draw = |renderer: &mut Renderer| -> Result<RgbImageF32> {
         renderer.set_environment(inputs.map, inputs.rotation_deg);
         renderer.set_lighting(lighting)?;
         renderer.render()?;
@@ -180,7 +187,7 @@ pub fn composite_frame(
         ));
     }
     let proxies = proxies_scene(inputs.scene, transfer);
-    let proxies_transfer = proxies_bake(inputs.scene, transfer)?;
+    let proxies_transfer = proxies_bake(inputs.scene, transfer, observer)?;
     let mut without = Renderer::new(
         gpu,
         &proxies.geometry,

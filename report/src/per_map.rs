@@ -1,45 +1,33 @@
-//! Error-statistics reports (thesis chapter 5, Table 5.1 and Figures 5.7–5.11): for each
+//! The report per map (thesis chapter 5, Table 5.1 and Figures 5.7–5.11): for each
 //! environment map, the path-traced reference, the plain PRT image and the hybrid in both
 //! decomposition modes, their error images and statistics, and the error against the Weber
-//! threshold; written as `report.html`, `stats.json` and `stats.csv`.
+//! threshold.
 
-pub mod composite;
-mod composite_truth;
-mod csv;
-pub mod figures;
-mod html;
-pub mod path;
-mod results;
-pub mod sequence;
-mod settings;
-pub mod shard;
-pub mod stats;
-mod truth;
-
-use crate::maps::{default_exposure, load_map, scene_rotation};
-use crate::support::median;
-use figures::Curve;
+use crate::error::{Result, error_chain};
+use crate::figures::{self, Curve};
+use crate::maps::{default_exposure, load_map, median, scene_rotation};
+use crate::observer::Observer;
+use crate::results::{MapReport, MapStatus, Method, MethodResult, Report, SweepPoint};
+use crate::settings::ReportSettings;
+use crate::stats::{self, Masks, NoiseFloor, error_stats};
+use crate::truth::{ReferenceImages, reference_images};
+use crate::{csv, html};
 use foundation::camera::Camera;
 use foundation::image_io::{RgbImageF32, write_exr, write_png};
 use foundation::infra::atomic_file::write_atomic;
 use foundation::scene::Scene;
 use precompute::bake::Transfer;
-pub use results::{MapReport, MapStatus, Method, MethodResult, Report, SweepPoint};
 use runtime::render::{FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
-pub use settings::ReportSettings;
-use stats::{Masks, NoiseFloor, error_stats};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-pub use truth::NoiseTarget;
-pub(crate) use truth::{ReferenceImages, ReferenceRequest, reference_images};
 
 /// Renders with `lighting` and times `frames` frames (static lighting, median).
 fn render_timed(
     renderer: &mut Renderer,
     lighting: &FrameLighting,
     frames: usize,
-) -> anyhow::Result<(RgbImageF32, f64)> {
+) -> Result<(RgbImageF32, f64)> {
     renderer.set_lighting(lighting)?;
     renderer.render()?;
     let image = renderer.read_back()?;
@@ -55,7 +43,7 @@ fn render_timed(
 
 /// Each map's name in the report (and its folder's): the file stem, with `-2`, `-3`... added to
 /// later maps of the same stem, so that no map's images overwrite another's.
-fn unique_map_names(envs: &[PathBuf]) -> Vec<String> {
+pub(crate) fn unique_map_names(envs: &[PathBuf]) -> Vec<String> {
     let mut names: Vec<String> = Vec::with_capacity(envs.len());
     for env in envs {
         let stem = map_name(env);
@@ -84,11 +72,12 @@ struct MapJob<'a> {
     settings: &'a ReportSettings,
     renderer: &'a mut Renderer,
     out: &'a Path,
+    observer: &'a dyn Observer,
 }
 
 /// What making a method's lighting cost, in milliseconds.
 #[derive(Debug, Clone, Copy)]
-struct LightingCost {
+pub(crate) struct LightingCost {
     /// On the map's first frame.
     first_ms: f64,
     /// On a later frame of a changing map.
@@ -98,12 +87,12 @@ struct LightingCost {
 /// The lighting of `method` at Weber `threshold` (each mode's own defaults otherwise), its
 /// number of lights and what the decomposition (or projection) cost: on the first frame, and
 /// done again as for the next frame of a changing map.
-fn method_lighting(
+pub(crate) fn method_lighting(
     lighting: &mut EnvironmentLighting,
     order: usize,
     method: Method,
     threshold: f32,
-) -> anyhow::Result<(FrameLighting, usize, LightingCost)> {
+) -> Result<(FrameLighting, usize, LightingCost)> {
     let (frame, lights, first_ms) = first_frame_lighting(lighting, order, method, threshold)?;
     lighting.forget_derived();
     let (_, _, warm_ms) = first_frame_lighting(lighting, order, method, threshold)?;
@@ -116,7 +105,7 @@ fn first_frame_lighting(
     order: usize,
     method: Method,
     threshold: f32,
-) -> anyhow::Result<(FrameLighting, usize, f64)> {
+) -> Result<(FrameLighting, usize, f64)> {
     let (mode, render_mode) = match method {
         Method::Prt => (DecomposeMode::Consistent, RenderMode::Prt),
         Method::Hybrid(mode) => (mode, RenderMode::Hybrid),
@@ -142,7 +131,7 @@ fn first_frame_lighting(
 }
 
 /// The reference's images, written into the map's folder.
-fn write_reference(dir: &Path, reference: &ReferenceImages, exposure: f32) -> anyhow::Result<()> {
+fn write_reference(dir: &Path, reference: &ReferenceImages, exposure: f32) -> Result<()> {
     let (w, h) = (reference.radiance.width, reference.radiance.height);
     write_exr(&dir.join("reference.exr"), &reference.radiance)?;
     write_png(&dir.join("reference.png"), &reference.radiance, exposure)?;
@@ -169,7 +158,7 @@ fn write_heat_maps(
     reference: &RgbImageF32,
     masks: &Masks,
     exposure: f32,
-) -> anyhow::Result<()> {
+) -> Result<()> {
     let errors: Vec<Vec<f32>> = images
         .iter()
         .map(|image| stats::error_image(image, reference, exposure))
@@ -184,13 +173,13 @@ fn write_heat_maps(
 }
 
 /// One map's section; an error is reported as a failed map by the caller.
-fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapReport> {
+fn report_map(job: &mut MapJob, env: &Path, name: &str) -> Result<MapReport> {
     let name = name.to_owned();
     let map = load_map(env, None)?.map;
     let rotation = scene_rotation(job.scene, None);
     let exposure = default_exposure(&map);
     let dir = job.out.join(&name);
-    crate::support::create_folder(&dir)?;
+    crate::maps::create_folder(&dir)?;
 
     // The methods first: a reference rendered to a share of the best method's error needs
     // their images.
@@ -217,9 +206,10 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
         rotation,
         &request,
         &best_error,
+        job.observer,
     )?;
     let noise = reference.noise(exposure);
-    announce_reference(&name, &reference, &noise, &job.camera);
+    announce_reference(job.observer, &name, &reference, &noise, &job.camera);
     write_reference(&dir, &reference, exposure)?;
     let masks = reference.masks();
     let methods: Vec<MethodResult> = rendered
@@ -243,7 +233,7 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> anyhow::Result<MapRep
         .collect();
     write_heat_maps(&dir, &images, &reference.radiance, &masks, exposure)?;
     let (sweep, curves) = threshold_sweep(job, &mut lighting, &reference, &masks, exposure)?;
-    let noise_warning = warn_if_noisy(&name, &noise, &methods);
+    let noise_warning = warn_if_noisy(job.observer, &name, &noise, &methods);
     let svg = figures::threshold_plot(&name, &curves, methods[0].stats.mean)?;
     write_atomic(&dir.join("threshold.svg"), svg.as_bytes())?;
     Ok(MapReport {
@@ -279,7 +269,7 @@ fn render_methods(
     lighting: &mut EnvironmentLighting,
     dir: &Path,
     exposure: f32,
-) -> anyhow::Result<(Vec<RenderedMethod>, Vec<RgbImageF32>)> {
+) -> Result<(Vec<RenderedMethod>, Vec<RgbImageF32>)> {
     let order = job.renderer.order();
     let default_threshold = DecomposeSettings::default().threshold;
     let mut rendered = Vec::new();
@@ -306,6 +296,7 @@ fn render_methods(
 
 /// Says where the map's reference came from and how noisy it is.
 fn announce_reference(
+    observer: &dyn Observer,
     name: &str,
     reference: &ReferenceImages,
     noise: &NoiseFloor,
@@ -313,17 +304,17 @@ fn announce_reference(
 ) {
     let spp = 2 * reference.samples_per_half;
     if reference.cached {
-        println!("{name}: reference from the cache ({spp} spp)");
+        observer.line(&format!("{name}: reference from the cache ({spp} spp)"));
     } else {
-        println!(
+        observer.line(&format!(
             "{name}: reference ({}x{}, {spp} spp) rendered in {:.1} s",
             camera.width, camera.height, reference.seconds
-        );
+        ));
     }
-    println!(
+    observer.line(&format!(
         "{name}: reference noise floor {:.5} (mean), {:.5} (shadow region)",
         noise.mean, noise.shadow_mean
-    );
+    ));
 }
 
 /// Error against the Weber threshold, for both hybrid modes: the sweep's points and the
@@ -334,7 +325,7 @@ fn threshold_sweep(
     reference: &ReferenceImages,
     masks: &Masks,
     exposure: f32,
-) -> anyhow::Result<(Vec<MethodSweep>, Vec<Curve>)> {
+) -> Result<(Vec<MethodSweep>, Vec<Curve>)> {
     let order = job.renderer.order();
     let mut sweep = Vec::new();
     let mut curves = Vec::new();
@@ -368,35 +359,41 @@ fn threshold_sweep(
 
 /// Warns when the reference's noise is a large share of the best method's error; returns
 /// whether it did.
-fn warn_if_noisy(name: &str, noise: &NoiseFloor, methods: &[MethodResult]) -> bool {
+fn warn_if_noisy(
+    observer: &dyn Observer,
+    name: &str,
+    noise: &NoiseFloor,
+    methods: &[MethodResult],
+) -> bool {
     let best = methods
         .iter()
         .map(|m| m.stats.mean)
         .fold(f64::INFINITY, f64::min);
     let noisy = stats::noise_dominates(noise, best);
     if noisy {
-        println!(
+        observer.line(&format!(
             "warning: {name}: the reference's noise floor {:.5} is {:.0}% of the best method's \
              mean error {best:.5}; the statistics measure the reference as much as the methods \
              (raise --spp or pass --target-noise {:.5})",
             noise.mean,
             100.0 * noise.mean / best,
             stats::NOISE_WARNING * best
-        );
+        ));
     }
     noisy
 }
 
 /// The report's adapter, camera and renderer of `scene`'s bake, at the report's image size.
-fn report_renderer(
+pub(crate) fn report_renderer(
     scene: &Scene,
     transfer: &Transfer,
     settings: &ReportSettings,
-) -> anyhow::Result<(GpuContext, Camera, Renderer)> {
+    observer: &dyn Observer,
+) -> Result<(GpuContext, Camera, Renderer)> {
     let camera = scene.camera.with_size(settings.width, settings.height);
     camera.validate()?;
     let gpu = GpuContext::headless(settings.backend)?;
-    println!("adapter: {}", gpu.description());
+    observer.line(&format!("adapter: {}", gpu.description()));
     let renderer = Renderer::new(
         &gpu,
         &scene.geometry,
@@ -415,9 +412,10 @@ pub fn run_report(
     envs: &[PathBuf],
     settings: &ReportSettings,
     out: &Path,
-) -> anyhow::Result<Report> {
-    crate::support::create_folder(out)?;
-    let (gpu, camera, mut renderer) = report_renderer(scene, transfer, settings)?;
+    observer: &dyn Observer,
+) -> Result<Report> {
+    crate::maps::create_folder(out)?;
+    let (gpu, camera, mut renderer) = report_renderer(scene, transfer, settings, observer)?;
     let mut maps = Vec::new();
     for (env, name) in envs.iter().zip(unique_map_names(envs)) {
         let mut cx = MapJob {
@@ -426,14 +424,16 @@ pub fn run_report(
             settings,
             renderer: &mut renderer,
             out,
+            observer,
         };
         let report = report_map(&mut cx, env, &name).unwrap_or_else(|e| {
-            println!("{}: failed: {e:#}", env.display());
+            let error = error_chain(&e);
+            observer.line(&format!("{}: failed: {error}", env.display()));
             MapReport {
                 name: name.clone(),
                 path: env.display().to_string(),
                 status: MapStatus::Failed,
-                error: Some(format!("{e:#}")),
+                error: Some(error),
                 exposure: 0.0,
                 reference_cached: false,
                 reference_seconds: 0.0,
@@ -467,11 +467,11 @@ pub fn run_report(
     Ok(report)
 }
 
-/// Prints the report's table: every map's methods and their errors.
-pub fn print_summary(report: &Report, glossy: bool) {
-    println!();
+/// The report's table, a line each: every map's methods and their errors.
+pub fn summary_lines(report: &Report, glossy: bool) -> Vec<String> {
+    let mut lines = vec![String::new()];
     // Glossy scenes add the highlight region's mean error.
-    println!(
+    lines.push(format!(
         "{:<12} {:<18} {:>8} {:>8} {:>8} {:>8} {:>6}{}",
         "map",
         "method",
@@ -481,10 +481,10 @@ pub fn print_summary(report: &Report, glossy: bool) {
         "rel.rmse",
         "lights",
         if glossy { "  highlight" } else { "" }
-    );
+    ));
     for map in &report.maps {
         if map.methods.is_empty() {
-            println!("{:<12} failed", map.name);
+            lines.push(format!("{:<12} failed", map.name));
         }
         for m in &map.methods {
             let highlight = if glossy {
@@ -492,7 +492,7 @@ pub fn print_summary(report: &Report, glossy: bool) {
             } else {
                 String::new()
             };
-            println!(
+            lines.push(format!(
                 "{:<12} {:<18} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>6}{highlight}",
                 map.name,
                 m.method,
@@ -501,9 +501,10 @@ pub fn print_summary(report: &Report, glossy: bool) {
                 m.stats.penumbra_mean,
                 m.stats.relative_rmse,
                 m.lights
-            );
+            ));
         }
     }
+    lines
 }
 
 #[cfg(test)]

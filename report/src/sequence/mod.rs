@@ -5,21 +5,26 @@
 //! follows the sun. Writes `report.html` (plots and an animated GIF of hybrid | prt |
 //! reference), `sequence.json`, `sequence.csv`, the plots as SVG and the GIF.
 
-pub(in crate::report) mod output;
+pub(crate) mod output;
 mod results;
-pub(in crate::report) mod temporal;
+pub(crate) mod temporal;
 
-use super::stats::error_stats;
-use super::{ReferenceImages, ReferenceRequest, ReportSettings, reference_images};
+pub use output::summary_lines;
+pub use results::SequenceReport;
+
 use crate::env_sequence::Sequence;
+use crate::error::{ReportError, Result};
 use crate::maps::{default_exposure, scene_rotation};
+use crate::observer::Observer;
+use crate::stats::error_stats;
+use crate::{ReferenceImages, ReferenceRequest, ReportSettings, reference_images};
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::envmap::animated::SunDisc;
 use foundation::image_io::{RgbImageF32, check_finite};
 use foundation::luminance;
 use foundation::scene::Scene;
-use output::{print_summary, side_by_side, write_outputs};
+use output::{side_by_side, write_outputs};
 use precompute::bake::Transfer;
 use results::{FrameResult, SequenceFrame, SequenceMethod, SunAccuracy, summarise};
 use runtime::DirectionalLight;
@@ -31,16 +36,16 @@ use temporal::{temporal, tonemapped_luminance};
 /// Writes the report on `sequence` (read from `sequence_path`) into `out`.
 pub fn write_sequence_report(
     scene: &Scene,
-    sequence: &Sequence,
-    sequence_path: &Path,
+    (sequence_path, sequence): (&Path, &Sequence),
     transfer: &Transfer,
     camera: Camera,
     settings: &ReportSettings,
     out: &Path,
-) -> anyhow::Result<()> {
-    crate::support::create_folder(out)?;
+    observer: &dyn Observer,
+) -> Result<SequenceReport> {
+    crate::maps::create_folder(out)?;
     let gpu = GpuContext::headless(settings.backend)?;
-    println!("adapter: {}", gpu.description());
+    observer.line(&format!("adapter: {}", gpu.description()));
     let renderer = Renderer::new(
         &gpu,
         &scene.geometry,
@@ -75,15 +80,21 @@ pub fn write_sequence_report(
         } else {
             sequence.frame(k)?
         };
-        let reference =
-            reference_images(scene, &camera, &map, rotation, &request, &|_| f64::INFINITY)?;
+        let no_limit = |_: &ReferenceImages| f64::INFINITY;
+        let reference = reference_images(
+            scene, &camera, &map, rotation, &request, &no_limit, observer,
+        )?;
         let (results, images, sun) = run.frame(k, &map, &reference, sequence.sun(k))?;
         // hybrid/tracked | prt | reference
         gif_frames.push(side_by_side(
             &[&images[1], &images[0], &reference.radiance],
             exposure,
         ));
-        println!("frame {k}/{}: {}", sequence.len() - 1, frame_line(&results));
+        observer.line(&format!(
+            "frame {k}/{}: {}",
+            sequence.len() - 1,
+            frame_line(&results)
+        ));
         frames.push(SequenceFrame {
             frame: k,
             methods: results,
@@ -93,8 +104,7 @@ pub fn write_sequence_report(
     }
     let report = summarise(scene, sequence_path, settings, frames, &run.light_changes);
     write_outputs(&report, &gif_frames, camera.width * 3, camera.height, out)?;
-    print_summary(&report);
-    Ok(())
+    Ok(report)
 }
 
 /// The methods' state from frame to frame of a sequence report.
@@ -121,7 +131,7 @@ impl SequenceRun {
         map: &EnvMap,
         reference: &ReferenceImages,
         sun: Option<SunDisc>,
-    ) -> anyhow::Result<(Vec<FrameResult>, Vec<RgbImageF32>, Option<SunAccuracy>)> {
+    ) -> Result<(Vec<FrameResult>, Vec<RgbImageF32>, Option<SunAccuracy>)> {
         let exposure = self.exposure;
         let masks = reference.masks();
         let reference_y = tonemapped_luminance(&reference.radiance, exposure);
@@ -140,8 +150,11 @@ impl SequenceRun {
             self.renderer.render()?;
             let image = self.renderer.read_back()?;
             // Statistics over NaN pixels would read as numbers: refuse the frame instead.
-            check_finite(&image, "frame")
-                .map_err(|e| anyhow::anyhow!("frame {k}, {}: {e}", method.name()))?;
+            check_finite(&image, "frame").map_err(|error| ReportError::Frame {
+                frame: k,
+                method: method.name(),
+                error,
+            })?;
             let s = error_stats(&image, &reference.radiance, &masks, exposure);
             let y = tonemapped_luminance(&image, exposure);
             let temporal_error = self.previous.as_ref().map(|(reference_before, before)| {
@@ -192,7 +205,7 @@ fn method_lightings(
     first: &EnvMap,
     order: usize,
     rotation: f32,
-) -> anyhow::Result<(Vec<EnvironmentLighting>, Option<EnvironmentLighting>)> {
+) -> Result<(Vec<EnvironmentLighting>, Option<EnvironmentLighting>)> {
     let decompose = DecomposeSettings::for_mode(runtime::DecomposeMode::Consistent, order);
     let mut lightings = Vec::new();
     for method in SequenceMethod::ALL {

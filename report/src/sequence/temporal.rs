@@ -13,7 +13,7 @@ pub const POP_SPIKE: f64 = 2.0;
 pub const POP_FLOOR: f64 = 0.002;
 
 /// Tone-mapped luminance of every pixel.
-pub(in crate::report) fn tonemapped_luminance(image: &RgbImageF32, exposure: f32) -> Vec<f32> {
+pub(crate) fn tonemapped_luminance(image: &RgbImageF32, exposure: f32) -> Vec<f32> {
     image
         .pixels
         .iter()
@@ -23,7 +23,7 @@ pub(in crate::report) fn tonemapped_luminance(image: &RgbImageF32, exposure: f32
 
 /// Temporal error of a method's frame: the mean over covered pixels of how much its change
 /// differs from the reference's.
-pub(in crate::report) fn temporal(
+pub(crate) fn temporal(
     now: &[f32],
     before: &[f32],
     reference_now: &[f32],
@@ -51,7 +51,7 @@ const POP_WINDOW: usize = 3;
 /// pops nowhere, while a light appearing at once does. A frame with neighbours on one side
 /// only (a sequence's first or last) is compared with the larger of their median and their
 /// trend carried on to it, so that the end of a motion that keeps speeding up is not a spike.
-pub(in crate::report) fn mark_popping(temporal: &[Option<f64>]) -> Vec<bool> {
+pub(crate) fn mark_popping(temporal: &[Option<f64>]) -> Vec<bool> {
     (0..temporal.len())
         .map(|t| {
             let Some(value) = temporal[t] else {
@@ -68,7 +68,7 @@ pub(in crate::report) fn mark_popping(temporal: &[Option<f64>]) -> Vec<bool> {
             if neighbours.is_empty() {
                 return false;
             }
-            let mut local = crate::support::median(neighbours);
+            let mut local = crate::maps::median(neighbours);
             if before.is_empty() || after.is_empty() {
                 let one_side = if before.is_empty() { &after } else { &before };
                 local = local.max(trend_at(one_side, t as f64).unwrap_or(0.0));

@@ -1,8 +1,9 @@
 //! The sequence report's files: `report.html`, `sequence.json`, `sequence.csv`, the plots and
 //! the animated GIF; and its summary on the terminal.
 
-use super::super::figures;
 use super::results::{FrameResult, SequenceMethod, SequenceReport};
+use crate::error::{ReportError, Result};
+use crate::figures;
 use base64::Engine;
 use foundation::image_io::{RgbImageF32, to_display_rgb8};
 use foundation::infra::atomic_file::write_atomic;
@@ -10,7 +11,7 @@ use std::fmt::Write;
 use std::path::Path;
 
 /// The start of a report page of plots and tables, up to its body.
-pub(in crate::report) fn page_head(title: &str) -> String {
+pub(crate) fn page_head(title: &str) -> String {
     format!(
         "<!doctype html><html><head><meta charset=\"utf-8\"><title>{title}</title>\
          <style>body{{font-family:sans-serif;max-width:1100px;margin:auto}}\
@@ -20,7 +21,7 @@ pub(in crate::report) fn page_head(title: &str) -> String {
 }
 
 /// Tone-mapped images next to each other, as 8-bit RGB rows.
-pub(in crate::report) fn side_by_side(images: &[&RgbImageF32], exposure: f32) -> Vec<u8> {
+pub(crate) fn side_by_side(images: &[&RgbImageF32], exposure: f32) -> Vec<u8> {
     let parts: Vec<Vec<u8>> = images
         .iter()
         .map(|image| to_display_rgb8(image, exposure))
@@ -41,7 +42,7 @@ pub(super) fn write_outputs(
     gif_width: u32,
     gif_height: u32,
     out: &Path,
-) -> anyhow::Result<()> {
+) -> Result<()> {
     let series = |value: &dyn Fn(&FrameResult) -> Option<f64>| -> Vec<(String, Vec<f64>)> {
         SequenceMethod::ALL
             .iter()
@@ -102,7 +103,8 @@ pub(super) fn write_outputs(
     }
     write_atomic(
         &out.join("sequence.csv"),
-        &csv.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?,
+        &csv.into_inner()
+            .map_err(|e| ReportError::Csv(e.to_string()))?,
     )?;
     let html = page(report, &gif, &error_svg, &temporal_svg)?;
     write_atomic(&out.join("report.html"), html.as_bytes())?;
@@ -114,7 +116,7 @@ fn page(
     gif: &[u8],
     error_svg: &str,
     temporal_svg: &str,
-) -> anyhow::Result<String> {
+) -> Result<String> {
     let mut html = page_head("hprt sequence report");
     writeln!(
         html,
@@ -172,23 +174,25 @@ fn page(
     Ok(html)
 }
 
-pub(super) fn print_summary(report: &SequenceReport) {
-    println!();
-    println!(
+/// The sequence report's table, a line each.
+pub fn summary_lines(report: &SequenceReport) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    lines.push(format!(
         "{:<18} {:>10} {:>14} {:>9} {:>14}",
         "method", "mean", "temporal", "popping", "count changes"
-    );
+    ));
     for m in &report.methods {
-        println!(
+        lines.push(format!(
             "{:<18} {:>10.4} {:>14.4} {:>9} {:>14}",
             m.method, m.mean_error, m.mean_temporal_error, m.popping_frames, m.light_count_changes
-        );
+        ));
     }
     if let Some(sun) = report.sun_worst {
-        println!(
+        lines.push(format!(
             "sun: the tracked light is at most {:.3}° from the sun, its power at most {:.2}% off",
             sun.angle_deg,
             100.0 * sun.power_error
-        );
+        ));
     }
+    lines
 }

@@ -10,14 +10,18 @@
 mod output;
 mod results;
 
-use super::sequence::output::side_by_side;
-use super::sequence::temporal::{temporal, tonemapped_luminance};
-use super::stats::error_image;
-use super::{ReferenceImages, ReferenceRequest, ReportSettings, reference_images};
+pub use output::summary_lines;
+pub use results::PathReport;
+
+use crate::error::{ReportError, Result};
 use crate::gpu_composite::PrimaryHits;
 use crate::maps::default_exposure;
+use crate::observer::Observer;
 use crate::room::{PosedModel, RoomModel};
-use anyhow::Context;
+use crate::sequence::output::side_by_side;
+use crate::sequence::temporal::{temporal, tonemapped_luminance};
+use crate::stats::error_image;
+use crate::{ReferenceImages, ReferenceRequest, ReportSettings, reference_images};
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::image_io::{RgbImageF32, check_finite};
@@ -53,33 +57,32 @@ pub fn write_path_report(
     settings: &ReportSettings,
     options: &PathOptions,
     out: &Path,
-) -> anyhow::Result<()> {
+    observer: &dyn Observer,
+) -> Result<PathReport> {
     let sky = map.rotated(rotation_deg);
     let decompose = DecomposeSettings::for_mode(DecomposeMode::Consistent, scene.bake.order);
-    let model = RoomModel::open(scene, sky, decompose.clone())?;
+    let model = RoomModel::open(scene, sky, decompose.clone(), observer)?;
     let Some(path) = model.path.clone() else {
-        anyhow::bail!(
-            "{}: the report on a model's path needs a [path] in the scene",
-            scene.path.display()
-        );
+        return Err(ReportError::NoPath(scene.path.clone()));
     };
     let gpu = GpuContext::headless(settings.backend)?;
-    println!("adapter: {}", gpu.description());
+    observer.line(&format!("adapter: {}", gpu.description()));
     let sky = (map, rotation_deg);
-    let mut run = PathRun::new(scene, (model, decompose), &gpu, sky, &camera, settings)?;
+    let setup = (&gpu, settings, observer);
+    let mut run = PathRun::new(scene, (model, decompose), sky, &camera, setup)?;
     let poses = path.poses();
     let frames = pick_frames(poses.len(), options.positions);
     let (mut per_position, mut gif) = (Vec::new(), Vec::new());
     for (n, &frame) in frames.iter().enumerate() {
-        let (position, images) = run.position(frame, poses[frame], options.probe_spp)?;
-        println!(
+        let (position, images) = run.position(frame, poses[frame], options.probe_spp, observer)?;
+        observer.line(&format!(
             "position {n}/{} (frame {frame}): {}",
             frames.len() - 1,
             position_line(&position)
-        );
+        ));
         if position.intersects_room {
-            eprintln!(
-                "warning: {}: at frame {frame} the model ({}) passes through the room's proxies",
+            log::warn!(
+                "{}: at frame {frame} the model ({}) passes through the room's proxies",
                 scene.path.display(),
                 poses[frame].centre
             );
@@ -98,8 +101,7 @@ pub fn write_path_report(
     );
     let gif_size = (camera.width * 4, camera.height);
     output::write_outputs(&report, &gif, gif_size, out)?;
-    output::print_summary(&report);
-    Ok(())
+    Ok(report)
 }
 
 /// `count` frames of `frames`, evenly spaced with the first and the last (all of them when
@@ -147,11 +149,10 @@ impl PathRun {
     fn new(
         scene: &Scene,
         (model, decompose): (RoomModel, DecomposeSettings),
-        gpu: &GpuContext,
         (map, rotation_deg): (&EnvMap, f32),
         camera: &Camera,
-        settings: &ReportSettings,
-    ) -> anyhow::Result<Self> {
+        (gpu, settings, observer): (&GpuContext, &ReportSettings, &dyn Observer),
+    ) -> Result<Self> {
         let shadow = ShadowSettings::default();
         let room_geometry = scene.geometry.of_role(ObjectRole::Proxy);
         let mut whole = Renderer::new(gpu, &model.geometry, &model.transfer, camera, shadow)?;
@@ -176,8 +177,16 @@ impl PathRun {
             .with_geometry(room_geometry.clone())
             .without_backplate();
         let no_limit = |_: &ReferenceImages| f64::INFINITY;
-        let empty = reference_images(&room_scene, camera, map, rotation_deg, &request, &no_limit)
-            .context("cannot render the empty room's truth")?;
+        let empty = reference_images(
+            &room_scene,
+            camera,
+            map,
+            rotation_deg,
+            &request,
+            &no_limit,
+            observer,
+        )
+        .map_err(|e| ReportError::EmptyRoomTruth(Box::new(e)))?;
         Ok(Self {
             scene: scene.clone(),
             model,
@@ -202,11 +211,12 @@ impl PathRun {
         frame: usize,
         pose: Pose,
         probe_spp: u32,
-    ) -> anyhow::Result<(PathPosition, [RgbImageF32; 4])> {
+        observer: &dyn Observer,
+    ) -> Result<(PathPosition, [RgbImageF32; 4])> {
         let centre = pose.centre;
         let posed = self.model.posed(pose)?;
         let geometry = &posed.geometry;
-        let truth = self.truth_at(geometry)?;
+        let truth = self.truth_at(geometry, observer)?;
         let kinds = pixel_kinds(
             geometry,
             &PrimaryHits::trace(&self.scene_with(geometry), &self.camera).triangles,
@@ -226,8 +236,10 @@ impl PathRun {
         let (mut results, mut ys, mut images) = (Vec::new(), Vec::new(), Vec::new());
         for (m, lighting) in lightings.iter().enumerate() {
             let image = self.composite_with(&kinds, &posed, lighting)?;
-            check_finite(&image, "frame").map_err(|e| {
-                anyhow::anyhow!("frame {frame}, {}: {e}", PathMethod::ALL[m].name())
+            check_finite(&image, "frame").map_err(|error| ReportError::Frame {
+                frame,
+                method: PathMethod::ALL[m].name(),
+                error,
             })?;
             let errors = error_image(&image, &truth.radiance, self.exposure);
             let y = tonemapped_luminance(&image, self.exposure);
@@ -274,7 +286,7 @@ impl PathRun {
     }
 
     /// The room path-traced with the model placed as in `geometry`.
-    fn truth_at(&self, geometry: &SceneMesh) -> anyhow::Result<ReferenceImages> {
+    fn truth_at(&self, geometry: &SceneMesh, observer: &dyn Observer) -> Result<ReferenceImages> {
         let scene = self.scene_with(geometry);
         let no_limit = |_: &ReferenceImages| f64::INFINITY;
         let (map, rotation) = (&self.map, self.rotation_deg);
@@ -285,6 +297,7 @@ impl PathRun {
             rotation,
             &self.request,
             &no_limit,
+            observer,
         )
     }
 
@@ -307,7 +320,7 @@ impl PathRun {
         kinds: &[PixelKind],
         posed: &PosedModel,
         lighting: &FrameLighting,
-    ) -> anyhow::Result<RgbImageF32> {
+    ) -> Result<RgbImageF32> {
         self.model.draw(&mut self.whole, posed, lighting)?;
         self.whole.render()?;
         let with = self.whole.read_back()?;
@@ -347,8 +360,8 @@ struct MethodLightings {
 }
 
 impl MethodLightings {
-    fn new(probes: &[Probe], one: usize, settings: DecomposeSettings) -> anyhow::Result<Self> {
-        let tracked = |map: &EnvMap| -> anyhow::Result<EnvironmentLighting> {
+    fn new(probes: &[Probe], one: usize, settings: DecomposeSettings) -> Result<Self> {
+        let tracked = |map: &EnvMap| -> Result<EnvironmentLighting> {
             let mut lighting = EnvironmentLighting::new(map, settings.clone())?;
             lighting.enable_tracking(Some(TrackingSettings::default()))?;
             Ok(lighting)
@@ -370,7 +383,7 @@ impl MethodLightings {
         model: &mut RoomModel,
         centre: Vec3,
         true_probe: &Probe,
-    ) -> anyhow::Result<Vec<FrameLighting>> {
+    ) -> Result<Vec<FrameLighting>> {
         let probes = model.lighting.probes();
         let near = nearest(probes, centre);
         if near != self.nearest_index {

@@ -1,6 +1,7 @@
 //! The report's figures, drawn with plotters: error heat maps with a scale bar (PNG) and the
 //! error-against-threshold plots (SVG).
 
+use crate::error::{ReportError, Result};
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 use std::sync::Once;
@@ -31,7 +32,7 @@ pub fn heat_map(
     height: u32,
     max: f32,
     title: &str,
-) -> anyhow::Result<Vec<u8>> {
+) -> Result<Vec<u8>> {
     let (w, h) = (width + BAR_AREA, height.max(120));
     let mut rgb = vec![255u8; (w * h * 3) as usize];
     for y in 0..height {
@@ -105,7 +106,7 @@ pub struct Curve {
 
 /// Mean error against the Weber threshold, each point labelled with its number of lights, and
 /// the PRT error as a horizontal line. Returns SVG text.
-pub fn threshold_plot(title: &str, curves: &[Curve], prt_error: f64) -> anyhow::Result<String> {
+pub fn threshold_plot(title: &str, curves: &[Curve], prt_error: f64) -> Result<String> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (600, 300)).into_drawing_area();
@@ -188,11 +189,7 @@ pub fn threshold_plot(title: &str, curves: &[Curve], prt_error: f64) -> anyhow::
 }
 
 /// Values over the frames of a sequence, one line per method. Returns SVG text.
-pub fn time_plot(
-    title: &str,
-    y_label: &str,
-    series: &[(String, Vec<f64>)],
-) -> anyhow::Result<String> {
+pub fn time_plot(title: &str, y_label: &str, series: &[(String, Vec<f64>)]) -> Result<String> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (600, 300)).into_drawing_area();
@@ -259,12 +256,7 @@ pub fn time_plot(
 
 /// An animated GIF of `frames` (8-bit RGB, `width × height` each), `delay_ms` per frame,
 /// looping.
-pub fn animated_gif(
-    frames: &[Vec<u8>],
-    width: u32,
-    height: u32,
-    delay_ms: u32,
-) -> anyhow::Result<Vec<u8>> {
+pub fn animated_gif(frames: &[Vec<u8>], width: u32, height: u32, delay_ms: u32) -> Result<Vec<u8>> {
     use image::codecs::gif::{GifEncoder, Repeat};
     let mut bytes = Vec::new();
     {
@@ -276,7 +268,7 @@ pub fn animated_gif(
                 .flat_map(|p| [p[0], p[1], p[2], 255])
                 .collect();
             let buffer = image::RgbaImage::from_raw(width, height, rgba)
-                .ok_or_else(|| anyhow::anyhow!("a GIF frame of the wrong size"))?;
+                .ok_or_else(|| ReportError::Figure("a GIF frame of the wrong size".into()))?;
             encoder.encode_frame(image::Frame::from_parts(
                 buffer,
                 0,

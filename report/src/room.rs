@@ -8,8 +8,9 @@
 //! model keeps its bake turned with it (it was baked alone, so nothing else's shadow turns
 //! with it).
 
-use crate::bake_cache::bake_for;
-use anyhow::Context;
+use crate::bake::cached_bake;
+use crate::error::{ReportError, Result};
+use crate::observer::Observer;
 use foundation::bvh::SceneBvh;
 use foundation::envmap::EnvMap;
 use foundation::probe::Probe;
@@ -52,12 +53,21 @@ impl RoomModel {
     /// The room and model of `scene`, its probes loaded (their distances traced where not
     /// given), lit under `sky` (the scene's map, turned by its rotation); both parts baked
     /// with the scene's `[bake]` settings, or taken from the cache.
-    pub fn open(scene: &Scene, sky: EnvMap, settings: DecomposeSettings) -> anyhow::Result<Self> {
-        anyhow::ensure!(
-            !scene.probes.is_empty(),
-            "{}: a model moves through a room lit by its [[probe]] entries, and it has none",
-            scene.path.display()
-        );
+    pub fn open(
+        scene: &Scene,
+        sky: EnvMap,
+        settings: DecomposeSettings,
+        observer: &dyn Observer,
+    ) -> Result<Self> {
+        if scene.probes.is_empty() {
+            return Err(ReportError::NoProbes(scene.path.clone()));
+        }
+        let bake = |scene: &Scene, what: &'static str| {
+            cached_bake(scene, observer).map_err(|e| ReportError::Bake {
+                what,
+                source: Box::new(e),
+            })
+        };
         let part = |role: ObjectRole, suffix: &str| scene.of_role(role).renamed(suffix);
         let (model, room) = (
             part(ObjectRole::Object, "model"),
@@ -65,15 +75,15 @@ impl RoomModel {
         );
         let centre = (model.geometry.mesh.bounds())
             .map(|(lo, hi)| 0.5 * (lo + hi))
-            .context("the scene has no virtual objects to move")?;
-        let (_, model_transfer) = bake_for(&model, None).context("cannot bake the model alone")?;
+            .ok_or(ReportError::NoObjects)?;
+        let (_, model_transfer) = bake(&model, "the model alone")?;
         // The room without the model, baked with the model's vertices kept (collapsed to a
         // point no ray meets), so that its rows sit on the scene's vertices; the room renderer
         // draws the same rows, so the composite's ratio is one but for the model's shadows.
         let mut collapsed = scene.geometry.clone();
         collapsed.collapse_objects(centre);
         let empty = scene.with_geometry(collapsed).renamed("room");
-        let (_, empty) = bake_for(&empty, None).context("cannot bake the room alone")?;
+        let (_, empty) = bake(&empty, "the room alone")?;
         let transfer = with_objects_alone(&scene.geometry, &empty, &model_transfer)?;
         let room_transfer = rows_of(&scene.geometry, ObjectRole::Proxy, &empty)?;
         let proxies = SceneBvh::build(&room.geometry.mesh);
@@ -100,7 +110,7 @@ impl RoomModel {
     }
 
     /// The scene's geometry with the objects at `pose`, and the bake turned with them.
-    pub fn posed(&self, pose: Pose) -> anyhow::Result<PosedModel> {
+    pub fn posed(&self, pose: Pose) -> Result<PosedModel> {
         let mut geometry = self.geometry.clone();
         geometry.pose_objects(self.centre, pose);
         let turned = match pose.is_turned() {
@@ -115,7 +125,7 @@ impl RoomModel {
     }
 
     /// [`Self::transfer`] with the model's rows turned by `rotation`.
-    fn turned_transfer(&self, rotation: Quat) -> anyhow::Result<Transfer> {
+    fn turned_transfer(&self, rotation: Quat) -> Result<Transfer> {
         let mut transfer = self.transfer.clone();
         let turn = ShRotation::new(
             Mat3::from_quat(rotation.normalize()),
@@ -139,7 +149,7 @@ impl RoomModel {
         renderer: &mut Renderer,
         posed: &PosedModel,
         lighting: &FrameLighting,
-    ) -> anyhow::Result<f64> {
+    ) -> Result<f64> {
         renderer.move_vertices(&posed.geometry)?;
         // Copied only to be scaled by the soft shadow.
         let mut transfer = Cow::Borrowed(posed.turned.as_ref().unwrap_or(&self.transfer));

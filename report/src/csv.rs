@@ -1,6 +1,7 @@
 //! `stats.csv`: one row per map and method.
 
 use super::results::Report;
+use crate::error::{ReportError, Result};
 
 /// The columns of `stats.csv`.
 const CSV_COLUMNS: [&str; 26] = [
@@ -32,7 +33,7 @@ const CSV_COLUMNS: [&str; 26] = [
     "warm_decomposition_ms",
 ];
 
-pub(super) fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
+pub(super) fn csv_bytes(report: &Report) -> Result<Vec<u8>> {
     let mut writer = csv::Writer::from_writer(Vec::new());
     writer.write_record(CSV_COLUMNS)?;
     for map in &report.maps {
@@ -74,5 +75,7 @@ pub(super) fn csv_bytes(report: &Report) -> anyhow::Result<Vec<u8>> {
             ])?;
         }
     }
-    writer.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
+    writer
+        .into_inner()
+        .map_err(|e| ReportError::Csv(e.to_string()))
 }

@@ -3,12 +3,78 @@
 //! file-name order), or a TOML file naming the frames, a folder, a cross-fade between two maps
 //! or a sun moving over a base map.
 
-use crate::maps::load_map;
-use anyhow::Context;
 use foundation::envmap::EnvMap;
 use foundation::envmap::animated::{SunArc, SunDisc, crossfade, direction_of};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+type Result<T, E = SequenceError> = std::result::Result<T, E>;
+
+/// What is wrong with a sequence, naming its file.
+#[derive(Debug, Error)]
+pub enum SequenceError {
+    #[error("cannot read the sequence {}", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: foundation::infra::limits::ReadError,
+    },
+    #[error("{}: not a valid sequence file", path.display())]
+    Parse {
+        path: PathBuf,
+        #[source]
+        source: toml::de::Error,
+    },
+    #[error("{}: give exactly one of `frames`, `folder`, [crossfade] or [sun]", .0.display())]
+    NotOneSource(PathBuf),
+    #[error("{}: a sequence has 1 to {MAX_FRAMES} frames, this one {count}", path.display())]
+    FrameCount { path: PathBuf, count: usize },
+    #[error("frame {frame} is past the sequence's last frame ({last})")]
+    PastLastFrame { frame: usize, last: usize },
+    #[error("--frame {frame}: the sequence has frames 0 to {last}")]
+    FrameOption { frame: usize, last: usize },
+    #[error(
+        "{}: line {line}: angular_radius_deg must be in [{MIN_SUN_RADIUS_DEG}, 45], got {radius}",
+        path.display()
+    )]
+    SunRadius {
+        path: PathBuf,
+        line: usize,
+        radius: f32,
+    },
+    #[error(
+        "{}: line {line}: the sun's power {power:?} must be finite, not negative and at most \
+         {MAX_SUN_POWER:e} per channel",
+        path.display()
+    )]
+    SunPower {
+        path: PathBuf,
+        line: usize,
+        power: [f32; 3],
+    },
+    #[error("{}: the sun's from and to angles must be finite", .0.display())]
+    SunAngles(PathBuf),
+    /// (The map's error in the message, as the header reader words it.)
+    #[error("frame {frame} of the sequence cannot be read: {error}")]
+    UnreadableFrame {
+        frame: usize,
+        error: foundation::envmap::EnvMapError,
+    },
+    #[error("cannot read the folder {}", path.display())]
+    Folder {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{}: no .exr or .hdr maps in the folder", .0.display())]
+    NoMaps(PathBuf),
+    /// A frame's map, or a map a sequence file names, that cannot be loaded.
+    #[error("cannot load the environment map")]
+    Map(#[from] foundation::envmap::EnvMapError),
+    #[error(transparent)]
+    Decompose(#[from] runtime::DecomposeError),
+}
 
 /// Most frames a sequence may have.
 pub const MAX_FRAMES: usize = 10_000;
@@ -69,7 +135,7 @@ pub enum Sequence {
 
 impl Sequence {
     /// A folder of maps, or a sequence file.
-    pub fn load(path: &Path) -> anyhow::Result<Self> {
+    pub fn load(path: &Path) -> Result<Self> {
         let sequence = if path.is_dir() {
             Self::Files(maps_in(path)?)
         } else {
@@ -78,20 +144,26 @@ impl Sequence {
         if let Self::Files(paths) = &sequence {
             check_frames(paths)?;
         }
-        anyhow::ensure!(
-            (1..=MAX_FRAMES).contains(&sequence.len()),
-            "{}: a sequence has 1 to {MAX_FRAMES} frames, this one {}",
-            path.display(),
-            sequence.len()
-        );
+        if !(1..=MAX_FRAMES).contains(&sequence.len()) {
+            return Err(SequenceError::FrameCount {
+                path: path.to_owned(),
+                count: sequence.len(),
+            });
+        }
         Ok(sequence)
     }
 
-    fn from_file(path: &Path) -> anyhow::Result<Self> {
-        let text = foundation::infra::limits::read_text_file(path)
-            .with_context(|| format!("cannot read the sequence {}", path.display()))?;
-        let spec: SequenceFile = toml::from_str(&text)
-            .with_context(|| format!("{}: not a valid sequence file", path.display()))?;
+    fn from_file(path: &Path) -> Result<Self> {
+        let text = foundation::infra::limits::read_text_file(path).map_err(|source| {
+            SequenceError::Read {
+                path: path.to_owned(),
+                source,
+            }
+        })?;
+        let spec: SequenceFile = toml::from_str(&text).map_err(|source| SequenceError::Parse {
+            path: path.to_owned(),
+            source,
+        })?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let resolve = |p: &Path| dir.join(p);
         let given = [
@@ -100,11 +172,9 @@ impl Sequence {
             spec.crossfade.is_some(),
             spec.sun.is_some(),
         ];
-        anyhow::ensure!(
-            given.iter().filter(|g| **g).count() == 1,
-            "{}: give exactly one of `frames`, `folder`, [crossfade] or [sun]",
-            path.display()
-        );
+        if given.iter().filter(|g| **g).count() != 1 {
+            return Err(SequenceError::NotOneSource(path.to_owned()));
+        }
         if let Some(frames) = spec.frames {
             return Ok(Self::Files(frames.iter().map(|p| resolve(p)).collect()));
         }
@@ -113,15 +183,15 @@ impl Sequence {
         }
         if let Some(c) = spec.crossfade {
             return Ok(Self::CrossFade {
-                from: load_map(&resolve(&c.from), None)?.map,
-                to: load_map(&resolve(&c.to), None)?.map,
+                from: foundation::envmap::load(&resolve(&c.from), None)?.map,
+                to: foundation::envmap::load(&resolve(&c.to), None)?.map,
                 frames: c.frames,
             });
         }
         let s = spec.sun.expect("one of the four is given");
         check_sun(path, &text, &s)?;
         Ok(Self::Sun {
-            base: load_map(&resolve(&s.base), None)?.map,
+            base: foundation::envmap::load(&resolve(&s.base), None)?.map,
             arc: SunArc {
                 from: direction_of(s.from[0], s.from[1]),
                 to: direction_of(s.to[0], s.to[1]),
@@ -132,6 +202,8 @@ impl Sequence {
         })
     }
 
+    // A sequence has at least one frame (`load` refuses none), so no `is_empty`.
+    #[allow(clippy::len_without_is_empty)]
     pub fn len(&self) -> usize {
         match self {
             Self::Files(paths) => paths.len(),
@@ -145,14 +217,13 @@ impl Sequence {
     }
 
     /// The map of frame `k`.
-    pub fn frame(&self, k: usize) -> anyhow::Result<EnvMap> {
-        anyhow::ensure!(
-            k < self.len(),
-            "frame {k} is past the sequence's last frame ({})",
-            self.len() - 1
-        );
+    pub fn frame(&self, k: usize) -> Result<EnvMap> {
+        if k >= self.len() {
+            let last = self.len().saturating_sub(1);
+            return Err(SequenceError::PastLastFrame { frame: k, last });
+        }
         Ok(match self {
-            Self::Files(paths) => load_map(&paths[k], None)?.map,
+            Self::Files(paths) => foundation::envmap::load(&paths[k], None)?.map,
             Self::CrossFade { from, to, .. } => crossfade(from, to, self.time(k)),
             Self::Sun { base, arc, .. } => arc.at(self.time(k)).over(base),
         })
@@ -182,12 +253,12 @@ pub fn lighting_at_frame(
     settings: runtime::DecomposeSettings,
     rotation_deg: f32,
     last: usize,
-) -> anyhow::Result<runtime::EnvironmentLighting> {
-    anyhow::ensure!(
-        last < sequence.len(),
-        "--frame {last}: the sequence has frames 0 to {}",
-        sequence.len() - 1
-    );
+) -> Result<runtime::EnvironmentLighting> {
+    if last >= sequence.len() {
+        let frame = last;
+        let last = sequence.len().saturating_sub(1);
+        return Err(SequenceError::FrameOption { frame, last });
+    }
     let mut lighting = runtime::EnvironmentLighting::new(&sequence.frame(0)?, settings)?;
     lighting.enable_tracking(Some(runtime::TrackingSettings::default()))?;
     lighting.set_rotation(rotation_deg);
@@ -202,56 +273,54 @@ pub fn lighting_at_frame(
 
 /// The `.exr` and `.hdr` files of `folder`, sorted by name.
 /// Refuses a sun whose radius or power is out of range, naming the file and line.
-fn check_sun(path: &Path, text: &str, s: &SunSpec) -> anyhow::Result<()> {
+fn check_sun(path: &Path, text: &str, s: &SunSpec) -> Result<(), SequenceError> {
     let line =
         |span: std::ops::Range<usize>| text[..span.start.min(text.len())].lines().count().max(1);
     let radius = *s.angular_radius_deg.get_ref();
-    anyhow::ensure!(
-        (MIN_SUN_RADIUS_DEG..=45.0).contains(&radius),
-        "{}: line {}: angular_radius_deg must be in [{MIN_SUN_RADIUS_DEG}, 45], got {radius}",
-        path.display(),
-        line(s.angular_radius_deg.span())
-    );
+    if !(MIN_SUN_RADIUS_DEG..=45.0).contains(&radius) {
+        return Err(SequenceError::SunRadius {
+            path: path.to_owned(),
+            line: line(s.angular_radius_deg.span()),
+            radius,
+        });
+    }
     let power = *s.power.get_ref();
-    anyhow::ensure!(
-        power
-            .iter()
-            .all(|p| p.is_finite() && (0.0..=MAX_SUN_POWER).contains(p)),
-        "{}: line {}: the sun's power {power:?} must be finite, not negative and at most \
-         {MAX_SUN_POWER:e} per channel",
-        path.display(),
-        line(s.power.span())
-    );
-    anyhow::ensure!(
-        s.from.iter().chain(&s.to).all(|a| a.is_finite()),
-        "{}: the sun's from and to angles must be finite",
-        path.display()
-    );
+    if !(power.iter()).all(|p| p.is_finite() && (0.0..=MAX_SUN_POWER).contains(p)) {
+        return Err(SequenceError::SunPower {
+            path: path.to_owned(),
+            line: line(s.power.span()),
+            power,
+        });
+    }
+    if !s.from.iter().chain(&s.to).all(|a| a.is_finite()) {
+        return Err(SequenceError::SunAngles(path.to_owned()));
+    }
     Ok(())
 }
 
 /// Checks that every frame file is there and readable as a map header, before any frame is
 /// rendered (a missing last frame must not cost the whole sequence's work first).
-fn check_frames(paths: &[PathBuf]) -> anyhow::Result<()> {
-    for (k, path) in paths.iter().enumerate() {
+fn check_frames(paths: &[PathBuf]) -> Result<(), SequenceError> {
+    for (frame, path) in paths.iter().enumerate() {
         foundation::envmap::read_size(path)
-            .map_err(|e| anyhow::anyhow!("frame {k} of the sequence cannot be read: {e}"))?;
+            .map_err(|error| SequenceError::UnreadableFrame { frame, error })?;
     }
     Ok(())
 }
 
-fn maps_in(folder: &Path) -> anyhow::Result<Vec<PathBuf>> {
+fn maps_in(folder: &Path) -> Result<Vec<PathBuf>, SequenceError> {
     let mut maps: Vec<PathBuf> = std::fs::read_dir(folder)
-        .with_context(|| format!("cannot read the folder {}", folder.display()))?
+        .map_err(|source| SequenceError::Folder {
+            path: folder.to_owned(),
+            source,
+        })?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
         .collect();
     maps.sort();
-    anyhow::ensure!(
-        !maps.is_empty(),
-        "{}: no .exr or .hdr maps in the folder",
-        folder.display()
-    );
+    if maps.is_empty() {
+        return Err(SequenceError::NoMaps(folder.to_owned()));
+    }
     Ok(maps)
 }
 
@@ -267,7 +336,7 @@ mod tests {
             std::fs::write(&p, text).unwrap();
             p
         };
-        let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/env/sunrise.exr");
+        let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/env/sunrise.exr");
         let sun = write(
             "sun.toml",
             &format!(

@@ -1,7 +1,7 @@
 //! What a path report found, per position and per method.
 
-use super::super::sequence::temporal::{POP_FLOOR, POP_SPIKE, mark_popping};
-use super::super::settings::ReportSettings;
+use crate::sequence::temporal::{POP_FLOOR, POP_SPIKE, mark_popping};
+use crate::settings::ReportSettings;
 
 /// The lighting each method gives the model at a position of the path.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
