@@ -3,7 +3,6 @@
 
 use anyhow::Context;
 use foundation::infra::atomic_file::{AtomicOutput, commit_all};
-use foundation::scene::Scene;
 use std::path::{Path, PathBuf};
 
 /// One output of a command: the option that names it and its path.
@@ -77,46 +76,7 @@ pub fn check_folder_output(
     Ok(())
 }
 
-/// Refuses an output folder that holds any of `inputs` (a report replaces its whole folder).
-pub fn check_folder_spares_inputs(
-    inputs: &[&Path],
-    option: &str,
-    folder: &Path,
-) -> anyhow::Result<()> {
-    let Ok(folder_real) = folder.canonicalize() else {
-        return Ok(()); // not there yet: it holds nothing
-    };
-    for input in inputs {
-        if input
-            .canonicalize()
-            .is_ok_and(|input| input.starts_with(&folder_real))
-        {
-            anyhow::bail!(
-                "{option} {}: the folder holds {}, which this command reads, and is replaced \
-                 by the output; give the output another folder",
-                folder.display(),
-                input.display()
-            );
-        }
-    }
-    Ok(())
-}
-
-/// What a command reads of a scene (its file, meshes, backplate, map, and its probes' images
-/// and distance maps), with the command's `other` inputs.
-pub fn scene_inputs<'a>(scene: &'a Scene, other: &[Option<&'a Path>]) -> Vec<&'a Path> {
-    let environment = scene.environment.as_ref().map(|e| e.map.as_path());
-    let probes = (scene.probes.iter())
-        .flat_map(|p| std::iter::once(p.image.as_path()).chain(p.distances.as_deref()));
-    scene
-        .sources
-        .iter()
-        .map(PathBuf::as_path)
-        .chain(other.iter().flatten().copied())
-        .chain(environment)
-        .chain(probes)
-        .collect()
-}
+pub use report::output::{check_folder_spares_inputs, scene_inputs};
 
 /// Whether two paths name the same file: the same inode when both exist (links included),
 /// else the same name in the same folder.

@@ -2,7 +2,7 @@
 
 import os
 from pathlib import Path
-from typing import Callable, Literal, Optional, Union
+from typing import Callable, Literal, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -282,3 +282,40 @@ def capture(
     response: Optional[npt.NDArray[np.float32]] = None,
 ) -> Captured:
     """The map a capture description's photographs see (as ``hprt capture``)."""
+
+CompositeForm = Literal["differential", "occlusion"]
+
+def composite(
+    renderer: Renderer,
+    lighting: Union[MapArgument, Decomposition],
+    mode: RenderMode = "hybrid",
+    form: CompositeForm = "differential",
+    rotation_deg: Optional[float] = None,
+    decompose_mode: DecomposeMode = "consistent",
+    camera: Optional[Camera] = None,
+    progress: Optional[Progress] = None,
+) -> Composite:
+    """The GPU methods' composite of the frame ``renderer`` draws into the scene's
+    ``[backplate]`` (``hprt render``'s for such a scene), with its layers."""
+
+def report_json(
+    scene: Scene,
+    output: Union[str, "os.PathLike[str]"],
+    maps: Optional[Sequence[Union[str, "os.PathLike[str]"]]] = None,
+    bake: Optional[Bake] = None,
+    sequence: Optional[Union[str, "os.PathLike[str]"]] = None,
+    path: bool = False,
+    width: Optional[int] = None,
+    height: Optional[int] = None,
+    spp: int = 512,
+    bounces: Optional[int] = None,
+    seed: int = 0,
+    thresholds: Optional[Sequence[float]] = None,
+    frames: int = 5,
+    positions: int = 24,
+    probe_spp: int = 64,
+    backend: Backend = "auto",
+    progress: Optional[Progress] = None,
+    log: Optional[Callable[[str], object]] = None,
+) -> str:
+    """``report``'s statistics as JSON text (use ``hprt.report``)."""

@@ -111,7 +111,8 @@ pub(crate) fn reference_composite(
     Ok(layers(&rendered.composite))
 }
 
-fn layers(c: &CompositeData) -> Composite {
+/// A composite's image and layers as numpy arrays.
+pub(crate) fn layers(c: &CompositeData) -> Composite {
     let (w, h) = (c.image.width, c.image.height);
     let kind = |k: &PixelKind| match k {
         PixelKind::Object => 0u8,

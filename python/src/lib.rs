@@ -14,10 +14,12 @@ mod capture;
 mod composite;
 mod decompose;
 mod errors;
+mod gpu_composite;
 mod maps;
 mod progress;
 mod reference;
 mod render;
+mod report;
 mod scene;
 
 #[pymodule]
@@ -40,5 +42,7 @@ fn _hprt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<capture::Captured>()?;
     m.add_function(wrap_pyfunction!(composite::reference_composite, m)?)?;
     m.add_class::<composite::Composite>()?;
+    m.add_function(wrap_pyfunction!(report::report_json, m)?)?;
+    m.add_function(wrap_pyfunction!(gpu_composite::composite, m)?)?;
     Ok(())
 }

@@ -8,6 +8,7 @@ use crate::scene::{Bake, Scene};
 use foundation::Rgb;
 use foundation::envmap::EnvMap;
 use numpy::{IntoPyArray, PyArray3};
+use precompute::bake::Transfer;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use runtime::render::{Backend, GpuContext, Renderer as GpuRenderer, ShadowSettings};
@@ -22,12 +23,14 @@ use std::sync::Arc;
 pub(crate) struct Renderer {
     renderer: GpuRenderer,
     scene: Arc<foundation::scene::Scene>,
+    /// The whole scene's bake (the composite's proxies are baked with its settings).
+    transfer: Arc<Transfer>,
     order: usize,
     /// The image size, fixed when made.
     size: (u32, u32),
     adapter: String,
     // Declared last: the device outlives the renderer's resources.
-    _gpu: GpuContext,
+    gpu: GpuContext,
 }
 
 #[pymethods]
@@ -58,10 +61,11 @@ impl Renderer {
         Ok(Self {
             renderer,
             scene: data,
+            transfer: Arc::clone(&bake.transfer),
             order: bake.transfer.settings.order,
             size: (camera.width, camera.height),
             adapter: gpu.description().to_string(),
-            _gpu: gpu,
+            gpu,
         })
     }
 
@@ -93,20 +97,49 @@ impl Renderer {
         background: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         let rotation_deg = crate::scene::map_rotation(&self.scene, rotation_deg);
+        self.set_view(camera.as_ref())?;
+        let (frame, environment) =
+            self.frame_lighting(lighting, (mode, decompose_mode), rotation_deg, background)?;
+        self.renderer.set_environment(&environment, rotation_deg);
+        self.renderer
+            .set_lighting(&frame)
+            .map_err(crate::errors::hprt_error)?;
+        self.renderer.render().map_err(crate::errors::hprt_error)?;
+        let image = self
+            .renderer
+            .read_back()
+            .map_err(crate::errors::hprt_error)?;
+        Ok(image_array(&image).into_pyarray(py))
+    }
+}
+
+impl Renderer {
+    /// Points the renderer at `camera` (the scene's when not given), at its image size.
+    pub(crate) fn set_view(
+        &mut self,
+        camera: Option<&Camera>,
+    ) -> PyResult<foundation::camera::Camera> {
         let (width, height) = self.size;
-        let view = resolve(
-            &self.scene.camera,
-            camera.as_ref(),
-            Some(width),
-            Some(height),
-        )?;
+        let view = resolve(&self.scene.camera, camera, Some(width), Some(height))?;
         self.renderer
             .set_camera(&view)
             .map_err(crate::errors::hprt_error)?;
+        Ok(view)
+    }
+
+    /// A frame's lighting from `lighting` (a map, decomposed here, or a `Decomposition`) in
+    /// `mode`, and the map the background shows.
+    pub(crate) fn frame_lighting(
+        &self,
+        lighting: &Bound<'_, PyAny>,
+        (mode, decompose_mode): (&str, &str),
+        rotation_deg: f32,
+        background: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<(FrameLighting, EnvMap)> {
         let mode: RenderMode = crate::errors::parse_choice("mode", mode)?;
         let decompose_mode: DecomposeMode =
             crate::errors::parse_choice("decompose_mode", decompose_mode)?;
-        let (frame, environment) = match lighting.cast::<Decomposition>() {
+        Ok(match lighting.cast::<Decomposition>() {
             Ok(given) => {
                 let frame = self.given_lighting(&given.borrow(), mode, decompose_mode)?;
                 let environment = match background {
@@ -128,21 +161,27 @@ impl Renderer {
                 }
                 (decomposer.frame(mode, None).lighting, map)
             }
-        };
-        self.renderer.set_environment(&environment, rotation_deg);
-        self.renderer
-            .set_lighting(&frame)
-            .map_err(crate::errors::hprt_error)?;
-        self.renderer.render().map_err(crate::errors::hprt_error)?;
-        let image = self
-            .renderer
-            .read_back()
-            .map_err(crate::errors::hprt_error)?;
-        Ok(image_array(&image).into_pyarray(py))
+        })
     }
-}
 
-impl Renderer {
+    /// The scene it draws.
+    pub(crate) fn scene(&self) -> &foundation::scene::Scene {
+        &self.scene
+    }
+
+    /// What the GPU composite draws with: the device, the whole scene's renderer and bake,
+    /// and the scene.
+    pub(crate) fn composite_parts(
+        &mut self,
+    ) -> (
+        &GpuContext,
+        &mut GpuRenderer,
+        &Transfer,
+        &foundation::scene::Scene,
+    ) {
+        (&self.gpu, &mut self.renderer, &self.transfer, &self.scene)
+    }
+
     /// A frame of given SH and lights, in the modes that draw a decomposition as it is.
     fn given_lighting(
         &self,

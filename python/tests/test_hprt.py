@@ -310,6 +310,112 @@ class Composite(unittest.TestCase):
             hprt.reference_composite(hprt.load_scene(TEAPOT), INTERIOR, spp=1, width=8, height=6)
 
 
+class GpuComposite(unittest.TestCase):
+    def test_the_gpu_composite_is_the_command_lines(self) -> None:
+        scene = hprt.load_scene(SCENES / "teapot_composite.toml")
+        bake = hprt.bake(scene, samples=64, bounces=1)
+        environment = scene.environment
+        assert environment is not None
+        renderer = hprt.Renderer(scene, bake, width=96, height=48)
+        composite = hprt.composite(renderer, environment)
+        occlusion = hprt.composite(renderer, environment, form="occlusion")
+        with tempfile.TemporaryDirectory() as folder:
+            bake_file, out = Path(folder) / "scene.bake", Path(folder) / "composite.exr"
+            bake.save(bake_file)
+            hprt_program("render", str(SCENES / "teapot_composite.toml"), "--bake", str(bake_file),
+                         "--width", "96", "--height", "48", "-o", str(Path(folder) / "c.png"),
+                         "--exr", str(out))
+            expected = hprt.load_map(out)
+        np.testing.assert_array_equal(composite.image, expected)
+        kinds = composite.kinds
+        self.assertEqual(set(np.unique(kinds)), {0, 1, 2})
+        # The objects' shadows darken the proxies; the backplate alone stays as it is.
+        self.assertLess(float(composite.ratio[kinds == 1].min()), 0.9)
+        self.assertTrue(np.all(composite.ratio[kinds != 1] == 1.0))
+        # The occlusion peer has the same objects and another account of their shadow.
+        np.testing.assert_array_equal(occlusion.image[kinds == 0], composite.image[kinds == 0])
+        self.assertFalse(np.array_equal(occlusion.image[kinds == 1], composite.image[kinds == 1]))
+        # The renderer is reused after a composite: a plain render is the scene's whole frame.
+        plain = renderer.render(environment)
+        np.testing.assert_array_equal(plain[kinds == 0], composite.image[kinds == 0])
+        with self.assertRaisesRegex(ValueError, "form"):
+            hprt.composite(renderer, environment, form="live")  # type: ignore[arg-type]
+        teapot = hprt.load_scene(TEAPOT)
+        with self.assertRaisesRegex(ValueError, "backplate"):
+            hprt.composite(hprt.Renderer(teapot, hprt.bake(teapot, samples=16, bounces=0),
+                                         width=8, height=6), INTERIOR)
+
+
+def timeless(value: object) -> object:
+    """A report's statistics without what differs from run to run (timings, the adapter's
+    name) and the bake's path (a file here, a bake in memory there)."""
+    if isinstance(value, dict):
+        return {k: timeless(v) for k, v in value.items()
+                if not (k.endswith("_ms") or "seconds" in k or k in ("adapter", "bake"))}
+    if isinstance(value, list):
+        return [timeless(v) for v in value]
+    return value
+
+
+class Report(unittest.TestCase):
+    def test_the_report_is_the_command_lines(self) -> None:
+        scene = hprt.load_scene(TEAPOT)
+        bake = hprt.bake(scene, samples=64, bounces=1)
+        maps = [SCENES / "env" / "sunrise.exr", INTERIOR]
+        size = dict(width=64, height=48, spp=16, frames=1, thresholds=[0.05, 0.2])
+        lines: list[str] = []
+        with tempfile.TemporaryDirectory() as folder:
+            # Each its own cache: neither reads the other's references.
+            mine, theirs = Path(folder) / "mine", Path(folder) / "theirs"
+            before = os.environ.get("HPRT_CACHE")
+            os.environ["HPRT_CACHE"] = str(Path(folder) / "cache-mine")
+            try:
+                stats = hprt.report(scene, mine, maps=maps, bake=bake, log=lines.append,
+                                    **size)  # type: ignore[arg-type]
+            finally:
+                if before is None:
+                    del os.environ["HPRT_CACHE"]
+                else:
+                    os.environ["HPRT_CACHE"] = before
+            bake_file = Path(folder) / "teapot.bake"
+            bake.save(bake_file)
+            program = os.environ.get("HPRT_BIN", "hprt")
+            subprocess.run(
+                [program, "report", str(TEAPOT), "--bake", str(bake_file), "--envs",
+                 *map(str, maps), "--width", "64", "--height", "48", "--spp", "16",
+                 "--frames", "1", "--thresholds", "0.05", "0.2", "-o", str(theirs)],
+                check=True, capture_output=True,
+                env=dict(os.environ, HPRT_CACHE=str(Path(folder) / "cache-theirs")),
+            )
+            expected = json.loads((theirs / "stats.json").read_text())
+            self.assertEqual(timeless(stats), timeless(expected))
+            self.assertEqual(timeless(json.loads((mine / "stats.json").read_text())),
+                             timeless(expected))
+            for name in ("sunrise/reference.exr", "sunrise/hybrid-consistent.exr",
+                         "interior/prt.exr", "interior/error-hybrid-consistent.png"):
+                self.assertEqual((mine / name).read_bytes(), (theirs / name).read_bytes(), name)
+            self.assertTrue((mine / "report.html").exists())
+        methods = {m["method"]: m["mean"] for m in stats["maps"][0]["methods"]}
+        self.assertLess(methods["hybrid/consistent"], methods["prt"])
+        self.assertTrue(any(line.startswith("adapter: ") for line in lines), lines)
+
+    def test_a_report_never_replaces_what_it_reads(self) -> None:
+        scene = hprt.load_scene(TEAPOT)
+        bake = hprt.bake(scene, samples=16, bounces=0)
+        with self.assertRaisesRegex(ValueError, "holds"):
+            hprt.report(scene, SCENES, maps=[INTERIOR], bake=bake, spp=1, width=8, height=6)
+        with tempfile.TemporaryDirectory() as folder:
+            for bad in (dict(thresholds=[1.5]), dict(frames=0), dict(spp=0),
+                        dict(maps=[INTERIOR], sequence=INTERIOR), dict(path=True)):
+                with self.subTest(bad=bad), self.assertRaises(ValueError):
+                    hprt.report(scene, Path(folder) / "out", bake=bake, **bad)
+            self.assertFalse((Path(folder) / "out").exists())
+            with self.assertRaises(hprt.HprtError):
+                hprt.report(scene, Path(folder) / "out", maps=[Path(folder) / "missing.exr"],
+                            bake=bake, spp=1, width=8, height=6, frames=1)
+            self.assertFalse((Path(folder) / "out").exists())
+
+
 class Capture(unittest.TestCase):
     def test_the_bundled_photographs_give_the_command_lines_map(self) -> None:
         description = SCENES / "capture" / "capture.toml"

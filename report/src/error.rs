@@ -92,6 +92,18 @@ pub enum ReportError {
     NoProbes(PathBuf),
     #[error("the scene has no virtual objects to move")]
     NoObjects,
+    /// An output folder that holds an input.
+    #[error(
+        "{option} {}: the folder holds {}, which this command reads, and is replaced by the \
+         output; give the output another folder",
+        folder.display(),
+        input.display()
+    )]
+    OutputHoldsInput {
+        option: &'static str,
+        folder: PathBuf,
+        input: PathBuf,
+    },
     #[error("cannot render the empty room's truth")]
     EmptyRoomTruth(#[source] Box<ReportError>),
 }

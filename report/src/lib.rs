@@ -15,6 +15,7 @@ pub mod gpu_composite;
 mod html;
 pub mod maps;
 mod observer;
+pub mod output;
 pub mod path;
 mod per_map;
 mod results;
