@@ -32,6 +32,7 @@ from ._hprt import (
     reference,
     reference_composite,
 )
+from ._tqdm import TqdmProgress
 
 __all__ = [
     "Bake",
@@ -44,6 +45,7 @@ __all__ = [
     "Renderer",
     "Scene",
     "SceneObject",
+    "TqdmProgress",
     "bake",
     "capture",
     "decompose",
