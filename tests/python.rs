@@ -1,6 +1,6 @@
-//! The Python module (`python/`) on every test run: its tests (`python/tests/`, against this
-//! checkout's command line and path tracer) and `mypy --strict` over the tests, the examples
-//! and the package's stubs.
+//! The Python module (`python/`) on every test run: its tests (`python/tests/`, pytest, against
+//! this checkout's command line and path tracer; they run the examples and the README's Python
+//! examples too) and `mypy --strict` over the tests, the examples and the package's stubs.
 //!
 //! `tests/run.sh` builds and installs the module with `pip install ./python` into a private
 //! virtual environment (`target/python-venv`) and points `HPRT_PYTHON` at its interpreter.
@@ -9,12 +9,15 @@
 use std::path::Path;
 use std::process::Command;
 
-/// The interpreter with the module installed, or a panic that says how to get one.
+/// What the tests import besides the module.
+const PACKAGES: &str = "numpy mypy pytest matplotlib tqdm";
+
+/// The interpreter with the module and [`PACKAGES`] installed, or a panic that says how to get
+/// them.
 fn python() -> String {
     let python = std::env::var("HPRT_PYTHON").unwrap_or_else(|_| "python3".into());
-    let check = Command::new(&python)
-        .args(["-c", "import hprt, mypy"])
-        .output();
+    let imports = format!("import hprt, {}", PACKAGES.replace(' ', ", "));
+    let check = Command::new(&python).args(["-c", &imports]).output();
     match check {
         Ok(out) if out.status.success() => python,
         other => {
@@ -27,8 +30,9 @@ fn python() -> String {
                 .and_then(|p| std::fs::read_to_string(p).ok())
                 .unwrap_or_default();
             panic!(
-                "{python} cannot import hprt and mypy ({reason}); tests/run.sh installs them \
-                 (`pip install ./python` into target/python-venv). Install log:\n{log}"
+                "{python} cannot import hprt and {PACKAGES} ({reason}); tests/run.sh installs \
+                 them into target/python-venv (`pip install {PACKAGES}` and `pip install \
+                 ./python`). Install log:\n{log}"
             );
         }
     }
@@ -56,7 +60,14 @@ fn the_python_module_passes_its_tests_and_strict_typing() {
     let python = python();
     run(
         &python,
-        &["-m", "unittest", "discover", "-s", "python/tests", "-v"],
+        &[
+            "-m",
+            "pytest",
+            "python/tests",
+            "-v",
+            "-p",
+            "no:cacheprovider",
+        ],
     );
     run(
         &python,

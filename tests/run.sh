@@ -43,14 +43,15 @@ fi
 export HPRT_MITSUBA_PYTHON="$venv/bin/python" HPRT_MITSUBA_INSTALL_LOG="$log"
 
 # The Python module for tests/python.rs: built from this checkout with the documented command
-# (`pip install ./python`, maturin) into a private virtual environment, rebuilt every run. If
-# it cannot be built, that test fails and shows this log; it never skips.
+# (`pip install ./python`, maturin) into a private virtual environment, rebuilt every run, with
+# what its tests and examples use (numpy, mypy, pytest, matplotlib, tqdm). If it cannot be
+# built, that test fails and shows this log; it never skips.
 pyvenv="$PWD/target/python-venv"
 pylog="$PWD/target/python-install.log"
 echo "building the Python module into $pyvenv (log: $pylog)"
 if ! {
     { [ -x "$pyvenv/bin/python" ] || python3 -m venv "$pyvenv"; } &&
-        "$pyvenv/bin/pip" install --quiet --disable-pip-version-check numpy mypy &&
+        "$pyvenv/bin/pip" install --quiet --disable-pip-version-check numpy mypy pytest matplotlib tqdm &&
         "$pyvenv/bin/pip" install --quiet --disable-pip-version-check --force-reinstall --no-deps ./python
 } >"$pylog" 2>&1; then
     echo "the Python module could not be built (see $pylog); tests/python.rs will fail"

@@ -2,12 +2,11 @@
 //! caller (the program's commands, the viewer, the Python module), written atomically so that
 //! concurrent callers never read half a file.
 
-use crate::bake::{BakeSettings, BakeStats, Transfer, bake};
+use crate::bake::{BakeError, BakeSettings, BakeStats, Transfer, bake};
 use crate::bakefile::{self, BakeFileError};
 use foundation::bvh::SceneBvh;
 use foundation::infra::progress::Progress;
 use foundation::scene::Scene;
-use foundation::settings::InvalidSettings;
 use std::path::{Path, PathBuf};
 
 /// Why a bake could not be cached.
@@ -20,7 +19,7 @@ pub enum CacheError {
     )]
     Folder { dir: PathBuf, cause: std::io::Error },
     #[error(transparent)]
-    Settings(#[from] InvalidSettings),
+    Bake(#[from] BakeError),
     #[error(transparent)]
     File(#[from] BakeFileError),
 }

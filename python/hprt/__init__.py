@@ -40,6 +40,8 @@ from ._hprt import (
     reference_composite,
     report_json,
 )
+from ._tqdm import TqdmProgress
+
 if TYPE_CHECKING:
     from ._hprt import Backend, Progress
 
@@ -98,6 +100,7 @@ __all__ = [
     "Renderer",
     "Scene",
     "SceneObject",
+    "TqdmProgress",
     "bake",
     "capture",
     "composite",

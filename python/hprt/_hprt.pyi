@@ -12,8 +12,10 @@ MapArgument = Union[str, "os.PathLike[str]", npt.NDArray[np.float32]]
 DecomposeMode = Literal["consistent", "thesis"]
 RenderMode = Literal["hybrid", "prt", "lights", "unshadowed", "median-cut", "sh-sun"]
 Backend = Literal["auto", "vulkan", "gl"]
-Progress = Callable[[str, int, int], object]
-"""``progress(stage, done, total)``: called at most once per percent of each stage."""
+Progress = Union[Callable[[str, int, int], object], Literal["tqdm"], bool]
+"""``progress(stage, done, total)``, called at most once per percent of each stage (an
+exception it raises stops the work and is raised); ``"tqdm"`` or ``True`` for tqdm bars
+(``hprt.TqdmProgress``); ``False`` for nothing. Ctrl-C stops a long call whatever it is."""
 
 class HprtError(Exception):
     """An hprt library call failed; the message says what and where."""

@@ -8,7 +8,7 @@ use crate::progress::with_progress;
 use crate::reference::path_settings;
 use crate::scene::{Scene, map_rotation};
 use ::reference::EnvironmentLight;
-use ::reference::composite::{Composite as CompositeData, PixelKind, render_composite};
+use ::reference::composite::{Composite as CompositeData, PixelKind, try_render_composite};
 use foundation::scene::{Backplate, load_backplate_image};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2, PyArray3};
@@ -75,7 +75,7 @@ pub(crate) fn reference_composite(
     width: Option<u32>,
     height: Option<u32>,
     camera: Option<Camera>,
-    progress: Option<Py<PyAny>>,
+    progress: Option<Bound<'_, PyAny>>,
 ) -> PyResult<Composite> {
     let data = Arc::clone(&scene.data);
     let Some(backplate) = &data.backplate else {
@@ -95,19 +95,18 @@ pub(crate) fn reference_composite(
         Backplate::Environment => None,
     };
     let map = map_argument(map)?;
-    let rendered = py.detach(|| {
-        with_progress(progress, "composite", |progress| {
-            let light = EnvironmentLight::new(&map, rotation_deg);
-            render_composite(
-                &data.geometry,
-                &light,
-                &camera,
-                &settings,
-                plate.as_ref(),
-                progress,
-            )
-        })
-    })?;
+    let rendered = with_progress(py, progress.as_ref(), "composite", |progress| {
+        let light = EnvironmentLight::new(&map, rotation_deg);
+        try_render_composite(
+            &data.geometry,
+            &light,
+            &camera,
+            &settings,
+            plate.as_ref(),
+            progress,
+        )
+    })?
+    .map_err(crate::errors::hprt_error)?;
     Ok(layers(&rendered.composite))
 }
 

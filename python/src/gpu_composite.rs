@@ -34,6 +34,9 @@ impl foundation::infra::progress::Progress for Forward<'_> {
     fn status(&self, text: &str) {
         self.0.status(text);
     }
+    fn cancelled(&self) -> bool {
+        self.0.cancelled()
+    }
 }
 
 /// Composites the frame `renderer` draws with `lighting` (as `Renderer.render` takes it)
@@ -46,6 +49,7 @@ impl foundation::infra::progress::Progress for Forward<'_> {
 #[pyo3(signature = (renderer, lighting, mode = "hybrid", form = "differential", rotation_deg = None, decompose_mode = "consistent", camera = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn composite(
+    py: Python<'_>,
     renderer: &mut Renderer,
     lighting: &Bound<'_, PyAny>,
     mode: &str,
@@ -53,7 +57,7 @@ pub(crate) fn composite(
     rotation_deg: Option<f32>,
     decompose_mode: &str,
     camera: Option<Camera>,
-    progress: Option<Py<PyAny>>,
+    progress: Option<Bound<'_, PyAny>>,
 ) -> PyResult<Composite> {
     let form = match form {
         "differential" => CompositeForm::Differential,
@@ -84,7 +88,7 @@ pub(crate) fn composite(
         shadow: ShadowSettings::default(),
         form,
     };
-    let drawn = with_progress(progress, "proxies' bake", |progress| {
+    let drawn = with_progress(py, progress.as_ref(), "proxies' bake", |progress| {
         let observer = BakeProgress(progress);
         composite_frame(gpu, whole, transfer, &frame, &inputs, &observer)
     })?;

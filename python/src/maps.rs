@@ -45,19 +45,25 @@ fn map_from_array(array: &PyReadonlyArray3<'_, f32>) -> PyResult<EnvMap> {
             "map: an equirectangular map is (H, 2H, 3); got {shape:?}"
         )));
     }
+    // A C-ordered array (numpy's default) is read as it is, any other copied to that order
+    // first: a texel by index costs more than the rest of a frame's conversion.
     let view = array.as_array();
-    let mut texels = Vec::with_capacity(width * height);
-    for row in view.outer_iter() {
-        for texel in row.outer_iter() {
-            let rgb = Rgb::new(texel[0], texel[1], texel[2]);
-            if !rgb.is_finite() || rgb.min_element() < 0.0 {
-                return Err(PyValueError::new_err(format!(
-                    "map: texel {} holds {rgb}: radiance must be finite and non-negative",
-                    texels.len()
-                )));
-            }
-            texels.push(rgb);
-        }
+    let standard = view.as_standard_layout();
+    let flat = standard
+        .as_slice()
+        .expect("a standard-layout array is one slice");
+    let texels: Vec<Rgb> = flat
+        .chunks_exact(3)
+        .map(|c| Rgb::new(c[0], c[1], c[2]))
+        .collect();
+    if let Some((index, rgb)) = texels
+        .iter()
+        .enumerate()
+        .find(|(_, rgb)| !rgb.is_finite() || rgb.min_element() < 0.0)
+    {
+        return Err(PyValueError::new_err(format!(
+            "map: texel {index} holds {rgb}: radiance must be finite and non-negative"
+        )));
     }
     Ok(EnvMap::new(width, height, texels))
 }

@@ -4,7 +4,7 @@
 
 use crate::camera::resolve;
 use crate::errors::{HprtError, hprt_error};
-use crate::progress::PyProgress;
+use crate::progress::with_progress;
 use crate::reference::path_settings;
 use crate::scene::{Bake, Scene};
 use foundation::infra::atomic_file::AtomicFolder;
@@ -19,20 +19,18 @@ use runtime::render::Backend;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-/// A report's lines to `log`, its long steps' progress to `progress` (each forwarded with the
-/// interpreter's lock; what a callback raises is raised when the report ends).
-struct PyObserver {
+/// A report's lines to `log` (with the interpreter's lock; what it raises is raised when the
+/// report ends), its long steps' progress to the call's one progress, named by the step.
+struct PyObserver<'a> {
     log: Option<Py<PyAny>>,
-    progress: Option<Py<PyAny>>,
-    /// Every progress handed out, to collect what its callback raised.
-    steps: Mutex<Vec<Arc<PyProgress>>>,
+    progress: &'a dyn Progress,
     error: Mutex<Option<PyErr>>,
 }
 
-/// One step's progress, shared with the observer that collects its callback's exception.
-struct SharedProgress(Arc<PyProgress>);
+/// The call's progress, lent to one step of the report.
+struct Step<'a>(&'a dyn Progress);
 
-impl Progress for SharedProgress {
+impl Progress for Step<'_> {
     fn start(&self, total: u64) {
         self.0.start(total);
     }
@@ -42,12 +40,12 @@ impl Progress for SharedProgress {
     fn status(&self, text: &str) {
         self.0.status(text);
     }
-    fn finish(&self) {
-        self.0.finish();
+    fn cancelled(&self) -> bool {
+        self.0.cancelled()
     }
 }
 
-impl Observer for PyObserver {
+impl Observer for PyObserver<'_> {
     fn line(&self, text: &str) {
         let Some(log) = &self.log else { return };
         Python::attach(|py| {
@@ -60,32 +58,8 @@ impl Observer for PyObserver {
     }
 
     fn progress(&self, what: &str) -> Box<dyn Progress + '_> {
-        let Some(callback) = &self.progress else {
-            return Box::new(foundation::infra::progress::NoProgress);
-        };
-        let step = Arc::new(PyProgress::new(
-            Python::attach(|py| callback.clone_ref(py)),
-            what,
-        ));
-        if let Ok(mut steps) = self.steps.lock() {
-            steps.push(Arc::clone(&step));
-        }
-        Box::new(SharedProgress(step))
-    }
-}
-
-impl PyObserver {
-    /// The first exception a callback raised, if any.
-    fn into_result(self) -> PyResult<()> {
-        if let Ok(Some(error)) = self.error.into_inner() {
-            return Err(error);
-        }
-        for step in self.steps.into_inner().unwrap_or_default() {
-            if let Ok(step) = Arc::try_unwrap(step) {
-                step.into_result()?;
-            }
-        }
-        Ok(())
+        self.progress.status(what);
+        Box::new(Step(self.progress))
     }
 }
 
@@ -121,7 +95,7 @@ pub(crate) fn report_json(
     positions: usize,
     probe_spp: u32,
     backend: &str,
-    progress: Option<Py<PyAny>>,
+    progress: Option<Bound<'_, PyAny>>,
     log: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let data = Arc::clone(&scene.data);
@@ -133,12 +107,6 @@ pub(crate) fn report_json(
     let backend: Backend = crate::errors::parse_choice("backend", backend)?;
     check_output(&data, &kind, bake, &output)?;
     let given = bake.map(|b| Arc::clone(&b.transfer));
-    let observer = PyObserver {
-        log,
-        progress,
-        steps: Mutex::new(Vec::new()),
-        error: Mutex::new(None),
-    };
     let settings = ReportSettings {
         width: camera.width,
         height: camera.height,
@@ -152,20 +120,31 @@ pub(crate) fn report_json(
         frames,
         backend,
     };
-    let job = ReportJob {
-        scene: &data,
-        kind: &kind,
-        given,
-        settings,
-        bounces,
-        options: report::path::PathOptions {
-            positions,
-            probe_spp,
-        },
-        observer: &observer,
+    let options = report::path::PathOptions {
+        positions,
+        probe_spp,
     };
-    let written = py.detach(|| job.write(&output));
-    observer.into_result()?;
+    let written = with_progress(py, progress.as_ref(), "report", |progress| {
+        let observer = PyObserver {
+            log,
+            progress,
+            error: Mutex::new(None),
+        };
+        let job = ReportJob {
+            scene: &data,
+            kind: &kind,
+            given,
+            settings,
+            bounces,
+            options,
+            observer: &observer,
+        };
+        let written = job.write(&output);
+        match observer.error.into_inner() {
+            Ok(Some(error)) => Err(error),
+            _ => written,
+        }
+    })?;
     written
 }
 
@@ -178,7 +157,7 @@ struct ReportJob<'a> {
     /// The reference's bounces; the bake's when not given, so both see the same light.
     bounces: Option<u32>,
     options: report::path::PathOptions,
-    observer: &'a PyObserver,
+    observer: &'a PyObserver<'a>,
 }
 
 impl ReportJob<'_> {

@@ -248,8 +248,9 @@ fn vectors_array(vectors: &TransferVectors) -> Array3<f32> {
 const MAX_THREADS: usize = 1024;
 
 /// Bakes `scene` (its `[bake]` settings, each overridden where given) on `threads` threads
-/// (all cores when `None`); the same bits whatever the thread count. `progress(stage, done,
-/// total)` is called at most once per percent of each stage. With `cache`, the bake is read
+/// (all cores when `None`); the same bits whatever the thread count. `progress`: a callable
+/// `progress(stage, done, total)`, called at most once per percent of each stage, or `"tqdm"`
+/// (or `True`) for bars; Ctrl-C stops the bake within a chunk of vertices. With `cache`, the bake is read
 /// from the cache the command line and the viewer share (`$HPRT_CACHE`, else
 /// `$XDG_CACHE_HOME/hprt`, else `~/.cache/hprt`) when it holds this geometry and these
 /// settings, and written there when not.
@@ -264,7 +265,7 @@ pub(crate) fn bake(
     order: Option<usize>,
     seed: Option<u64>,
     threads: Option<usize>,
-    progress: Option<Py<PyAny>>,
+    progress: Option<Bound<'_, PyAny>>,
     cache: bool,
 ) -> PyResult<Bake> {
     let defaults = scene.data.bake;
@@ -282,29 +283,27 @@ pub(crate) fn bake(
     }
     let mesh_hash = scene.data.geometry.content_hash();
     let data = Arc::clone(&scene.data);
-    let transfer = py.detach(move || -> PyResult<Transfer> {
+    let transfer = with_progress(py, progress.as_ref(), "bake", |progress| {
         if cache && let Some((_, transfer)) = cache::load_cached(&data, &settings) {
             return Ok(transfer);
         }
-        with_progress(progress, "bake", |progress| {
-            let run = || -> Result<Transfer, CacheError> {
-                if cache {
-                    return Ok(cache::bake_into_cache(&data, &settings, progress)?.1);
-                }
-                let bvh = SceneBvh::build(&data.geometry.mesh);
-                Ok(precompute::bake::bake(&data.geometry, &bvh, &settings, progress)?.0)
-            };
-            match threads {
-                None => run().map_err(hprt_error),
-                Some(n) => rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build()
-                    .map_err(hprt_error)?
-                    .install(run)
-                    .map_err(hprt_error),
+        let run = || -> Result<Transfer, CacheError> {
+            if cache {
+                return Ok(cache::bake_into_cache(&data, &settings, progress)?.1);
             }
-        })?
-    })?;
+            let bvh = SceneBvh::build(&data.geometry.mesh);
+            Ok(precompute::bake::bake(&data.geometry, &bvh, &settings, progress)?.0)
+        };
+        match threads {
+            None => run().map_err(hprt_error),
+            Some(n) => rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(hprt_error)?
+                .install(run)
+                .map_err(hprt_error),
+        }
+    })??;
     Ok(Bake {
         transfer: Arc::new(transfer),
         mesh_hash,

@@ -4,7 +4,7 @@
 //! multiplied by `L(with) / L(without)`, object pixels show the rendered objects, and every
 //! other pixel keeps the backplate.
 
-use crate::{EnvironmentLight, NO_HIT, ReferenceImage, ReferenceSettings};
+use crate::{EnvironmentLight, NO_HIT, ReferenceImage, ReferenceSettings, RenderError};
 use foundation::bvh::SceneBvh;
 use foundation::camera::Camera;
 use foundation::color::{Rgb, luminance};
@@ -139,7 +139,8 @@ pub struct CompositeRender {
 
 /// Path-traces `geometry` with and without its virtual objects (same settings and seed) and
 /// composites the objects into `backplate` (`None`: the environment map as the camera sees
-/// it). `progress` counts the rows of both renders.
+/// it). `progress` counts the rows of both renders; it cannot cancel this form
+/// ([`try_render_composite`] can).
 pub fn render_composite(
     geometry: &SceneMesh,
     light: &EnvironmentLight,
@@ -148,21 +149,36 @@ pub fn render_composite(
     backplate: Option<&RgbImageF32>,
     progress: &dyn Progress,
 ) -> CompositeRender {
+    let progress = crate::NeverCancelled(progress);
+    try_render_composite(geometry, light, camera, settings, backplate, &progress)
+        .expect("never cancelled")
+}
+
+/// [`render_composite`], stopped with [`RenderError::Cancelled`] when `progress` answers
+/// [`Progress::cancelled`] (asked before each row of either render).
+pub fn try_render_composite(
+    geometry: &SceneMesh,
+    light: &EnvironmentLight,
+    camera: &Camera,
+    settings: &ReferenceSettings,
+    backplate: Option<&RgbImageF32>,
+    progress: &dyn Progress,
+) -> Result<CompositeRender, RenderError> {
     let rows: Vec<usize> = (0..camera.height as usize).collect();
     let [with_objects, without_objects] =
-        render_composite_rows(geometry, light, camera, settings, &rows, progress);
-    composite_renders(
+        try_render_composite_rows(geometry, light, camera, settings, &rows, progress)?;
+    Ok(composite_renders(
         geometry,
         light,
         camera,
         with_objects,
         without_objects,
         backplate,
-    )
+    ))
 }
 
 /// The rows `rows` of both path traces of [`render_composite`]: the whole scene, and the
-/// proxies alone.
+/// proxies alone. `progress` cannot cancel this form ([`try_render_composite_rows`] can).
 pub fn render_composite_rows(
     geometry: &SceneMesh,
     light: &EnvironmentLight,
@@ -171,12 +187,27 @@ pub fn render_composite_rows(
     rows: &[usize],
     progress: &dyn Progress,
 ) -> [ReferenceImage; 2] {
+    let progress = crate::NeverCancelled(progress);
+    try_render_composite_rows(geometry, light, camera, settings, rows, &progress)
+        .expect("never cancelled")
+}
+
+/// [`render_composite_rows`], stopped with [`RenderError::Cancelled`] when `progress` answers
+/// [`Progress::cancelled`].
+pub fn try_render_composite_rows(
+    geometry: &SceneMesh,
+    light: &EnvironmentLight,
+    camera: &Camera,
+    settings: &ReferenceSettings,
+    rows: &[usize],
+    progress: &dyn Progress,
+) -> Result<[ReferenceImage; 2], RenderError> {
     let proxies = geometry.of_role(ObjectRole::Proxy);
     let trace = |scene: &SceneMesh| {
         let bvh = SceneBvh::build(&scene.mesh);
-        crate::render_rows(scene, &bvh, light, camera, settings, rows, progress)
+        crate::try_render_rows(scene, &bvh, light, camera, settings, rows, progress)
     };
-    [trace(geometry), trace(&proxies)]
+    Ok([trace(geometry)?, trace(&proxies)?])
 }
 
 /// The composite of the two whole path traces of [`render_composite`] into `backplate`

@@ -176,7 +176,34 @@ struct PixelResult {
     primary: u32,
 }
 
-/// Renders `camera`'s view of `geometry` lit by `light`. `progress` counts image rows.
+/// Why a path trace stopped without an image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum RenderError {
+    /// Its [`Progress`] answered [`Progress::cancelled`] (asked before each image row).
+    #[error("the path trace was cancelled")]
+    Cancelled,
+}
+
+/// `progress` with its cancellation ignored: the work it reports on always finishes.
+pub(crate) struct NeverCancelled<'a>(pub(crate) &'a dyn Progress);
+
+impl Progress for NeverCancelled<'_> {
+    fn start(&self, total: u64) {
+        self.0.start(total);
+    }
+    fn advance(&self, steps: u64) {
+        self.0.advance(steps);
+    }
+    fn status(&self, text: &str) {
+        self.0.status(text);
+    }
+    fn finish(&self) {
+        self.0.finish();
+    }
+}
+
+/// Renders `camera`'s view of `geometry` lit by `light`. `progress` counts image rows; it
+/// cannot cancel this form ([`try_render`] can).
 pub fn render(
     geometry: &SceneMesh,
     bvh: &SceneBvh,
@@ -185,14 +212,28 @@ pub fn render(
     settings: &ReferenceSettings,
     progress: &dyn Progress,
 ) -> ReferenceImage {
+    let progress = NeverCancelled(progress);
+    try_render(geometry, bvh, light, camera, settings, &progress).expect("never cancelled")
+}
+
+/// [`render`], stopped with [`RenderError::Cancelled`] when `progress` answers
+/// [`Progress::cancelled`] (asked before each row); the same image when it does not.
+pub fn try_render(
+    geometry: &SceneMesh,
+    bvh: &SceneBvh,
+    light: &EnvironmentLight,
+    camera: &Camera,
+    settings: &ReferenceSettings,
+    progress: &dyn Progress,
+) -> Result<ReferenceImage, RenderError> {
     let rows: Vec<usize> = (0..camera.height as usize).collect();
-    render_rows(geometry, bvh, light, camera, settings, &rows, progress)
+    try_render_rows(geometry, bvh, light, camera, settings, &rows, progress)
 }
 
 /// Renders the image rows `rows` (in that order, one below the other) of [`render`]'s
 /// image, each pixel exactly as the whole image has it (a pixel's samples depend only on its
 /// index and the seed), so rows rendered apart and [assembled](ReferenceImage::assemble)
-/// equal the whole image.
+/// equal the whole image. `progress` cannot cancel this form ([`try_render_rows`] can).
 pub fn render_rows(
     geometry: &SceneMesh,
     bvh: &SceneBvh,
@@ -202,6 +243,22 @@ pub fn render_rows(
     rows: &[usize],
     progress: &dyn Progress,
 ) -> ReferenceImage {
+    let progress = NeverCancelled(progress);
+    try_render_rows(geometry, bvh, light, camera, settings, rows, &progress)
+        .expect("never cancelled")
+}
+
+/// [`render_rows`], stopped with [`RenderError::Cancelled`] when `progress` answers
+/// [`Progress::cancelled`] (asked before each row).
+pub fn try_render_rows(
+    geometry: &SceneMesh,
+    bvh: &SceneBvh,
+    light: &EnvironmentLight,
+    camera: &Camera,
+    settings: &ReferenceSettings,
+    rows: &[usize],
+    progress: &dyn Progress,
+) -> Result<ReferenceImage, RenderError> {
     let start = Instant::now();
     let (width, height) = (camera.width as usize, rows.len());
     let basis = camera.basis();
@@ -210,6 +267,9 @@ pub fn render_rows(
     let rows: Vec<(Vec<PixelResult>, u64)> = rows
         .par_iter()
         .map(|&j| {
+            if progress.cancelled() {
+                return None;
+            }
             let mut rays = 0u64;
             let row = (0..width)
                 .map(|i| {
@@ -226,9 +286,10 @@ pub fn render_rows(
                 })
                 .collect();
             progress.advance(1);
-            (row, rays)
+            Some((row, rays))
         })
-        .collect();
+        .collect::<Option<_>>()
+        .ok_or(RenderError::Cancelled)?;
     progress.finish();
     let pixels: Vec<PixelResult> = rows
         .iter()
@@ -237,7 +298,7 @@ pub fn render_rows(
     let image = |f: fn(&PixelResult) -> Rgb| {
         RgbImageF32::new(width, height, pixels.iter().map(f).collect())
     };
-    ReferenceImage {
+    Ok(ReferenceImage {
         radiance: image(|p| p.radiance),
         specular: image(|p| p.specular),
         coverage: pixels.iter().map(|p| p.coverage).collect(),
@@ -247,7 +308,7 @@ pub fn render_rows(
             rays: rows.iter().map(|(_, rays)| rays).sum(),
             seconds: start.elapsed().as_secs_f64(),
         },
-    }
+    })
 }
 
 /// A synthetic light probe: the radiance arriving at `position` through the centre of each

@@ -444,3 +444,62 @@ fn probes_see_the_furnace_and_the_sky() {
     }
     assert!(outside > 128 * 20, "{outside} texels see the sky");
 }
+
+/// Progress that asks to stop once `limit` rows are rendered.
+struct CancelAfter {
+    limit: u64,
+    done: std::sync::atomic::AtomicU64,
+}
+
+impl Progress for CancelAfter {
+    fn advance(&self, steps: u64) {
+        self.done
+            .fetch_add(steps, std::sync::atomic::Ordering::Relaxed);
+    }
+    fn cancelled(&self) -> bool {
+        self.done.load(std::sync::atomic::Ordering::Relaxed) >= self.limit
+    }
+}
+
+/// A progress that answers cancelled stops the path trace within a row per thread with
+/// `Cancelled`; one that never does changes no bit; the infallible form never asks.
+#[test]
+fn a_cancelled_render_stops_early_and_an_uncancelled_one_is_unchanged() {
+    let geometry = scene_of(&[(&sphere_mesh(Vec3::ZERO, 1.0, 3), Rgb::splat(0.5))]);
+    let map = EnvMap::uniform(32, 16, Rgb::ONE);
+    let cam = camera(Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, 200);
+    let settings = ReferenceSettings::new(2, 1, 3);
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let light = EnvironmentLight::new(&map, 0.0);
+    let progress = |limit| CancelAfter {
+        limit,
+        done: Default::default(),
+    };
+
+    let early = progress(1);
+    let result = try_render(&geometry, &bvh, &light, &cam, &settings, &early);
+    assert_eq!(result.err(), Some(RenderError::Cancelled));
+    let rows = early.done.into_inner();
+    assert!(
+        rows <= rayon::current_num_threads() as u64,
+        "rendered {rows} of 200 rows after the cancel"
+    );
+
+    let bits = |image: &ReferenceImage| -> Vec<u32> {
+        let values = image.radiance.pixels.iter().flat_map(|p| p.to_array());
+        values.map(f32::to_bits).collect()
+    };
+    let plain = render_with(&geometry, &map, &cam, &settings);
+    let asked = try_render(
+        &geometry,
+        &bvh,
+        &light,
+        &cam,
+        &settings,
+        &progress(u64::MAX),
+    );
+    assert_eq!(bits(&asked.unwrap()), bits(&plain));
+    // The infallible form renders every row even when asked to stop.
+    let ignored = render(&geometry, &bvh, &light, &cam, &settings, &progress(1));
+    assert_eq!(bits(&ignored), bits(&plain));
+}

@@ -1,6 +1,11 @@
 //! How long-running library work (bakes, reference renders) reports its progress, without the
 //! library choosing how it is shown: the command line draws a terminal bar, the viewer a panel
 //! widget, tests nothing.
+//!
+//! The same object carries cancellation the other way: work that may run long asks
+//! [`Progress::cancelled`] at coarse points (a chunk of vertices, an image row) and stops with
+//! its own `Cancelled` error when it answers true (the Python module answers true after Ctrl-C).
+//! Asking never changes what is computed: work that is not cancelled gives the same bits.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -14,6 +19,11 @@ pub trait Progress: Sync {
     fn status(&self, _text: &str) {}
     /// The work is over.
     fn finish(&self) {}
+    /// Whether the work should stop now (its result is then an error, never a partial one).
+    /// Asked from any of the work's threads, often: keep it cheap.
+    fn cancelled(&self) -> bool {
+        false
+    }
 }
 
 /// Progress that goes nowhere.

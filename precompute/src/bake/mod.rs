@@ -26,6 +26,17 @@ use foundation::scene::SceneMesh;
 use foundation::settings::InvalidSettings;
 use std::time::Instant;
 
+/// Why a bake stopped without a result.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum BakeError {
+    #[error(transparent)]
+    Settings(#[from] InvalidSettings),
+    /// Its [`Progress`] answered [`Progress::cancelled`] (asked per chunk of vertices and per
+    /// bounce).
+    #[error("the bake was cancelled")]
+    Cancelled,
+}
+
 /// Direct and interreflected transfer of every vertex.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Transfer {
@@ -170,18 +181,19 @@ impl<'a> NeumannSeries<'a> {
 }
 
 /// Traces every (vertex, sample) ray once: the direct transfer and the interreflection
-/// operator. `progress` counts vertices.
+/// operator. `progress` counts vertices, and may cancel.
 pub fn trace(
     geometry: &SceneMesh,
     bvh: &SceneBvh,
     settings: &BakeSettings,
     progress: &dyn Progress,
-) -> Result<TracedScene, InvalidSettings> {
+) -> Result<TracedScene, BakeError> {
     settings.validate()?;
     let start = Instant::now();
     let vertex_count = geometry.mesh.vertex_count();
     progress.start(vertex_count as u64);
-    let traced = visibility::trace_vertices(geometry, bvh, settings, 0..vertex_count, progress);
+    let traced = visibility::trace_vertices(geometry, bvh, settings, 0..vertex_count, progress)
+        .ok_or(BakeError::Cancelled)?;
     Ok(TracedScene::new(
         geometry,
         settings,
@@ -226,27 +238,29 @@ impl TracedScene {
 }
 
 /// Bakes the transfer of every vertex of `geometry`. `progress` counts vertices of the
-/// tracing pass (pass [`foundation::infra::progress::NoProgress`] for none).
+/// tracing pass (pass [`foundation::infra::progress::NoProgress`] for none); when it answers
+/// [`Progress::cancelled`] the bake stops with [`BakeError::Cancelled`].
 pub fn bake(
     geometry: &SceneMesh,
     bvh: &SceneBvh,
     settings: &BakeSettings,
     progress: &dyn Progress,
-) -> Result<(Transfer, BakeStats), InvalidSettings> {
+) -> Result<(Transfer, BakeStats), BakeError> {
     let start = Instant::now();
     let traced = trace(geometry, bvh, settings, progress)?;
-    let (transfer, mut stats) = sum_bounces(geometry, settings, traced, progress);
+    let (transfer, mut stats) = sum_bounces(geometry, settings, traced, progress)?;
     stats.total_seconds = start.elapsed().as_secs_f64();
     Ok((transfer, stats))
 }
 
-/// The Neumann series over a traced scene: the finished bake.
+/// The Neumann series over a traced scene: the finished bake (cancelled between bounces when
+/// `progress` asks).
 fn sum_bounces(
     geometry: &SceneMesh,
     settings: &BakeSettings,
     traced: TracedScene,
     progress: &dyn Progress,
-) -> (Transfer, BakeStats) {
+) -> Result<(Transfer, BakeStats), BakeError> {
     let start = Instant::now();
     let vertex_count = geometry.mesh.vertex_count();
     let mut stats = BakeStats {
@@ -258,6 +272,9 @@ fn sum_bounces(
     };
     let mut series = NeumannSeries::new(&traced, settings.bounces);
     for bounce in 0..settings.bounces {
+        if progress.cancelled() {
+            return Err(BakeError::Cancelled);
+        }
         let bounce_start = Instant::now();
         series.step();
         stats
@@ -270,7 +287,7 @@ fn sum_bounces(
         .unwrap_or_else(|| TransferVectors::zeros(settings.order, vertex_count));
     stats.total_seconds = traced.seconds + start.elapsed().as_secs_f64();
     progress.finish();
-    (
+    Ok((
         Transfer {
             settings: *settings,
             direct: traced.direct,
@@ -283,7 +300,7 @@ fn sum_bounces(
                 .sum(),
         },
         stats,
-    )
+    ))
 }
 
 #[cfg(test)]

@@ -10,12 +10,11 @@
 
 use super::bounce::InterreflectionOperator;
 use super::visibility::{self, TracedVertices};
-use super::{BakeSettings, BakeStats, TracedScene, Transfer};
+use super::{BakeError, BakeSettings, BakeStats, TracedScene, Transfer};
 use foundation::bvh::SceneBvh;
 use foundation::infra::progress::Progress;
 use foundation::infra::shard::{IncompleteShards, ShardSpec, check_indices, split_by_cost};
 use foundation::scene::SceneMesh;
-use foundation::settings::InvalidSettings;
 use std::ops::Range;
 use std::time::Instant;
 
@@ -60,6 +59,8 @@ pub enum MergeError {
     SceneChanged,
     #[error("the shards' vertex ranges do not cover the scene's vertices exactly")]
     Gaps,
+    #[error(transparent)]
+    Bake(#[from] BakeError),
 }
 
 /// Probe rays traced from each probed vertex to estimate its cost.
@@ -97,13 +98,14 @@ pub fn trace_shard(
     spec: ShardSpec,
     (scene_path, scene_hash): (&str, [u8; 32]),
     progress: &dyn Progress,
-) -> Result<BakeShard, InvalidSettings> {
+) -> Result<BakeShard, BakeError> {
     settings.validate()?;
     let start = Instant::now();
     let ranges = partition(geometry, bvh, settings, spec.count);
     let vertices = ranges[spec.index as usize].clone();
     progress.start(vertices.len() as u64);
-    let traced = visibility::trace_vertices(geometry, bvh, settings, vertices.clone(), progress);
+    let traced = visibility::trace_vertices(geometry, bvh, settings, vertices.clone(), progress)
+        .ok_or(BakeError::Cancelled)?;
     progress.finish();
     Ok(BakeShard {
         spec,
@@ -194,7 +196,7 @@ pub fn merge(
         inside,
     };
     let traced = TracedScene::new(geometry, &settings, traced, seconds);
-    Ok(super::sum_bounces(geometry, &settings, traced, progress))
+    Ok(super::sum_bounces(geometry, &settings, traced, progress)?)
 }
 
 #[cfg(test)]

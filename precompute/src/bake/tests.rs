@@ -341,7 +341,7 @@ fn bounces_sum_the_series_term_by_term() {
             }
         }
         let partial_sums: Vec<TransferVectors> = traced.cumulative_indirect(bounces).collect();
-        let (transfer, _) = sum_bounces(&geometry, &settings, traced, no_progress);
+        let (transfer, _) = sum_bounces(&geometry, &settings, traced, no_progress).unwrap();
         let bits =
             |t: &TransferVectors| t.as_slice().iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert!(sum.as_slice().iter().any(|&x| x > 0.01), "no light bounced");
@@ -349,4 +349,73 @@ fn bounces_sum_the_series_term_by_term() {
         assert_eq!(partial_sums.len(), bounces as usize);
         assert_eq!(bits(partial_sums.last().unwrap()), bits(&sum));
     }
+}
+
+/// Progress that asks to stop once `limit` vertices are traced.
+struct CancelAfter {
+    limit: u64,
+    done: std::sync::atomic::AtomicU64,
+}
+
+impl CancelAfter {
+    fn new(limit: u64) -> Self {
+        Self {
+            limit,
+            done: Default::default(),
+        }
+    }
+    fn done(&self) -> u64 {
+        self.done.load(std::sync::atomic::Ordering::Relaxed)
+    }
+}
+
+impl Progress for CancelAfter {
+    fn advance(&self, steps: u64) {
+        self.done
+            .fetch_add(steps, std::sync::atomic::Ordering::Relaxed);
+    }
+    fn cancelled(&self) -> bool {
+        self.done() >= self.limit
+    }
+}
+
+/// A progress that answers cancelled stops the tracing within a few chunks, or the bounces
+/// after the tracing, with `Cancelled`; one that never does changes no bit of the bake.
+#[test]
+fn a_cancelled_bake_stops_early_and_an_uncancelled_one_is_unchanged() {
+    let geometry = scene_of(&sphere_mesh(Vec3::ZERO, 1.0, 5), Rgb::splat(0.5));
+    let bvh = SceneBvh::build(&geometry.mesh);
+    let vertices = geometry.mesh.vertex_count() as u64;
+    assert!(
+        vertices > 100 * visibility::CHUNK as u64,
+        "{vertices} vertices"
+    );
+    let settings = BakeSettings {
+        order: 2,
+        samples: 16,
+        bounces: 1,
+        seed: 1,
+    };
+
+    let early = CancelAfter::new(1);
+    let result = bake(&geometry, &bvh, &settings, &early);
+    assert_eq!(result.err(), Some(BakeError::Cancelled));
+    // Each worker thread finishes the chunk it started, and starts no other.
+    let threads = rayon::current_num_threads() as u64;
+    assert!(
+        early.done() <= threads * visibility::CHUNK as u64,
+        "traced {} of {vertices} vertices after the cancel",
+        early.done()
+    );
+
+    // Tracing done, cancelled before the first bounce.
+    let late = CancelAfter::new(vertices);
+    let result = bake(&geometry, &bvh, &settings, &late);
+    assert_eq!(result.err(), Some(BakeError::Cancelled));
+    assert_eq!(late.done(), vertices);
+
+    let never = CancelAfter::new(u64::MAX);
+    let (asked, _) = bake(&geometry, &bvh, &settings, &never).unwrap();
+    let (plain, _) = run(&geometry, settings);
+    assert_eq!(asked, plain);
 }

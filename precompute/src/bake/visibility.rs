@@ -93,14 +93,15 @@ struct Chunk {
 pub(crate) const CHUNK: usize = 32;
 
 /// Traces the rays of `vertices` (a vertex's results do not depend on which others are traced
-/// with it, so shards of the range concatenate to the whole).
+/// with it, so shards of the range concatenate to the whole). `None` when `progress` asks to
+/// stop: it is asked before each chunk of [`CHUNK`] vertices.
 pub(crate) fn trace_vertices(
     geometry: &SceneMesh,
     bvh: &SceneBvh,
     settings: &BakeSettings,
     vertices: std::ops::Range<usize>,
     progress: &dyn Progress,
-) -> TracedVertices {
+) -> Option<TracedVertices> {
     let order = settings.order;
     let n = num_coeffs(order);
     let tracer = VertexTracer::new(geometry, bvh, settings);
@@ -118,6 +119,9 @@ pub(crate) fn trace_vertices(
                 hits: Vec::with_capacity(3 * tracer.fans.len()),
             },
             |scratch, chunk_index| {
+                if progress.cancelled() {
+                    return None;
+                }
                 let vertices = first + chunk_index * CHUNK
                     ..first + ((chunk_index + 1) * CHUNK).min(vertex_count);
                 let mut chunk = Chunk {
@@ -135,10 +139,10 @@ pub(crate) fn trace_vertices(
                 }
                 chunk.operator.shrink_to_fit();
                 progress.advance(vertices.len() as u64);
-                chunk
+                Some(chunk)
             },
         )
-        .collect();
+        .collect::<Option<_>>()?;
 
     let mut visibility = Vec::with_capacity(vertex_count * n);
     let mut blocks = Vec::with_capacity(chunks.len());
@@ -148,12 +152,12 @@ pub(crate) fn trace_vertices(
         blocks.push(chunk.operator);
         inside.extend(chunk.inside);
     }
-    TracedVertices {
+    Some(TracedVertices {
         order,
         visibility,
         operator: InterreflectionOperator::from_blocks(blocks),
         inside,
-    }
+    })
 }
 
 /// Each vertex's estimated tracing cost: the BVH nodes visited by `probe_rays` rays from one
