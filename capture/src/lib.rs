@@ -42,7 +42,7 @@ pub use description::{BallDescription, CaptureDescription, ShotDescription};
 pub use error::{CaptureError, EntryKind, EntryProblem};
 pub use exif::{ExifExposure, exif_block, read_exposure};
 pub use inverse_response::{InverseResponse, Observation, RESPONSE_BINS};
-pub use load::{LoadedCapture, load_capture};
+pub use load::{LoadedCapture, load_ball_photographs, load_capture};
 pub use merge::hat_weight;
 pub use photo::{Photo, View};
 pub use response::{equal_step_ratio, equal_steps_warning, recover_response};

@@ -43,6 +43,49 @@ pub fn load_capture(path: &Path) -> Result<LoadedCapture, CaptureError> {
             path: path.to_path_buf(),
             cause,
         })?;
+    let folder = path.parent().unwrap_or(Path::new("."));
+    load_described(&description, folder, path)
+}
+
+/// A mirror ball's bracketed photographs from one tripod position (the camera's vertical
+/// field of view `fov` degrees, looking along -Z): the ball's `outline` (centre and radius in
+/// pixels) in every one, or found in them when not given; each exposure from its EXIF. What
+/// a description of `[[ball]]` entries naming only `image`, `fov`, `reflectance` and the
+/// outline gives; errors name the photographs' folder.
+pub fn load_ball_photographs(
+    images: &[PathBuf],
+    fov: f32,
+    reflectance: [f32; 3],
+    outline: Option<([f32; 2], f32)>,
+) -> Result<LoadedCapture, CaptureError> {
+    let description = CaptureDescription {
+        shot: Vec::new(),
+        ball: (images.iter())
+            .map(|image| BallDescription {
+                image: image.clone(),
+                exposure: None,
+                centre: outline.map(|(centre, _)| centre),
+                radius: outline.map(|(_, radius)| radius),
+                fov,
+                yaw: 0.0,
+                pitch: 0.0,
+                reflectance,
+            })
+            .collect(),
+    };
+    let folder = images
+        .first()
+        .and_then(|p| p.parent())
+        .unwrap_or(Path::new("."));
+    load_described(&description, Path::new(""), folder)
+}
+
+/// The photographs `description` names (relative to `folder`), checked; errors name `path`.
+fn load_described(
+    description: &CaptureDescription,
+    folder: &Path,
+    path: &Path,
+) -> Result<LoadedCapture, CaptureError> {
     if description.shot.is_empty() && description.ball.is_empty() {
         return Err(CaptureError::NoPhotographs {
             path: path.to_path_buf(),
@@ -55,7 +98,6 @@ pub fn load_capture(path: &Path) -> Result<LoadedCapture, CaptureError> {
             count,
         });
     }
-    let folder = path.parent().unwrap_or(Path::new("."));
     let mut notes = Vec::new();
     let mut photos = Vec::new();
     let mut given = Vec::new();

@@ -279,11 +279,17 @@ class Captured:
     def warnings(self) -> list[str]: ...
 
 def capture(
-    description: Union[str, "os.PathLike[str]"],
+    description: Union[str, "os.PathLike[str]", Sequence[Union[str, "os.PathLike[str]"]]],
     width: int = 1024,
     response: Optional[npt.NDArray[np.float32]] = None,
+    fov_deg: Optional[float] = None,
+    reflectance: tuple[float, float, float] = (1.0, 1.0, 1.0),
+    outline: Optional[tuple[float, float, float]] = None,
 ) -> Captured:
-    """The map a capture description's photographs see (as ``hprt capture``)."""
+    """The map the photographs see (as ``hprt capture``): those a capture description names,
+    or a list of a mirror ball's bracketed photographs from one tripod position (``fov_deg``
+    the camera's vertical field of view; ``outline`` the ball's centre x, y and radius in
+    pixels, found when not given; exposures from EXIF)."""
 
 CompositeForm = Literal["differential", "occlusion"]
 

@@ -41,15 +41,22 @@ impl Captured {
     }
 }
 
-/// Captures the map the description's photographs see, `width` texels wide; the response is
-/// recovered from the photographs unless given (a `(256, 3)` array, increasing per channel).
+/// Captures the map the photographs see, `width` texels wide: those a capture description
+/// names, or a list of a mirror ball's bracketed photographs from one tripod position (the
+/// camera's vertical field of view `fov_deg`, the ball's `reflectance`; the ball is found in
+/// them and each exposure read from its EXIF). The response is recovered from the
+/// photographs unless given (a `(256, 3)` array, increasing per channel).
 #[pyfunction]
-#[pyo3(signature = (description, width = 1024, response = None))]
+#[pyo3(signature = (description, width = 1024, response = None, fov_deg = None, reflectance = (1.0, 1.0, 1.0), outline = None))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn capture(
     py: Python<'_>,
-    description: PathBuf,
+    description: &Bound<'_, PyAny>,
     width: usize,
     response: Option<PyReadonlyArray2<'_, f32>>,
+    fov_deg: Option<f32>,
+    reflectance: (f32, f32, f32),
+    outline: Option<(f32, f32, f32)>,
 ) -> PyResult<Captured> {
     if !(8..=16384).contains(&width) || !width.is_multiple_of(2) {
         return Err(PyValueError::new_err(format!(
@@ -58,7 +65,12 @@ pub(crate) fn capture(
     }
     let given = response.map(|r| response_from_array(&r)).transpose()?;
     let response_given = given.is_some();
-    let loaded = ::capture::load_capture(&description).map_err(crate::errors::hprt_error)?;
+    let list = BallList {
+        fov_deg,
+        reflectance,
+        outline,
+    };
+    let loaded = load_photographs(description, &list)?;
     let mut warnings = loaded.notes;
     let settings = AssemblySettings {
         width,
@@ -90,6 +102,48 @@ pub(crate) fn capture(
         covered: captured.covered_fraction(),
         warnings,
     })
+}
+
+/// What a list of a ball's photographs needs besides the photographs.
+struct BallList {
+    fov_deg: Option<f32>,
+    reflectance: (f32, f32, f32),
+    /// Centre x, y and radius in pixels.
+    outline: Option<(f32, f32, f32)>,
+}
+
+/// The photographs of a description (a path), or a list of a ball's photographs.
+fn load_photographs(
+    description: &Bound<'_, PyAny>,
+    list: &BallList,
+) -> PyResult<::capture::LoadedCapture> {
+    if let Ok(path) = description.extract::<PathBuf>() {
+        if list.fov_deg.is_some() || list.outline.is_some() {
+            return Err(PyValueError::new_err(
+                "fov_deg and outline are for a list of photographs; a description gives each \
+                 one's",
+            ));
+        }
+        return ::capture::load_capture(&path).map_err(crate::errors::hprt_error);
+    }
+    let photos: Vec<PathBuf> = description.extract().map_err(|_| {
+        PyValueError::new_err("description: a capture description's path, or a list of photographs")
+    })?;
+    let Some(fov) = list.fov_deg else {
+        return Err(PyValueError::new_err(
+            "fov_deg: the camera's vertical field of view, in degrees, is needed with a list of \
+             photographs",
+        ));
+    };
+    if photos.is_empty() {
+        return Err(PyValueError::new_err(
+            "description: the list of photographs is empty",
+        ));
+    }
+    let (r, g, b) = list.reflectance;
+    let outline = list.outline.map(|(x, y, radius)| ([x, y], radius));
+    ::capture::load_ball_photographs(&photos, fov, [r, g, b], outline)
+        .map_err(crate::errors::hprt_error)
 }
 
 fn response_from_array(array: &PyReadonlyArray2<'_, f32>) -> PyResult<InverseResponse> {

@@ -438,6 +438,33 @@ class Capture(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "increasing"):
             hprt.capture(description, width=128, response=captured.response[::-1].copy())
 
+    def test_a_list_of_ball_photographs_is_the_description_of_them(self) -> None:
+        with tempfile.TemporaryDirectory() as folder:
+            # A mirror ball's bracket, photographed by the synthetic camera (its bench's own
+            # capture of them may fail: only the photographs are used).
+            subprocess.run([os.environ.get("HPRT_BIN", "hprt"), "bench", "capture", str(INTERIOR), "--ball",
+                            "--size", "320x240", "--width", "64", "--keep", folder],
+                           capture_output=True)
+            photos = sorted(Path(folder).glob("ball0_*.jpg"))
+            self.assertEqual(len(photos), 4)
+            # The synthetic ball: centred, 0.42 of the picture's height across its radius.
+            outline = (160.0, 120.0, 0.42 * 240)
+            captured = hprt.capture(photos, width=64, fov_deg=25.0, reflectance=(0.6, 0.6, 0.6),
+                                    outline=outline)
+            description = Path(folder) / "one-view.toml"
+            description.write_text("".join(
+                f'[[ball]]\nimage = "{p.name}"\nfov = 25.0\nreflectance = [0.6, 0.6, 0.6]\n'
+                f"centre = [160.0, 120.0]\nradius = {0.42 * 240}\n\n" for p in photos))
+            out = Path(folder) / "captured.exr"
+            hprt_program("capture", str(description), "-o", str(out), "--width", "64")
+            expected = hprt.load_map(out)
+            np.testing.assert_allclose(captured.map, expected, rtol=1e-6, atol=1e-12)
+            self.assertGreater(captured.covered, 0.5)
+            with self.assertRaisesRegex(ValueError, "fov_deg"):
+                hprt.capture(photos)
+            with self.assertRaisesRegex(ValueError, "list of photographs"):
+                hprt.capture(description, fov_deg=25.0)
+
 
 if __name__ == "__main__":
     unittest.main()
