@@ -124,7 +124,7 @@ pub(crate) fn report_json(
         positions,
         probe_spp,
     };
-    let written = with_progress(py, progress.as_ref(), "report", |progress| {
+    with_progress(py, progress.as_ref(), "report", |progress| {
         let observer = PyObserver {
             log,
             progress,
@@ -144,8 +144,7 @@ pub(crate) fn report_json(
             Ok(Some(error)) => Err(error),
             _ => written,
         }
-    })?;
-    written
+    })?
 }
 
 /// What one report call writes.
