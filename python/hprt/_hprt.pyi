@@ -20,6 +20,9 @@ exception it raises stops the work and is raised); ``"tqdm"`` or ``True`` for tq
 class HprtError(Exception):
     """An hprt library call failed; the message says what and where."""
 
+class HprtFileNotFoundError(HprtError, FileNotFoundError):
+    """A file an hprt call reads is missing."""
+
 class Light:
     """One directional light of a decomposition, or of your own."""
 

@@ -124,6 +124,7 @@ fn load_photographs(
                  one's",
             ));
         }
+        crate::errors::existing(&path)?;
         return ::capture::load_capture(&path).map_err(crate::errors::hprt_error);
     }
     let photos: Vec<PathBuf> = description.extract().map_err(|_| {
@@ -139,6 +140,9 @@ fn load_photographs(
         return Err(PyValueError::new_err(
             "description: the list of photographs is empty",
         ));
+    }
+    for photo in &photos {
+        crate::errors::existing(photo)?;
     }
     let (r, g, b) = list.reflectance;
     let outline = list.outline.map(|(x, y, radius)| ([x, y], radius));

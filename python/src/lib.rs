@@ -25,6 +25,7 @@ mod scene;
 #[pymodule]
 fn _hprt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("HprtError", m.py().get_type::<HprtError>())?;
+    errors::add_file_not_found(m)?;
     m.add_function(wrap_pyfunction!(maps::load_map, m)?)?;
     m.add_function(wrap_pyfunction!(decompose::decompose, m)?)?;
     m.add_class::<decompose::Light>()?;

@@ -19,6 +19,7 @@ pub(crate) fn load_map<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'p
 }
 
 pub(crate) fn read_map(path: &std::path::Path) -> PyResult<EnvMap> {
+    crate::errors::existing(path)?;
     foundation::envmap::load(path, None)
         .map(|loaded| loaded.map)
         .map_err(crate::errors::hprt_error)

@@ -293,6 +293,7 @@ fn report_kind(
         };
     }
     if let Some(sequence) = sequence {
+        crate::errors::existing(&sequence)?;
         return Ok(Kind::Sequence(sequence));
     }
     let maps = match maps {
@@ -311,6 +312,9 @@ fn report_kind(
         return Err(PyValueError::new_err(
             "maps: no environment maps to report on",
         ));
+    }
+    for map in &maps {
+        crate::errors::existing(map)?;
     }
     Ok(Kind::Maps(maps))
 }

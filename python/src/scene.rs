@@ -149,6 +149,7 @@ pub(crate) fn map_rotation(scene: &SceneData, requested_deg: Option<f32>) -> f32
 /// Loads a scene file or a model.
 #[pyfunction]
 pub(crate) fn load_scene(path: PathBuf) -> PyResult<Scene> {
+    crate::errors::existing(&path)?;
     let data = SceneData::open(&path).map_err(hprt_error)?;
     Ok(Scene {
         data: Arc::new(data),
@@ -313,6 +314,7 @@ pub(crate) fn bake(
 /// Loads a `.bake` file of `scene` (refused if it was baked from other geometry).
 #[pyfunction]
 pub(crate) fn load_bake(scene: &Scene, path: PathBuf) -> PyResult<Bake> {
+    crate::errors::existing(&path)?;
     let mesh_hash = scene.data.geometry.content_hash();
     let transfer = precompute::bakefile::read_for_mesh(&path, &mesh_hash).map_err(hprt_error)?;
     Ok(Bake {

@@ -277,9 +277,24 @@ class BakeAndRender(unittest.TestCase):
         shiny = [o for o in glossy.objects if max(o.specular) > 0.0]
         self.assertTrue(shiny and all(o.shininess > 1.0 for o in shiny))
 
-    def test_a_missing_scene_names_its_file(self) -> None:
+    def test_a_missing_file_is_a_file_not_found_error(self) -> None:
         with self.assertRaisesRegex(hprt.HprtError, "no_such_scene.toml"):
             hprt.load_scene("no_such_scene.toml")
+        calls = [
+            lambda: hprt.load_scene("no_such_scene.toml"),
+            lambda: hprt.load_map("no_such_map.exr"),
+            lambda: hprt.decompose("no_such_map.exr"),
+            lambda: hprt.load_bake(self.scene, "no_such.bake"),
+            lambda: hprt.capture("no_such_capture.toml"),
+            lambda: hprt.capture(["no_such_photo.jpg"], fov_deg=25.0),
+            lambda: hprt.reference(self.scene, "no_such_map.exr", spp=1, width=8, height=6),
+        ]
+        for call in calls:
+            with self.assertRaises(hprt.HprtFileNotFoundError) as raised:
+                call()
+            self.assertIsInstance(raised.exception, FileNotFoundError)
+            self.assertIsInstance(raised.exception, hprt.HprtError)
+            self.assertIn("no_such", str(raised.exception))
 
 
 
@@ -410,7 +425,7 @@ class Report(unittest.TestCase):
                 with self.subTest(bad=bad), self.assertRaises(ValueError):
                     hprt.report(scene, Path(folder) / "out", bake=bake, **bad)
             self.assertFalse((Path(folder) / "out").exists())
-            with self.assertRaises(hprt.HprtError):
+            with self.assertRaises(FileNotFoundError):
                 hprt.report(scene, Path(folder) / "out", maps=[Path(folder) / "missing.exr"],
                             bake=bake, spp=1, width=8, height=6, frames=1)
             self.assertFalse((Path(folder) / "out").exists())
