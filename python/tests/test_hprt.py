@@ -11,6 +11,7 @@ import subprocess
 import tempfile
 import unittest
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 import numpy.typing as npt
@@ -280,7 +281,7 @@ class BakeAndRender(unittest.TestCase):
     def test_a_missing_file_is_a_file_not_found_error(self) -> None:
         with self.assertRaisesRegex(hprt.HprtError, "no_such_scene.toml"):
             hprt.load_scene("no_such_scene.toml")
-        calls = [
+        calls: list[Callable[[], object]] = [
             lambda: hprt.load_scene("no_such_scene.toml"),
             lambda: hprt.load_map("no_such_map.exr"),
             lambda: hprt.decompose("no_such_map.exr"),
