@@ -368,7 +368,8 @@ fn composites_a_model_into_its_environment_under_xvfb() {
          move 0.5 0 0\nwait-bake\nwait 3\nscreenshot moved.png\ncommand moved.sh\n\
          state moved.json\n\
          set wireframe on\nwait 2\nscreenshot wire.png\nset composite off\nwait 2\n\
-         screenshot whole.png\nstate off.json\nquit\n",
+         screenshot whole.png\nstate off.json\nset wireframe off\nset composite on\n\
+         wait-bake\nwait 3\nscreenshot again.png\nquit\n",
     )
     .unwrap();
     let out = view_under_xvfb_with(
@@ -432,6 +433,12 @@ fn composites_a_model_into_its_environment_under_xvfb() {
             "{script} reproduces {screenshot} (worst {worst})"
         );
     }
+    // Turned on again after frames drawn whole: the same composite as before (the proxies'
+    // radiance is made from the lighting already set).
+    let (_, _, again) = image_rgb(&d.join("again.png"));
+    let (_, _, moved_shown) = image_rgb(&d.join("moved.png"));
+    let worst = worst_difference(&again, &moved_shown);
+    assert!(worst <= 1, "the composite turned on again (worst {worst})");
     let moved = state("moved.json");
     assert_eq!(moved["object_offset"][0], 0.5);
     let (_, _, after) = image_rgb(&d.join("moved.png"));

@@ -26,7 +26,7 @@ impl App {
             }
         }
         self.stats.last_frame = Some(now);
-        self.poll_bake();
+        self.poll_jobs();
         self.run_script(event_loop)?;
         self.ensure_renderer()?;
         self.apply_composite()?;

@@ -2,12 +2,12 @@
 //! settings change.
 
 use super::App;
-use super::state::BakeJob;
+use super::jobs::{Job, JobObserver};
 use crate::bake_cache;
 use crate::maps::default_exposure;
-use foundation::infra::progress::SharedProgress;
+use precompute::bake::Transfer;
 use runtime::EnvironmentLighting;
-use runtime::render::Renderer;
+use runtime::render::{LiveBackplate, Renderer};
 use std::sync::Arc;
 
 impl App {
@@ -71,38 +71,61 @@ impl App {
 
     pub(super) fn start_bake(&mut self) {
         let scene = self.scene.clone();
-        let progress = Arc::new(SharedProgress::default());
-        let shared = progress.clone();
-        let (sender, receiver) = std::sync::mpsc::channel();
-        std::thread::spawn(move || {
-            let result = bake_cache::bake_into_cache(&scene, &scene.bake, shared.as_ref())
-                .map(|(_, transfer, _)| transfer)
-                .map_err(anyhow::Error::from);
-            let _ = sender.send(result);
-        });
-        self.bake.job = Some(BakeJob {
-            progress,
-            result: receiver,
-        });
+        self.bake.job = Some(Job::start("baking the scene's transfer", move |progress| {
+            let (_, transfer, _) = bake_cache::bake_into_cache(&scene, &scene.bake, progress)?;
+            Ok(transfer)
+        }));
     }
 
-    pub(super) fn poll_bake(&mut self) {
-        let Some(job) = &self.bake.job else { return };
-        match job.result.try_recv() {
-            Ok(Ok(transfer)) => {
+    /// Takes in what the background work finished since the last frame.
+    pub(super) fn poll_jobs(&mut self) {
+        self.poll_bake();
+        self.poll_room();
+        if let Some(done) = self.jobs.proxies.as_ref().and_then(|j| j.poll()) {
+            self.jobs.proxies = None;
+            match done {
+                Ok(proxies) => self.bake.proxies = Some(Arc::new(proxies)),
+                Err(e) => self.composite_failed(&e),
+            }
+        }
+    }
+
+    fn poll_bake(&mut self) {
+        let Some(done) = self.bake.job.as_ref().and_then(|j| j.poll()) else {
+            return;
+        };
+        self.bake.job = None;
+        match done {
+            Ok(transfer) => {
                 // Drawn again from the new bake (the objects may have moved).
                 self.window.renderer = None;
                 self.settings.order = transfer.settings.order;
                 self.bake.transfer = Some(Arc::new(transfer));
-                self.bake.job = None;
                 self.stats.message = format!("baked into {}", self.bake.path.display());
             }
-            Ok(Err(e)) => {
-                self.stats.message = format!("the bake failed: {e:#}");
-                self.bake.job = None;
-            }
-            Err(_) => {}
+            Err(e) => self.stats.message = format!("the bake failed: {e:#}"),
         }
+    }
+
+    /// Whether background work runs, or is about to start for what the settings ask (the
+    /// composite's bake or picture): what a script's `wait-bake` waits for.
+    pub(super) fn busy(&self) -> bool {
+        let jobs = &self.jobs;
+        let running = self.bake.job.is_some()
+            || jobs.proxies.is_some()
+            || jobs.room.is_some()
+            || jobs.room_picture.is_some();
+        let compositing = (self.window.renderer.as_ref()).is_some_and(|r| r.is_compositing());
+        let composite_pending = self.settings.composite
+            && (self.scene.backplate.is_some() || self.room.is_some())
+            && self.bake.transfer.is_some()
+            && !compositing;
+        running || composite_pending
+    }
+
+    fn composite_failed(&mut self, e: &anyhow::Error) {
+        self.settings.composite = false;
+        self.stats.message = format!("cannot composite: {e:#}");
     }
 
     /// Shows the next frame of the sequence being played.
@@ -207,50 +230,87 @@ impl App {
         {
             return Ok(());
         }
-        let room_backplate = match self.settings.composite && !compositing {
-            true => self.room_backplate()?,
-            false => None,
-        };
-        let (Some(renderer), Some(transfer)) =
-            (self.window.renderer.as_mut(), self.bake.transfer.as_ref())
-        else {
-            return Ok(());
-        };
         let wanted =
             self.settings.composite && (self.scene.backplate.is_some() || self.room.is_some());
-        if wanted != renderer.is_compositing() {
-            if wanted {
-                let proxies = match &self.bake.proxies {
-                    Some(p) => p.clone(),
-                    None => {
-                        let p = Arc::new(report::gpu_composite::proxies_bake(
-                            &self.scene,
-                            transfer,
-                            &crate::support::TerminalObserver,
-                        )?);
-                        self.bake.proxies = Some(p.clone());
-                        p
-                    }
-                };
-                let backplate = match room_backplate {
-                    Some(photograph) => photograph,
-                    None => report::gpu_composite::live_backplate(&self.scene)?,
-                };
-                if let Err(e) =
-                    renderer.enable_composite(&self.scene.geometry, &proxies, &backplate)
-                {
-                    self.settings.composite = false;
-                    self.stats.message = format!("cannot composite: {e}");
-                }
-            } else {
+        if self.window.renderer.is_none() || self.bake.transfer.is_none() {
+            return Ok(());
+        }
+        if wanted && !compositing {
+            // The proxies' bake and the room's picture come from background work: composite
+            // once both are there.
+            let (Some(proxies), Some(backplate)) = (self.ready_proxies(), self.ready_backplate()?)
+            else {
+                return Ok(());
+            };
+            let Some(renderer) = self.window.renderer.as_mut() else {
+                return Ok(());
+            };
+            if let Err(e) = renderer.enable_composite(&self.scene.geometry, &proxies, &backplate) {
+                self.composite_failed(&e.into());
+            }
+            self.renderer_changed();
+        } else if !wanted && compositing {
+            if let Some(renderer) = self.window.renderer.as_mut() {
                 renderer.disable_composite();
             }
-            if let Some(gpu) = self.window.gpu.as_mut() {
-                gpu.renderer_changed();
+            self.renderer_changed();
+        }
+        if let Some(renderer) = self.window.renderer.as_mut() {
+            renderer.set_wireframe(self.settings.wireframe);
+        }
+        Ok(())
+    }
+
+    fn renderer_changed(&mut self) {
+        if let Some(gpu) = self.window.gpu.as_mut() {
+            gpu.renderer_changed();
+        }
+    }
+
+    /// The proxies' bake, or `None` while it is made in the background (started here).
+    fn ready_proxies(&mut self) -> Option<Arc<Transfer>> {
+        if let Some(proxies) = &self.bake.proxies {
+            return Some(Arc::clone(proxies));
+        }
+        if self.jobs.proxies.is_none()
+            && let Some(transfer) = self.bake.transfer.clone()
+        {
+            let scene = self.scene.clone();
+            self.jobs.proxies = Some(Job::start("baking the proxies alone", move |progress| {
+                let observer = JobObserver(progress);
+                Ok(report::gpu_composite::proxies_bake(
+                    &scene, &transfer, &observer,
+                )?)
+            }));
+        }
+        None
+    }
+
+    /// The composite's backplate: the scene's, or the room's picture for the view (`None`
+    /// while it is path-traced in the background, started here).
+    fn ready_backplate(&mut self) -> anyhow::Result<Option<LiveBackplate>> {
+        if self.room.is_none() {
+            return Ok(Some(report::gpu_composite::live_backplate(&self.scene)?));
+        }
+        if let Some(done) = self.jobs.room_picture.as_ref().and_then(|j| j.poll()) {
+            self.jobs.room_picture = None;
+            match done {
+                Ok(picture) => return Ok(Some(LiveBackplate::Photograph(picture))),
+                Err(e) => self.composite_failed(&e),
+            }
+            return Ok(None);
+        }
+        if self.jobs.room_picture.is_none() {
+            let camera = self.current_camera();
+            if let Some(room) = &self.room {
+                let request = room.photograph_request(camera);
+                self.jobs.room_picture = Some(Job::start(
+                    "path-tracing the empty room for the view",
+                    move |progress| request.render(&JobObserver(progress)),
+                ));
             }
         }
-        renderer.set_wireframe(self.settings.wireframe);
-        Ok(())
+        Ok(None)
     }
 
     pub(super) fn ensure_renderer(&mut self) -> anyhow::Result<()> {

@@ -7,6 +7,7 @@
 //! edits only the [`ViewSettings`].
 
 mod events;
+mod jobs;
 mod lighting;
 mod orbit;
 mod room;
@@ -28,7 +29,7 @@ use runtime::lights_indirect_default;
 use runtime::render::{Backend, RenderMode, ShadowSettings};
 use runtime::{DecomposeMode, DecomposeSettings};
 use settings::ViewSettings;
-use state::{BakeState, InputState, LightingState, ScriptState, Stats, WindowState};
+use state::{BakeState, InputState, Jobs, LightingState, ScriptState, Stats, WindowState};
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -83,6 +84,8 @@ pub struct App {
     stats: Stats,
     /// The room the model moves through, when the scene has probes.
     room: Option<room_state::RoomState>,
+    /// Background work besides the scene's bake.
+    jobs: Jobs,
     error: Option<anyhow::Error>,
 }
 
@@ -225,6 +228,7 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         script: ScriptState { commands, wait: 0 },
         stats: Stats::default(),
         room: None,
+        jobs: Jobs::default(),
         error: None,
     };
     app.load_environment();
@@ -232,8 +236,8 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         app.open_room(&map);
     }
     // A scene opened for the first time bakes at once, with its progress in the panel, into
-    // the cache the next opening reads.
-    if app.bake.transfer.is_none() {
+    // the cache the next opening reads (a room bakes its parts as it opens).
+    if app.bake.transfer.is_none() && app.jobs.room.is_none() {
         app.start_bake();
     }
     event_loop
@@ -263,7 +267,7 @@ impl App {
                     return Ok(());
                 }
                 C::WaitBake => {
-                    if self.bake.job.is_some() {
+                    if self.busy() {
                         self.script.commands.push_front(C::WaitBake);
                         return Ok(());
                     }
@@ -424,6 +428,7 @@ impl App {
         };
         PanelInfo {
             bake,
+            working: self.jobs.running(),
             has_backplate: self.scene.backplate.is_some() || self.room.is_some(),
             room: self.room.as_ref().map(|r| ui::RoomInfo {
                 probes: r.model.lighting.probes().len(),

@@ -5,25 +5,34 @@
 //! empty room's path-traced picture, seen through the scene's camera.
 
 use super::App;
+use super::jobs::{Job, JobObserver};
 use super::room_state::RoomState;
 use foundation::envmap::EnvMap;
 use glam::{Quat, Vec3};
-use runtime::render::LiveBackplate;
 use std::sync::Arc;
 
 impl App {
-    /// Opens the scene's room when it has probes; the viewer then draws the room's bakes.
+    /// Opens the scene's room when it has probes, in the background (its parts may need
+    /// baking); the viewer then draws the room's bakes.
     pub(super) fn open_room(&mut self, map: &EnvMap) {
-        if self.scene.probes.is_empty() || self.room.is_some() {
+        if self.scene.probes.is_empty() || self.room.is_some() || self.jobs.room.is_some() {
             return;
         }
+        let (scene, map) = (self.scene.clone(), map.clone());
         let rotation = self.settings.rotation_deg;
-        match RoomState::open(
-            &self.scene,
-            map,
-            rotation,
-            self.settings.decompose_settings(),
-        ) {
+        let settings = self.settings.decompose_settings();
+        self.jobs.room = Some(Job::start("opening the room", move |progress| {
+            RoomState::open(&scene, &map, rotation, settings, &JobObserver(progress))
+        }));
+    }
+
+    /// Takes in the room once it is open.
+    pub(super) fn poll_room(&mut self) {
+        let Some(done) = self.jobs.room.as_ref().and_then(|j| j.poll()) else {
+            return;
+        };
+        self.jobs.room = None;
+        match done {
             Ok(room) => {
                 self.bake.transfer = Some(Arc::new(room.model.transfer.clone()));
                 self.bake.proxies = Some(Arc::new(room.model.room_transfer.clone()));
@@ -33,15 +42,6 @@ impl App {
             }
             Err(e) => self.stats.message = format!("cannot open the room: {e:#}"),
         }
-    }
-
-    /// The room's backplate: the empty room's picture for the current view.
-    pub(super) fn room_backplate(&self) -> anyhow::Result<Option<LiveBackplate>> {
-        let Some(room) = &self.room else {
-            return Ok(None);
-        };
-        let picture = room.photograph(&self.current_camera())?;
-        Ok(Some(LiveBackplate::Photograph(picture)))
     }
 
     /// Moves the model by `offset`, live.

@@ -1,6 +1,5 @@
 //! A room's state in the viewer: the room and the model's place in it (see `room.rs`).
 
-use crate::support::TerminalObserver;
 use anyhow::Context;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
@@ -33,19 +32,15 @@ pub(super) struct RoomState {
 
 impl RoomState {
     /// The room of `scene` under `map` turned by `rotation_deg`: both parts baked (or taken
-    /// from the cache), the probes loaded, the empty room path-traced (or cached).
+    /// from the cache, telling `observer`), the probes loaded.
     pub(super) fn open(
         scene: &Scene,
         map: &EnvMap,
         rotation_deg: f32,
         settings: DecomposeSettings,
+        observer: &dyn report::Observer,
     ) -> anyhow::Result<Self> {
-        let model = RoomModel::open(
-            scene,
-            map.rotated(rotation_deg),
-            settings,
-            &TerminalObserver,
-        )?;
+        let model = RoomModel::open(scene, map.rotated(rotation_deg), settings, observer)?;
         let room = scene.of_role(ObjectRole::Proxy).without_backplate();
         let pose = (model.path.as_ref())
             .and_then(|p| p.poses().first().copied())
@@ -63,32 +58,14 @@ impl RoomState {
         })
     }
 
-    /// The empty room path-traced through `camera` (or taken from the reports' cache): the
-    /// picture the model is composited into, as a photograph of the room would be.
-    pub(super) fn photograph(&self, camera: &Camera) -> anyhow::Result<RgbImageF32> {
-        let request = ReferenceRequest {
-            spp: PHOTOGRAPH_SPP,
-            bounces: self.room.bake.bounces,
-            seed: 0,
-            sampler: reference::SamplerKind::default(),
-            target_noise: None,
-            max_seconds: None,
-            exposure: 1.0,
-        };
-        println!("path-tracing the empty room for the view (cached)");
-        let no_limit = |_: &ReferenceImages| f64::INFINITY;
-        let (map, rotation) = (&self.map, self.rotation_deg);
-        Ok(reference_images(
-            &self.room,
+    /// What the empty room's picture through `camera` needs, to be made on another thread.
+    pub(super) fn photograph_request(&self, camera: Camera) -> PictureRequest {
+        PictureRequest {
+            room: self.room.clone(),
+            map: self.map.clone(),
+            rotation_deg: self.rotation_deg,
             camera,
-            map,
-            rotation,
-            &request,
-            &no_limit,
-            &TerminalObserver,
-        )
-        .context("cannot path-trace the empty room")?
-        .radiance)
+        }
     }
 
     /// How far the model is turned from where the scene places it, in degrees (0 to 180),
@@ -113,5 +90,42 @@ impl RoomState {
             self.model.lighting.reset();
         }
         self.pose = poses[self.path_frame];
+    }
+}
+
+/// The empty room path-traced through a camera (or taken from the reports' cache): the
+/// picture the model is composited into, as a photograph of the room would be.
+pub(super) struct PictureRequest {
+    room: Scene,
+    map: EnvMap,
+    rotation_deg: f32,
+    camera: Camera,
+}
+
+impl PictureRequest {
+    pub(super) fn render(&self, observer: &dyn report::Observer) -> anyhow::Result<RgbImageF32> {
+        let request = ReferenceRequest {
+            spp: PHOTOGRAPH_SPP,
+            bounces: self.room.bake.bounces,
+            seed: 0,
+            sampler: reference::SamplerKind::default(),
+            target_noise: None,
+            max_seconds: None,
+            exposure: 1.0,
+        };
+        observer.line("path-tracing the empty room for the view (cached)");
+        let no_limit = |_: &ReferenceImages| f64::INFINITY;
+        let (map, rotation) = (&self.map, self.rotation_deg);
+        Ok(reference_images(
+            &self.room,
+            &self.camera,
+            map,
+            rotation,
+            &request,
+            &no_limit,
+            observer,
+        )
+        .context("cannot path-trace the empty room")?
+        .radiance)
     }
 }

@@ -1,11 +1,13 @@
 //! The viewer's state, one struct per concern.
 
+use super::jobs::Job;
 use super::orbit::Orbit;
+use super::room_state::RoomState;
 use super::script;
 use super::settings::ViewSettings;
 use super::window::WindowGpu;
 use crate::support::median;
-use foundation::infra::progress::SharedProgress;
+use foundation::image_io::RgbImageF32;
 use precompute::bake::Transfer;
 use report::env_sequence::Sequence;
 use runtime::render::{Backend, Renderer};
@@ -20,15 +22,33 @@ use winit::window::Window;
 pub(super) struct BakeState {
     pub(super) path: PathBuf,
     pub(super) transfer: Option<Arc<Transfer>>,
-    pub(super) job: Option<BakeJob>,
+    pub(super) job: Option<Job<Transfer>>,
     /// The bake of the proxies alone, for the live composite (made when first needed).
     pub(super) proxies: Option<Arc<Transfer>>,
 }
 
-/// A bake running in the background.
-pub(super) struct BakeJob {
-    pub(super) progress: Arc<SharedProgress>,
-    pub(super) result: std::sync::mpsc::Receiver<anyhow::Result<Transfer>>,
+/// The viewer's other background work, besides the scene's bake.
+#[derive(Default)]
+pub(super) struct Jobs {
+    /// The proxies' bake, when the live composite first needs it.
+    pub(super) proxies: Option<Job<Transfer>>,
+    /// The room: both parts baked, the probes loaded.
+    pub(super) room: Option<Job<RoomState>>,
+    /// The empty room's picture for the view, when the composite first needs it.
+    pub(super) room_picture: Option<Job<RgbImageF32>>,
+}
+
+impl Jobs {
+    /// The first job running, for the panel: what it does and its share done.
+    pub(super) fn running(&self) -> Option<(&'static str, f32)> {
+        let proxies = self
+            .proxies
+            .as_ref()
+            .map(|j| (j.what, j.progress.fraction()));
+        let room = self.room.as_ref().map(|j| (j.what, j.progress.fraction()));
+        let picture = (self.room_picture.as_ref()).map(|j| (j.what, j.progress.fraction()));
+        proxies.or(room).or(picture)
+    }
 }
 
 /// The environment map as lighting, and the settings it was last turned into lighting for.

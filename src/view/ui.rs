@@ -31,6 +31,8 @@ pub enum BakeStatus<'a> {
 /// What the panel shows of the viewer.
 pub struct PanelInfo<'a> {
     pub bake: BakeStatus<'a>,
+    /// Background work running besides the bake: what it does and its share done.
+    pub working: Option<(&'static str, f32)>,
     /// The scene composites into a backplate.
     pub has_backplate: bool,
     pub environment: Option<&'a EnvMap>,
@@ -193,6 +195,11 @@ impl Panel<'_> {
                     self.actions.push(PanelAction::StartBake);
                 }
             }
+        }
+        if let Some((what, done)) = self.info.working {
+            self.heading(ui, "Working");
+            ui.label(format!("{what}…"));
+            ui.add(egui::ProgressBar::new(done).show_percentage());
         }
     }
 

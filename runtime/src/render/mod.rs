@@ -226,8 +226,10 @@ impl Renderer {
             )
         })?;
         self.composite = Some(compositor);
-        // The shadow-map array gains the proxies' own maps.
+        // The shadow-map array gains the proxies' own maps, and the proxies' radiance is
+        // made from the lighting already set (a composite turned on after the first frame).
         self.shadow_maps.invalidate();
+        self.frame.radiance_dirty = true;
         Ok(())
     }
 
