@@ -1,7 +1,7 @@
 //! What a bake computes: SH order, rays per vertex, bounces, seed. Its own module because the
 //! scene file carries the defaults and the bake consumes them.
 
-use crate::settings::InvalidSettings;
+use crate::settings::{InvalidSettings, SettingsProblem};
 use crate::sh;
 
 /// Settings of a bake; a scene file's `[bake]` table gives the defaults.
@@ -36,19 +36,19 @@ pub const MAX_BOUNCES: u32 = 256;
 
 impl BakeSettings {
     pub fn validate(&self) -> Result<(), InvalidSettings> {
-        let invalid = |reason: String| InvalidSettings::new("bake settings", reason);
-        sh::check_order(self.order).map_err(|e| invalid(e.to_string()))?;
+        let invalid = |problem| InvalidSettings::new("bake settings", problem);
+        sh::check_order(self.order).map_err(|e| invalid(e.into()))?;
         if self.samples == 0 || self.samples > MAX_SAMPLES {
-            return Err(invalid(format!(
-                "samples must be between 1 and {MAX_SAMPLES}, got {}",
-                self.samples
-            )));
+            return Err(invalid(SettingsProblem::Samples {
+                samples: self.samples,
+                max: MAX_SAMPLES,
+            }));
         }
         if self.bounces > MAX_BOUNCES {
-            return Err(invalid(format!(
-                "bounces must be at most {MAX_BOUNCES}, got {}",
-                self.bounces
-            )));
+            return Err(invalid(SettingsProblem::Bounces {
+                bounces: self.bounces,
+                max: MAX_BOUNCES,
+            }));
         }
         Ok(())
     }

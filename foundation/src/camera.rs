@@ -1,6 +1,6 @@
 //! The pinhole camera shared by the reference renderer, the GPU renderer and the reports.
 
-use crate::settings::InvalidSettings;
+use crate::settings::{InvalidSettings, SettingsProblem};
 use glam::{Mat4, Vec3};
 
 /// A pinhole camera; pixel `(i, j)`, `j` counted from the top row, is seen through its centre.
@@ -56,44 +56,45 @@ impl Camera {
 
     /// Checks the camera can form an image; the message says what is wrong.
     pub fn validate(&self) -> Result<(), InvalidSettings> {
-        let invalid = |reason: String| Err(InvalidSettings::new("camera", reason));
-        if self.width == 0 || self.height == 0 {
-            return invalid(format!(
-                "image size {}x{} is empty",
-                self.width, self.height
-            ));
+        let invalid = |problem| Err(InvalidSettings::new("camera", problem));
+        let (width, height) = (self.width, self.height);
+        if width == 0 || height == 0 {
+            return invalid(SettingsProblem::EmptyImage { width, height });
         }
-        if self.width > MAX_IMAGE_SIDE
-            || self.height > MAX_IMAGE_SIDE
-            || self.width as u64 * self.height as u64 > MAX_IMAGE_PIXELS
+        if width > MAX_IMAGE_SIDE
+            || height > MAX_IMAGE_SIDE
+            || width as u64 * height as u64 > MAX_IMAGE_PIXELS
         {
-            return invalid(format!(
-                "image size {}x{} is over the limit ({MAX_IMAGE_SIDE} per side, \
-                 {MAX_IMAGE_PIXELS} pixels)",
-                self.width, self.height
-            ));
+            return invalid(SettingsProblem::ImageOverLimit {
+                width,
+                height,
+                max_side: MAX_IMAGE_SIDE,
+                max_pixels: MAX_IMAGE_PIXELS,
+            });
         }
         if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 179.0) {
-            return invalid(format!("fov_y_deg {} is outside (0, 179)", self.fov_y_deg));
+            return invalid(SettingsProblem::FieldOfView {
+                fov_y_deg: self.fov_y_deg,
+            });
         }
-        for (name, v) in [
+        for (field, value) in [
             ("position", self.position),
             ("target", self.target),
             ("up", self.up),
         ] {
-            if !v.is_finite() {
-                return invalid(format!("camera {name} {v} is not finite"));
+            if !value.is_finite() {
+                return invalid(SettingsProblem::CameraNotFinite { field, value });
             }
         }
         if self.up.length() < 1e-6 {
-            return invalid("camera up vector is zero".into());
+            return invalid(SettingsProblem::ZeroUp);
         }
         let forward = self.target - self.position;
         if !forward.is_finite() || forward.length() < 1e-6 {
-            return invalid("camera position and target coincide".into());
+            return invalid(SettingsProblem::TargetAtPosition);
         }
         if forward.cross(self.up).length() < 1e-6 * forward.length() * self.up.length() {
-            return invalid("camera up vector is parallel to the viewing direction".into());
+            return invalid(SettingsProblem::UpAlongView);
         }
         Ok(())
     }

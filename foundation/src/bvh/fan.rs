@@ -60,8 +60,9 @@
 //! the leaves or the boxes' rounding, and so, through the near rule, can move today's answers.
 
 use super::packet::{LANES, RayPacket};
+use super::stack::{Stack, insert_farthest_first};
 use super::wide::ChildRef;
-use super::{Hit, NoTally, SceneBvh, SegmentRay, Skip, Stack, insert_farthest_first};
+use super::{Hit, NoTally, SceneBvh, SegmentRay, Skip};
 use glam::Vec3;
 use wide::f32x8;
 

@@ -65,53 +65,9 @@ pub(crate) fn resample(
             Ok(EnvMap::new(first.width, first.height, first.pixels.clone()))
         }
         Layout::CrossHorizontal | Layout::CrossVertical => {
-            let horizontal = layout == Layout::CrossHorizontal;
-            let (cols, rows) = if horizontal { (4, 3) } else { (3, 4) };
-            let size = first.width / cols;
-            if size == 0 || first.width != cols * size || first.height != rows * size {
-                return Err(bad_shape(format!(
-                    "a {} cross must be {cols}:{rows} with square faces, this one is {}x{}",
-                    layout.name(),
-                    first.width,
-                    first.height
-                )));
-            }
-            let lookup = |w: Vec3| {
-                let (face, x, y) = CubeFace::locate_texel(w, size);
-                let ((col, row), rotated) = if horizontal {
-                    (horizontal_cross_cell(face), false)
-                } else {
-                    vertical_cross_cell(face)
-                };
-                let (x, y) = if rotated {
-                    (size - 1 - x, size - 1 - y)
-                } else {
-                    (x, y)
-                };
-                first.pixel(col * size + x, row * size + y)
-            };
-            Ok(EnvMap::from_fn(4 * size, 2 * size, SUPERSAMPLE, lookup))
+            from_cross(layout, first).map_err(bad_shape)
         }
-        Layout::Faces => {
-            let size = first.width;
-            if let Some((face, image)) = ALL_FACES
-                .iter()
-                .zip(images)
-                .find(|(_, im)| im.width != size || im.height != size)
-            {
-                return Err(bad_shape(format!(
-                    "face {} is {}x{}, but all faces must be {size}x{size}",
-                    face.tag(),
-                    image.width,
-                    image.height
-                )));
-            }
-            let lookup = |w: Vec3| {
-                let (face, x, y) = CubeFace::locate_texel(w, size);
-                images[face as usize].pixel(x, y)
-            };
-            Ok(EnvMap::from_fn(4 * size, 2 * size, SUPERSAMPLE, lookup))
-        }
+        Layout::Faces => from_faces(images).map_err(bad_shape),
         Layout::Probe => {
             if first.width != first.height {
                 return Err(bad_shape(format!(
@@ -129,6 +85,59 @@ pub(crate) fn resample(
             Ok(EnvMap::from_fn(2 * size, size, SUPERSAMPLE, lookup))
         }
     }
+}
+
+/// A horizontal or vertical cross resampled to an equirect map; the error says its shape.
+fn from_cross(layout: Layout, first: &RgbImage) -> Result<EnvMap, String> {
+    let horizontal = layout == Layout::CrossHorizontal;
+    let (cols, rows) = if horizontal { (4, 3) } else { (3, 4) };
+    let size = first.width / cols;
+    if size == 0 || first.width != cols * size || first.height != rows * size {
+        return Err(format!(
+            "a {} cross must be {cols}:{rows} with square faces, this one is {}x{}",
+            layout.name(),
+            first.width,
+            first.height
+        ));
+    }
+    let lookup = |w: Vec3| {
+        let (face, x, y) = CubeFace::locate_texel(w, size);
+        let ((col, row), rotated) = if horizontal {
+            (horizontal_cross_cell(face), false)
+        } else {
+            vertical_cross_cell(face)
+        };
+        let (x, y) = if rotated {
+            (size - 1 - x, size - 1 - y)
+        } else {
+            (x, y)
+        };
+        first.pixel(col * size + x, row * size + y)
+    };
+    Ok(EnvMap::from_fn(4 * size, 2 * size, SUPERSAMPLE, lookup))
+}
+
+/// Six face images (in `ALL_FACES` order) resampled to an equirect map; the error names the
+/// face of the wrong size.
+fn from_faces(images: &[RgbImage]) -> Result<EnvMap, String> {
+    let size = images[0].width;
+    if let Some((face, image)) = ALL_FACES
+        .iter()
+        .zip(images)
+        .find(|(_, im)| im.width != size || im.height != size)
+    {
+        return Err(format!(
+            "face {} is {}x{}, but all faces must be {size}x{size}",
+            face.tag(),
+            image.width,
+            image.height
+        ));
+    }
+    let lookup = |w: Vec3| {
+        let (face, x, y) = CubeFace::locate_texel(w, size);
+        images[face as usize].pixel(x, y)
+    };
+    Ok(EnvMap::from_fn(4 * size, 2 * size, SUPERSAMPLE, lookup))
 }
 
 /// Debevec's angular map: the image centre looks toward -Z, the rim toward +Z, and the radius

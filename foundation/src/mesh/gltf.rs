@@ -4,6 +4,7 @@
 //! says is ignored, with one note per material.
 
 use super::error::MeshError;
+use super::gltf_geometry::{assemble_triangles, check_type, with_flat_normals};
 use super::gltf_sources::Sources;
 use super::triangle_mesh::RawMesh;
 use crate::color::Rgb;
@@ -175,55 +176,7 @@ impl Loader<'_> {
                 continue;
             }
             self.check_primitive(&name, &primitive)?;
-            let reader = primitive.reader(|b| self.buffers.get(b.index()).map(|d| &d[..]));
-            let positions: Vec<Vec3> = reader
-                .read_positions()
-                .ok_or_else(|| self.invalid(format!("{name}: no POSITION attribute")))?
-                .map(Vec3::from)
-                .collect();
-            let normals: Option<Vec<Vec3>> =
-                reader.read_normals().map(|n| n.map(Vec3::from).collect());
-            let uvs: Option<Vec<Vec2>> = reader
-                .read_tex_coords(0)
-                .map(|t| t.into_f32().map(Vec2::from).collect());
-            let indices: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..positions.len() as u32).collect(),
-            };
-            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
-                return Err(self.invalid(format!(
-                    "{name}: index {bad} is past its {} vertices",
-                    positions.len()
-                )));
-            }
-            let mut triangles = assemble_triangles(primitive.mode(), &indices);
-            // A mirroring transform turns the winding around (glTF 2.0, 3.7.4).
-            let linear = Mat3::from_mat4(*world);
-            if linear.determinant() < 0.0 {
-                for t in &mut triangles {
-                    t.swap(1, 2);
-                }
-            }
-            if !linear.determinant().is_normal() {
-                return Err(self.invalid(format!("{name}: its node transform is singular")));
-            }
-            let normal_matrix = linear.inverse().transpose();
-            let mut raw = RawMesh {
-                positions: positions
-                    .iter()
-                    .map(|p| world.transform_point3(*p))
-                    .collect(),
-                normals: normals.map(|ns| {
-                    ns.iter()
-                        .map(|n| (normal_matrix * *n).normalize_or_zero())
-                        .collect()
-                }),
-                triangles,
-                uvs,
-            };
-            if raw.normals.is_none() {
-                raw = with_flat_normals(raw);
-            }
+            let raw = self.primitive_mesh(&name, &primitive, world)?;
             let material = self.material(&primitive.material())?;
             if material.texture.is_some() && raw.uvs.is_none() {
                 return Err(self.invalid(format!(
@@ -238,6 +191,65 @@ impl Loader<'_> {
             });
         }
         Ok(())
+    }
+
+    /// A triangle primitive's vertices in world space, its triangles wound as the transform
+    /// leaves them, flat normals where it has none.
+    fn primitive_mesh(
+        &self,
+        name: &str,
+        primitive: &gltf::Primitive,
+        world: &Mat4,
+    ) -> Result<RawMesh, MeshError> {
+        let reader = primitive.reader(|b| self.buffers.get(b.index()).map(|d| &d[..]));
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or_else(|| self.invalid(format!("{name}: no POSITION attribute")))?
+            .map(Vec3::from)
+            .collect();
+        let normals: Option<Vec<Vec3>> = reader.read_normals().map(|n| n.map(Vec3::from).collect());
+        let uvs: Option<Vec<Vec2>> = reader
+            .read_tex_coords(0)
+            .map(|t| t.into_f32().map(Vec2::from).collect());
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..positions.len() as u32).collect(),
+        };
+        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+            return Err(self.invalid(format!(
+                "{name}: index {bad} is past its {} vertices",
+                positions.len()
+            )));
+        }
+        let mut triangles = assemble_triangles(primitive.mode(), &indices);
+        // A mirroring transform turns the winding around (glTF 2.0, 3.7.4).
+        let linear = Mat3::from_mat4(*world);
+        if linear.determinant() < 0.0 {
+            for t in &mut triangles {
+                t.swap(1, 2);
+            }
+        }
+        if !linear.determinant().is_normal() {
+            return Err(self.invalid(format!("{name}: its node transform is singular")));
+        }
+        let normal_matrix = linear.inverse().transpose();
+        let mut raw = RawMesh {
+            positions: positions
+                .iter()
+                .map(|p| world.transform_point3(*p))
+                .collect(),
+            normals: normals.map(|ns| {
+                ns.iter()
+                    .map(|n| (normal_matrix * *n).normalize_or_zero())
+                    .collect()
+            }),
+            triangles,
+            uvs,
+        };
+        if raw.normals.is_none() {
+            raw = with_flat_normals(raw);
+        }
+        Ok(raw)
     }
 
     /// Checks every accessor of a primitive before the `gltf` crate's reader touches it.
@@ -372,77 +384,6 @@ impl Loader<'_> {
     }
 }
 
-/// The mesh with one vertex per triangle corner, each with its triangle's normal: glTF 2.0
-/// asks for flat normals where a primitive has none (3.7.2.1). Degenerate triangles get a
-/// zero normal, which the clean-up drops with the triangle.
-fn with_flat_normals(mesh: RawMesh) -> RawMesh {
-    let mut out = RawMesh {
-        normals: Some(Vec::with_capacity(3 * mesh.triangles.len())),
-        uvs: mesh.uvs.as_ref().map(|_| Vec::new()),
-        ..Default::default()
-    };
-    for tri in &mesh.triangles {
-        let [a, b, c] = tri.map(|i| mesh.positions[i as usize]);
-        let normal = (b - a).cross(c - a).normalize_or_zero();
-        let base = out.positions.len() as u32;
-        for &i in tri {
-            out.positions.push(mesh.positions[i as usize]);
-            if let (Some(all), Some(uvs)) = (&mut out.uvs, &mesh.uvs) {
-                all.push(uvs[i as usize]);
-            }
-        }
-        if let Some(normals) = &mut out.normals {
-            normals.extend([normal; 3]);
-        }
-        out.triangles.push([base, base + 1, base + 2]);
-    }
-    out
-}
-
-/// Refuses an attribute hprt reads whose type is not the one glTF gives it (the `gltf` crate's
-/// reader assumes it): positions and normals are float VEC3, texture coordinates VEC2 of float
-/// or normalised unsigned bytes or shorts.
-fn check_type(semantic: &gltf::Semantic, accessor: &gltf::Accessor) -> Result<(), String> {
-    let (data, dims) = (accessor.data_type(), accessor.dimensions());
-    let ok = match semantic {
-        gltf::Semantic::Positions | gltf::Semantic::Normals => {
-            data == DataType::F32 && dims == Dimensions::Vec3
-        }
-        gltf::Semantic::TexCoords(0) => {
-            dims == Dimensions::Vec2 && matches!(data, DataType::F32 | DataType::U8 | DataType::U16)
-        }
-        _ => true,
-    };
-    if ok {
-        Ok(())
-    } else {
-        Err(format!(
-            "its {semantic:?} (accessor {}) is {data:?} {dims:?}, not what glTF specifies",
-            accessor.index()
-        ))
-    }
-}
-
-/// Triangles of a triangle list, strip or fan.
-fn assemble_triangles(mode: Mode, indices: &[u32]) -> Vec<[u32; 3]> {
-    match mode {
-        Mode::TriangleStrip => (2..indices.len())
-            .map(|i| {
-                let (a, b, c) = (indices[i - 2], indices[i - 1], indices[i]);
-                // Every other triangle of a strip is wound the other way.
-                if i % 2 == 0 { [a, b, c] } else { [b, a, c] }
-            })
-            .collect(),
-        Mode::TriangleFan => (2..indices.len())
-            .map(|i| [indices[0], indices[i - 1], indices[i]])
-            .collect(),
-        _ => indices
-            .chunks_exact(3)
-            .map(|t| [t[0], t[1], t[2]])
-            .collect(),
-    }
-}
-
 /// Material properties that would change a render but that hprt ignores.
 fn ignored_properties(material: &gltf::Material) -> Vec<&'static str> {
     let pbr = material.pbr_metallic_roughness();
@@ -512,43 +453,4 @@ fn decode_srgb(image: &image::DynamicImage) -> Option<AlbedoTexture> {
         height,
         texels,
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn missing_normals_become_flat_per_triangle() {
-        // A roof: two triangles meeting at a right angle along the shared edge 0-1, indexed.
-        let roof = RawMesh {
-            positions: vec![
-                Vec3::ZERO,
-                Vec3::X,
-                Vec3::new(0.0, 1.0, 0.0),
-                Vec3::new(0.0, 0.0, -1.0),
-            ],
-            normals: None,
-            triangles: vec![[0, 1, 2], [0, 1, 3]],
-            uvs: Some(vec![Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE]),
-        };
-        let flat = with_flat_normals(roof);
-        assert_eq!(flat.positions.len(), 6);
-        assert_eq!(flat.triangles, vec![[0, 1, 2], [3, 4, 5]]);
-        let normals = flat.normals.unwrap();
-        assert_eq!(&normals[..3], &[Vec3::Z; 3]);
-        assert_eq!(&normals[3..], &[Vec3::Y; 3]);
-        // Each corner keeps its texture coordinates.
-        let uvs = flat.uvs.unwrap();
-        assert_eq!(uvs[4], Vec2::X);
-        assert_eq!(uvs[5], Vec2::ONE);
-    }
-
-    #[test]
-    fn strips_and_fans_become_triangles_wound_alike() {
-        let strip = assemble_triangles(Mode::TriangleStrip, &[0, 1, 2, 3]);
-        assert_eq!(strip, vec![[0, 1, 2], [2, 1, 3]]);
-        let fan = assemble_triangles(Mode::TriangleFan, &[0, 1, 2, 3]);
-        assert_eq!(fan, vec![[0, 1, 2], [0, 2, 3]]);
-    }
 }

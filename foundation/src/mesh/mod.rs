@@ -6,6 +6,7 @@ mod bpt;
 mod cleanup;
 mod error;
 mod gltf;
+mod gltf_geometry;
 mod gltf_sources;
 mod obj;
 mod ply;

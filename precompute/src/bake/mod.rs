@@ -27,7 +27,7 @@ use foundation::settings::InvalidSettings;
 use std::time::Instant;
 
 /// Why a bake stopped without a result.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BakeError {
     #[error(transparent)]
     Settings(#[from] InvalidSettings),

@@ -119,10 +119,7 @@ impl Decomposer {
             analysis_map: CubeMap::uniform(a, Rgb::ZERO),
             downsample,
             basis: foundation::sh::ShBasis::new(settings.order).map_err(|e| {
-                DecomposeError(InvalidSettings::new(
-                    "decomposition settings",
-                    e.to_string(),
-                ))
+                DecomposeError(InvalidSettings::new("decomposition settings", e.into()))
             })?,
             member_basis: MemberBasis::new(settings.order),
             detection_window: DETECTION_WINDOW.factors(settings.order),

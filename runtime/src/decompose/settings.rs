@@ -1,7 +1,7 @@
 //! What a decomposition is asked for: its mode, SH order, cube size, thresholds and caps.
 
 use super::window::Window;
-use foundation::settings::InvalidSettings;
+use foundation::settings::{InvalidSettings, SettingsProblem};
 
 foundation::named_enum! {
     /// How light power and the SH part are formed from the peaks.
@@ -19,7 +19,7 @@ foundation::named_enum! {
 }
 
 /// Settings the decomposer cannot work with.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error(transparent)]
 pub struct DecomposeError(#[from] pub InvalidSettings);
 
@@ -84,39 +84,61 @@ impl DecomposeSettings {
     }
 
     pub fn validate(&self) -> Result<(), DecomposeError> {
-        let invalid = |reason: String| {
+        let invalid = |problem| {
             Err(DecomposeError(InvalidSettings::new(
                 "decomposition settings",
-                reason,
+                problem,
             )))
         };
         if let Err(e) = foundation::sh::check_order(self.order) {
-            return invalid(e.to_string());
+            return invalid(e.into());
         }
         if !(4..=1024).contains(&self.face_size) {
-            return invalid(format!("face size {} outside 4..=1024", self.face_size));
+            return invalid(SettingsProblem::OutOfRange {
+                quantity: "face size",
+                value: self.face_size as u64,
+                min: 4,
+                max: 1024,
+            });
         }
         if self.ico_level > 7 {
-            return invalid(format!("icosahedron level {} above 7", self.ico_level));
+            return invalid(SettingsProblem::AboveMax {
+                quantity: "icosahedron level",
+                value: self.ico_level as u64,
+                max: 7,
+            });
         }
         if !(self.radius_deg > 0.0 && self.radius_deg <= 45.0) {
-            return invalid(format!("radius {}° outside (0, 45]", self.radius_deg));
+            return invalid(SettingsProblem::AngleOutOfRange {
+                quantity: "radius",
+                degrees: self.radius_deg,
+                max: 45.0,
+            });
         }
         if !(self.smoothing_deg > 0.0 && self.smoothing_deg <= 30.0) {
-            return invalid(format!("smoothing {}° outside (0, 30]", self.smoothing_deg));
+            return invalid(SettingsProblem::AngleOutOfRange {
+                quantity: "smoothing",
+                degrees: self.smoothing_deg,
+                max: 30.0,
+            });
         }
         if !(0.0..=1.0).contains(&self.threshold) {
-            return invalid(format!("threshold {} outside [0, 1]", self.threshold));
+            return invalid(SettingsProblem::NotAFraction {
+                quantity: "threshold",
+                value: self.threshold,
+            });
         }
         if self.min_contrast.is_nan() || self.min_contrast < 0.0 {
-            return invalid(format!("min contrast {} is negative", self.min_contrast));
+            return invalid(SettingsProblem::Negative {
+                quantity: "min contrast",
+                value: self.min_contrast,
+            });
         }
         if self.max_lights > MAX_CANDIDATES {
-            return invalid(format!(
-                "at most {MAX_CANDIDATES} lights can be kept (the peaks considered per frame), \
-                 {} asked",
-                self.max_lights
-            ));
+            return invalid(SettingsProblem::TooManyKeptLights {
+                asked: self.max_lights,
+                max: MAX_CANDIDATES,
+            });
         }
         Ok(())
     }

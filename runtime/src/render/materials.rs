@@ -8,7 +8,7 @@ use super::shaders::MAX_MATERIALS;
 use bytemuck::{Pod, Zeroable};
 use foundation::material::Material;
 use foundation::scene::SceneMesh;
-use foundation::settings::InvalidSettings;
+use foundation::settings::{InvalidSettings, SettingsProblem};
 use wgpu::util::DeviceExt;
 
 /// Matches `Material` in `shaders/glossy.wgsl`.
@@ -69,11 +69,10 @@ impl MaterialTable {
         if glossy.len() >= MAX_MATERIALS {
             return Err(InvalidSettings::new(
                 "materials",
-                format!(
-                    "{} distinct glossy materials, the renderer draws at most {}",
-                    glossy.len(),
-                    MAX_MATERIALS - 1
-                ),
+                SettingsProblem::TooManyGlossyMaterials {
+                    count: glossy.len(),
+                    max: MAX_MATERIALS - 1,
+                },
             ));
         }
         Ok(Self {

@@ -49,7 +49,7 @@ use foundation::envmap::EnvMap;
 use foundation::image_io::RgbImageF32;
 use foundation::material::Material;
 use foundation::scene::SceneMesh;
-use foundation::settings::InvalidSettings;
+use foundation::settings::{InvalidSettings, SettingsProblem};
 pub use gpu::{Backend, GpuContext, GpuError};
 use gpu_scene::GpuScene;
 use light_pass::{LightPass, LightPassInputs};
@@ -71,10 +71,11 @@ fn check_image_size(device: &wgpu::Device, camera: &Camera) -> Result<(), Render
     if camera.width > max || camera.height > max {
         return Err(InvalidSettings::new(
             "image size",
-            format!(
-                "{}x{} is larger than the graphics adapter allows ({max} per side)",
-                camera.width, camera.height
-            ),
+            SettingsProblem::ImageOverAdapter {
+                width: camera.width,
+                height: camera.height,
+                max_side: max,
+            },
         )
         .into());
     }
@@ -242,10 +243,10 @@ impl Renderer {
         if moved != self.scene.vertex_count {
             return Err(InvalidSettings::new(
                 "geometry",
-                format!(
-                    "the moved scene has {moved} vertices, the drawn one {}",
-                    self.scene.vertex_count
-                ),
+                SettingsProblem::VertexCount {
+                    moved,
+                    drawn: self.scene.vertex_count,
+                },
             )
             .into());
         }
@@ -335,10 +336,10 @@ impl Renderer {
         if lighting.lights.len() > MAX_LIGHTS {
             return Err(InvalidSettings::new(
                 "lighting",
-                format!(
-                    "{} lights, at most {MAX_LIGHTS} are drawn",
-                    lighting.lights.len()
-                ),
+                SettingsProblem::TooManyLights {
+                    lights: lighting.lights.len(),
+                    max: MAX_LIGHTS,
+                },
             )
             .into());
         }
@@ -362,11 +363,10 @@ impl Renderer {
         if materials.len() != self.scene.materials.table.object_entries.len() {
             return Err(InvalidSettings::new(
                 "materials",
-                format!(
-                    "{} materials for {} objects",
-                    materials.len(),
-                    self.scene.materials.table.object_entries.len()
-                ),
+                SettingsProblem::MaterialCount {
+                    materials: materials.len(),
+                    objects: self.scene.materials.table.object_entries.len(),
+                },
             )
             .into());
         }
@@ -382,7 +382,12 @@ impl Renderer {
         if !(4..=2048).contains(&face_size) {
             return Err(InvalidSettings::new(
                 "reflection maps",
-                format!("face size {face_size} outside 4..=2048"),
+                SettingsProblem::OutOfRange {
+                    quantity: "face size",
+                    value: face_size as u64,
+                    min: 4,
+                    max: 2048,
+                },
             )
             .into());
         }
@@ -421,7 +426,7 @@ impl Renderer {
             .frame
             .lighting
             .clone()
-            .ok_or_else(|| InvalidSettings::new("lighting", "no lighting set"))?;
+            .ok_or_else(|| InvalidSettings::new("lighting", SettingsProblem::NoLighting))?;
         let lights = &lighting.lights;
         let shadows = lighting.shadows && !lights.is_empty();
         let mut encoder = self.device.create_command_encoder(&Default::default());

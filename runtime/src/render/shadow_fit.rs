@@ -2,7 +2,7 @@
 //! sees of the scene (the receivers in the view frustum, plus every caster between them and the
 //! light), and the settings of the filtering. No GPU here; `shadow_maps.rs` renders the maps.
 
-use foundation::settings::InvalidSettings;
+use foundation::settings::{InvalidSettings, SettingsProblem};
 use glam::{Mat4, Vec2, Vec3};
 
 /// How shadows are filtered.
@@ -29,15 +29,19 @@ impl Default for ShadowSettings {
 
 impl ShadowSettings {
     pub fn validate(&self) -> Result<(), InvalidSettings> {
-        let invalid = |reason: String| Err(InvalidSettings::new("shadow settings", reason));
+        let invalid = |problem| Err(InvalidSettings::new("shadow settings", problem));
         if !(16..=8192).contains(&self.resolution) {
-            return invalid(format!(
-                "shadow-map resolution {} outside 16..=8192",
-                self.resolution
-            ));
+            return invalid(SettingsProblem::OutOfRange {
+                quantity: "shadow-map resolution",
+                value: self.resolution.into(),
+                min: 16,
+                max: 8192,
+            });
         }
         if self.pcf_taps == 0 || self.pcf_taps > 15 || self.pcf_taps.is_multiple_of(2) {
-            return invalid(format!("PCF taps {} must be odd, 1..=15", self.pcf_taps));
+            return invalid(SettingsProblem::PcfTaps {
+                taps: self.pcf_taps,
+            });
         }
         Ok(())
     }

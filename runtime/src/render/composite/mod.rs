@@ -32,7 +32,7 @@ use bytemuck::{Pod, Zeroable};
 use foundation::Rgb;
 use foundation::image_io::RgbImageF32;
 use foundation::scene::{ObjectRole, SceneMesh};
-use foundation::settings::InvalidSettings;
+use foundation::settings::{InvalidSettings, SettingsProblem};
 use passes::CompositePasses;
 use precompute::bake::{Transfer, TransferVectors};
 use std::ops::Range;
@@ -294,7 +294,7 @@ fn check_proxies(geometry: &SceneMesh) -> Result<(), InvalidSettings> {
     if !geometry.has_proxies() {
         return Err(InvalidSettings::new(
             "composite",
-            "the scene has no proxies",
+            SettingsProblem::NoProxies,
         ));
     }
     match geometry
@@ -304,11 +304,9 @@ fn check_proxies(geometry: &SceneMesh) -> Result<(), InvalidSettings> {
     {
         Some(o) => Err(InvalidSettings::new(
             "composite",
-            format!(
-                "proxy `{}` is glossy; the live composite draws diffuse proxies (`hprt render` \
-                 composites glossy ones)",
-                o.name
-            ),
+            SettingsProblem::GlossyProxy {
+                proxy: o.name.clone(),
+            },
         )),
         None => Ok(()),
     }
