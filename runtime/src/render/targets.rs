@@ -8,8 +8,9 @@ pub(crate) const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba1
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Depth copied into a colour target (split over two half floats, see `encode_depth` in
 /// `shaders/common.wgsl`), readable by the light pass on every backend: OpenGL can neither
-/// load from depth textures nor render to R32Float.
-pub(crate) const DEPTH_COPY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// load from depth textures nor render to R32Float. Two channels: each shadow map's copy is
+/// a third of its memory (32 maps of 2048² take 512 MiB here, half what four channels took).
+pub(crate) const DEPTH_COPY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
 
 /// The targets of one image size.
 pub(crate) struct Targets {
