@@ -5,6 +5,8 @@
 //! The checks read the sources as text with a small tokenizer (strings, characters and comments
 //! skipped), which is all these rules need.
 
+#[path = "layout/imports.rs"]
+mod imports;
 #[path = "layout/scan.rs"]
 mod scan;
 #[path = "layout/tokens.rs"]

@@ -4,12 +4,13 @@
 //! objects, over the changed region (proxy pixels the objects change by more than 2%) and over
 //! the whole frame, beside the truth's own noise there.
 
-use crate::composite_truth::{Regions, true_composite};
+use crate::composite_truth::{Regions, Truth, true_composite};
 use crate::error::{ReportError, Result};
 use crate::gpu_composite::{CompositeForm, CompositeInputs, composite_frame};
 use crate::maps::{default_exposure, load_map, scene_rotation};
+use crate::method_lighting::method_lighting;
 use crate::observer::Observer;
-use crate::per_map::{method_lighting, report_renderer, unique_map_names};
+use crate::per_map::{report_renderer, unique_map_names};
 use crate::{Method, ReportSettings};
 use foundation::Rgb;
 use foundation::color::luminance;
@@ -140,28 +141,8 @@ fn report_map(
     }
     write_exr(&dir.join("truth.exr"), &truth.image)?;
     write_png(&dir.join("truth.png"), &truth.image, exposure)?;
-    let (w, h) = (truth.image.width, truth.image.height);
-    let mask = |m: &[bool]| {
-        RgbImageF32::from_grey(
-            w,
-            h,
-            &m.iter()
-                .map(|b| f32::from(u8::from(*b)))
-                .collect::<Vec<_>>(),
-        )
-    };
-    write_exr(&dir.join("object_mask.exr"), &mask(&truth.regions.object))?;
-    write_exr(&dir.join("changed_mask.exr"), &mask(&truth.regions.changed))?;
-    let noise = region_errors(
-        &truth.halves[0].pixels,
-        &truth.halves[1].pixels,
-        &truth.regions,
-    );
-    let noise = RegionErrors {
-        object: noise.object / 2.0,
-        changed: noise.changed / 2.0,
-        frame: noise.frame / 2.0,
-    };
+    write_masks(dir, &truth)?;
+    let noise = truth_noise(&truth);
     let mut lighting = EnvironmentLighting::new(&map, DecomposeSettings::default())?;
     lighting.set_rotation(rotation);
     let mut results = Vec::new();
@@ -202,11 +183,43 @@ fn report_map(
         pixels: RegionPixels {
             object: truth.regions.object.iter().filter(|b| **b).count(),
             changed: truth.regions.changed.iter().filter(|b| **b).count(),
-            frame: w * h,
+            frame: truth.image.width * truth.image.height,
         },
         noise,
         methods: results,
     })
+}
+
+/// The truth's masks beside it: where the objects are, and where they change the backplate.
+fn write_masks(dir: &Path, truth: &Truth) -> Result<()> {
+    let (w, h) = (truth.image.width, truth.image.height);
+    let mask = |m: &[bool]| {
+        RgbImageF32::from_grey(
+            w,
+            h,
+            &m.iter()
+                .map(|b| f32::from(u8::from(*b)))
+                .collect::<Vec<_>>(),
+        )
+    };
+    write_exr(&dir.join("object_mask.exr"), &mask(&truth.regions.object))?;
+    write_exr(&dir.join("changed_mask.exr"), &mask(&truth.regions.changed))?;
+    Ok(())
+}
+
+/// The truth's own noise in each region, from its two independent halves (their error against
+/// each other, halved).
+fn truth_noise(truth: &Truth) -> RegionErrors {
+    let noise = region_errors(
+        &truth.halves[0].pixels,
+        &truth.halves[1].pixels,
+        &truth.regions,
+    );
+    RegionErrors {
+        object: noise.object / 2.0,
+        changed: noise.changed / 2.0,
+        frame: noise.frame / 2.0,
+    }
 }
 
 /// Writes the composite report of `scene` under each of `envs` into `out`.

@@ -111,15 +111,7 @@ pub fn threshold_plot(title: &str, curves: &[Curve], prt_error: f64) -> Result<S
     {
         let root = SVGBackend::with_string(&mut svg, (600, 300)).into_drawing_area();
         root.fill(&WHITE)?;
-        // Log scale: the thesis mode's errors can be ten times the others'.
-        let errors: Vec<f64> = curves
-            .iter()
-            .flat_map(|c| c.points.iter().map(|p| p.1))
-            .chain([prt_error])
-            .filter(|e| e.is_finite() && *e > 0.0)
-            .collect();
-        let high = errors.iter().copied().fold(1e-6, f64::max) * 1.6;
-        let low = errors.iter().copied().fold(high, f64::min) / 1.3;
+        let (low, high) = error_range(curves, prt_error);
         let thresholds = curves.iter().flat_map(|c| c.points.iter().map(|p| p.0));
         let last = thresholds.fold(0.0f32, f32::max).max(0.05);
         // Room on the right for the legend, clear of the curves.
@@ -186,6 +178,20 @@ pub fn threshold_plot(title: &str, curves: &[Curve], prt_error: f64) -> Result<S
         root.present()?;
     }
     Ok(svg)
+}
+
+/// The error axis of [`threshold_plot`], on a log scale (the thesis mode's errors can be ten
+/// times the others'): every finite positive error inside, with room above for the labels.
+fn error_range(curves: &[Curve], prt_error: f64) -> (f64, f64) {
+    let errors: Vec<f64> = curves
+        .iter()
+        .flat_map(|c| c.points.iter().map(|p| p.1))
+        .chain([prt_error])
+        .filter(|e| e.is_finite() && *e > 0.0)
+        .collect();
+    let high = errors.iter().copied().fold(1e-6, f64::max) * 1.6;
+    let low = errors.iter().copied().fold(high, f64::min) / 1.3;
+    (low, high)
 }
 
 /// Values over the frames of a sequence, one line per method. Returns SVG text.

@@ -83,76 +83,82 @@ fn summary_table(html: &mut String, maps: &[&MapReport]) {
         "</tr>"
     });
     for map in maps {
-        let best = |key: fn(&MethodResult) -> f64| {
-            map.methods
-                .iter()
-                .map(key)
-                .filter(|v| v.is_finite())
-                .fold(f64::INFINITY, f64::min)
+        map_rows(html, map, glossy);
+    }
+    html.push_str("</table>");
+}
+
+/// A map's rows of the summary: each method's errors, the best of each column marked, then
+/// the reference's noise floor.
+fn map_rows(html: &mut String, map: &MapReport, glossy: bool) {
+    let best = |key: fn(&MethodResult) -> f64| {
+        map.methods
+            .iter()
+            .map(key)
+            .filter(|v| v.is_finite())
+            .fold(f64::INFINITY, f64::min)
+    };
+    let best_mean = best(|m| m.stats.mean);
+    let best_shadow = best(|m| m.stats.shadow_mean);
+    let best_penumbra = best(|m| m.stats.penumbra_mean);
+    let best_rmse = best(|m| m.stats.relative_rmse);
+    let best_highlight = best(|m| m.stats.highlight_mean);
+    let cell = |value: f64, best: f64, text: String| {
+        let class = if value == best { " class=\"best\"" } else { "" };
+        format!("<td{class}>{text}</td>")
+    };
+    let ranks = ranks_by_mean(&map.methods);
+    for (k, m) in map.methods.iter().enumerate() {
+        let s = &m.stats;
+        let name = if k == 0 {
+            format!(
+                "<td class=\"name\" rowspan=\"{}\">{}</td>",
+                map.methods.len(),
+                escape(&map.name)
+            )
+        } else {
+            String::new()
         };
-        let best_mean = best(|m| m.stats.mean);
-        let best_shadow = best(|m| m.stats.shadow_mean);
-        let best_penumbra = best(|m| m.stats.penumbra_mean);
-        let best_rmse = best(|m| m.stats.relative_rmse);
-        let best_highlight = best(|m| m.stats.highlight_mean);
-        let cell = |value: f64, best: f64, text: String| {
-            let class = if value == best { " class=\"best\"" } else { "" };
-            format!("<td{class}>{text}</td>")
-        };
-        let ranks = ranks_by_mean(&map.methods);
-        for (k, m) in map.methods.iter().enumerate() {
-            let s = &m.stats;
-            let name = if k == 0 {
-                format!(
-                    "<td class=\"name\" rowspan=\"{}\">{}</td>",
-                    map.methods.len(),
-                    escape(&map.name)
+        let _ = write!(
+            html,
+            "<tr>{name}<td class=\"name\">{}</td><td>{}</td>{}{}{}{}<td>{:.4}</td><td>{}</td><td>{:.2} / {:.2}</td><td>{:.1}</td>{}</tr>",
+            escape(&m.method),
+            ranks[k],
+            cell(s.mean, best_mean, mean_std(s.mean, s.std)),
+            cell(
+                s.shadow_mean,
+                best_shadow,
+                mean_std(s.shadow_mean, s.shadow_std)
+            ),
+            cell(
+                s.penumbra_mean,
+                best_penumbra,
+                mean_std(s.penumbra_mean, s.penumbra_std)
+            ),
+            cell(
+                s.relative_rmse,
+                best_rmse,
+                format!("{:.4}", s.relative_rmse)
+            ),
+            m.relative_rmse_corrected,
+            m.lights,
+            m.decomposition_ms,
+            m.warm_decomposition_ms,
+            m.frame_ms,
+            if glossy {
+                cell(
+                    s.highlight_mean,
+                    best_highlight,
+                    mean_std(s.highlight_mean, s.highlight_std),
                 )
             } else {
                 String::new()
-            };
-            let _ = write!(
-                html,
-                "<tr>{name}<td class=\"name\">{}</td><td>{}</td>{}{}{}{}<td>{:.4}</td><td>{}</td><td>{:.2} / {:.2}</td><td>{:.1}</td>{}</tr>",
-                escape(&m.method),
-                ranks[k],
-                cell(s.mean, best_mean, mean_std(s.mean, s.std)),
-                cell(
-                    s.shadow_mean,
-                    best_shadow,
-                    mean_std(s.shadow_mean, s.shadow_std)
-                ),
-                cell(
-                    s.penumbra_mean,
-                    best_penumbra,
-                    mean_std(s.penumbra_mean, s.penumbra_std)
-                ),
-                cell(
-                    s.relative_rmse,
-                    best_rmse,
-                    format!("{:.4}", s.relative_rmse)
-                ),
-                m.relative_rmse_corrected,
-                m.lights,
-                m.decomposition_ms,
-                m.warm_decomposition_ms,
-                m.frame_ms,
-                if glossy {
-                    cell(
-                        s.highlight_mean,
-                        best_highlight,
-                        mean_std(s.highlight_mean, s.highlight_std),
-                    )
-                } else {
-                    String::new()
-                },
-            );
-        }
-        if !map.methods.is_empty() {
-            noise_row(html, map);
-        }
+            },
+        );
     }
-    html.push_str("</table>");
+    if !map.methods.is_empty() {
+        noise_row(html, map);
+    }
 }
 
 /// The row of the reference's noise floor under a map's methods.

@@ -14,6 +14,7 @@ pub mod figures;
 pub mod gpu_composite;
 mod html;
 pub mod maps;
+mod method_lighting;
 mod observer;
 pub mod output;
 pub mod path;

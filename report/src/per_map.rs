@@ -6,6 +6,7 @@
 use crate::error::{Result, error_chain};
 use crate::figures::{self, Curve};
 use crate::maps::{default_exposure, load_map, median, scene_rotation};
+use crate::method_lighting::{LightingCost, first_frame_lighting, method_lighting};
 use crate::observer::Observer;
 use crate::results::{MapReport, MapStatus, Method, MethodResult, Report, SweepPoint};
 use crate::settings::ReportSettings;
@@ -17,8 +18,8 @@ use foundation::image_io::{RgbImageF32, write_exr, write_png};
 use foundation::infra::atomic_file::write_atomic;
 use foundation::scene::Scene;
 use precompute::bake::Transfer;
-use runtime::render::{FrameLighting, GpuContext, RenderMode, Renderer, ShadowSettings};
-use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
+use runtime::render::{FrameLighting, GpuContext, Renderer, ShadowSettings};
+use runtime::{DecomposeSettings, EnvironmentLighting};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -73,61 +74,6 @@ struct MapJob<'a> {
     renderer: &'a mut Renderer,
     out: &'a Path,
     observer: &'a dyn Observer,
-}
-
-/// What making a method's lighting cost, in milliseconds.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct LightingCost {
-    /// On the map's first frame.
-    first_ms: f64,
-    /// On a later frame of a changing map.
-    warm_ms: f64,
-}
-
-/// The lighting of `method` at Weber `threshold` (each mode's own defaults otherwise), its
-/// number of lights and what the decomposition (or projection) cost: on the first frame, and
-/// done again as for the next frame of a changing map.
-pub(crate) fn method_lighting(
-    lighting: &mut EnvironmentLighting,
-    order: usize,
-    method: Method,
-    threshold: f32,
-) -> Result<(FrameLighting, usize, LightingCost)> {
-    let (frame, lights, first_ms) = first_frame_lighting(lighting, order, method, threshold)?;
-    lighting.forget_derived();
-    let (_, _, warm_ms) = first_frame_lighting(lighting, order, method, threshold)?;
-    Ok((frame, lights, LightingCost { first_ms, warm_ms }))
-}
-
-/// [`method_lighting`]'s lighting and the cost of making it from what `lighting` holds.
-fn first_frame_lighting(
-    lighting: &mut EnvironmentLighting,
-    order: usize,
-    method: Method,
-    threshold: f32,
-) -> Result<(FrameLighting, usize, f64)> {
-    let (mode, render_mode) = match method {
-        Method::Prt => (DecomposeMode::Consistent, RenderMode::Prt),
-        Method::Hybrid(mode) => (mode, RenderMode::Hybrid),
-        Method::MedianCut8 | Method::MedianCut32 | Method::ShSun => {
-            let (mode, count) = match method {
-                Method::MedianCut8 => (RenderMode::MedianCut, 8),
-                Method::MedianCut32 => (RenderMode::MedianCut, 32),
-                _ => (RenderMode::ShSun, 1),
-            };
-            lighting.set_median_cut_lights(count)?;
-            let frame = lighting.frame(mode, None);
-            let lights = frame.lighting.lights.len();
-            return Ok((frame.lighting, lights, frame.ms));
-        }
-    };
-    lighting.set_settings(DecomposeSettings {
-        threshold,
-        ..DecomposeSettings::for_mode(mode, order)
-    })?;
-    let frame = lighting.frame(render_mode, None);
-    let lights = frame.lighting.lights.len();
-    Ok((frame.lighting, lights, frame.ms))
 }
 
 /// The reference's images, written into the map's folder.

@@ -3,6 +3,11 @@
 //! stricter request continues them instead of starting over. (The path tracer itself is the
 //! `reference` crate; this module is the report's use of it.)
 
+mod request;
+
+pub(crate) use request::hash_view;
+pub use request::{NoiseTarget, ReferenceRequest};
+
 use crate::error::Result;
 use crate::observer::Observer;
 use crate::stats::{Masks, NoiseFloor, noise_floor};
@@ -16,52 +21,9 @@ use precompute::cache::{cache_dir, create_cache_folder};
 use reference::{
     self, EnvironmentLight, MAX_SOBOL_SAMPLES, ReferenceImage, ReferenceSettings, SamplerKind,
 };
+use request::reference_key;
 use std::path::PathBuf;
 use std::time::Instant;
-
-/// How quiet the reference must get: a noise floor (in the mean error's units), or a share of
-/// the best method's mean error against the reference itself (written `20%`).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub enum NoiseTarget {
-    Absolute(f64),
-    ShareOfBest(f64),
-}
-
-impl std::str::FromStr for NoiseTarget {
-    type Err = String;
-
-    fn from_str(text: &str) -> Result<Self, String> {
-        let text = text.trim();
-        let (number, share) = match text.strip_suffix('%') {
-            Some(percent) => (percent, true),
-            None => (text, false),
-        };
-        match number.trim().parse::<f64>() {
-            Ok(v) if v.is_finite() && v > 0.0 && share => Ok(Self::ShareOfBest(v / 100.0)),
-            Ok(v) if v.is_finite() && v > 0.0 => Ok(Self::Absolute(v)),
-            _ => Err(format!(
-                "expected a noise floor above 0 (0.001) or a share of the best method's error \
-                 (20%), got {text:?}"
-            )),
-        }
-    }
-}
-
-/// What the reference must reach.
-#[derive(Debug, Clone, Copy)]
-pub struct ReferenceRequest {
-    /// Samples per pixel at least, both halves together.
-    pub spp: u32,
-    pub bounces: u32,
-    pub seed: u64,
-    pub sampler: SamplerKind,
-    /// Keep doubling the samples until the noise floor (mean statistic) reaches this.
-    pub target_noise: Option<NoiseTarget>,
-    /// Stop doubling when the next pass would end later than this many seconds.
-    pub max_seconds: Option<f64>,
-    /// Tone-mapping exposure of the statistics (the floor is in their units).
-    pub exposure: f32,
-}
 
 /// The reference with its coverage, visibility and halves.
 pub struct ReferenceImages {
@@ -103,43 +65,6 @@ fn half_seed(seed: u64, k: usize) -> u64 {
     } else {
         seed ^ 0x9e37_79b9_7f4a_7c15
     }
-}
-
-/// Everything that determines the reference's samples, hashed: the cache key (the map by its
-/// content, so generated maps are cached too). The sample count is not in it: more samples
-/// continue the same sequence.
-fn reference_key(
-    scene: &Scene,
-    camera: &Camera,
-    map: &EnvMap,
-    rotation_deg: f32,
-    request: &ReferenceRequest,
-) -> Result<String> {
-    let mut hasher = blake3::Hasher::new();
-    hasher.update(b"hprt reference v4 (halves, files by sample count)");
-    hash_view(&mut hasher, scene, camera, map, rotation_deg)?;
-    hasher.update(&request.bounces.to_le_bytes());
-    hasher.update(&request.seed.to_le_bytes());
-    hasher.update(request.sampler.name().as_bytes());
-    Ok(hasher.finalize().to_hex()[..24].to_owned())
-}
-
-/// Hashes what a path trace sees: the scene's mesh (and materials), the camera, the map's
-/// texels and its rotation.
-pub(crate) fn hash_view(
-    hasher: &mut blake3::Hasher,
-    scene: &Scene,
-    camera: &Camera,
-    map: &EnvMap,
-    rotation_deg: f32,
-) -> Result<()> {
-    hasher.update(&scene.geometry.content_hash());
-    hasher.update(serde_json::to_string(camera)?.as_bytes());
-    hasher.update(&(map.width() as u64).to_le_bytes());
-    hasher.update(&(map.height() as u64).to_le_bytes());
-    hasher.update(bytemuck::cast_slice(map.texels()));
-    hasher.update(&rotation_deg.to_le_bytes());
-    Ok(())
 }
 
 #[derive(serde::Serialize, serde::Deserialize)]
@@ -360,6 +285,58 @@ fn sample_limit(sampler: SamplerKind) -> u32 {
     }
 }
 
+/// The next pass towards the noise target `wanted`: how many samples per half it ends at and
+/// its label, or none when the target is met or missed for good (warned).
+fn next_pass(
+    images: &ReferenceImages,
+    wanted: NoiseTarget,
+    request: &ReferenceRequest,
+    limit: u32,
+    start: Instant,
+    seconds_per_sample: Option<f64>,
+    best_error: &dyn Fn(&ReferenceImages) -> f64,
+) -> Option<(u32, String)> {
+    let target = match wanted {
+        NoiseTarget::Absolute(t) => t,
+        NoiseTarget::ShareOfBest(share) => share * best_error(images),
+    };
+    let floor = images.noise(request.exposure).mean;
+    let n = images.samples_per_half;
+    if floor <= target {
+        return None;
+    }
+    if n >= limit {
+        log::warn!(
+            "reference: the target noise {target:.5} was missed: the noise floor is \
+             {floor:.5} at 2 × {n} spp, the most samples the reference takes"
+        );
+        return None;
+    }
+    // Noise falls at least as 1/√n: the samples that should reach the target, at most
+    // the sampler's limit (a target far below the noise would predict ages).
+    let needed = (f64::from(n) * (floor / target).powi(2))
+        .ceil()
+        .min(f64::from(limit));
+    let next = (2 * n).min(limit);
+    if let (Some(max), Some(per_sample)) = (request.max_seconds, seconds_per_sample) {
+        let elapsed = start.elapsed().as_secs_f64();
+        if elapsed + per_sample * f64::from(next - n) > max {
+            log::warn!(
+                "reference: the target noise {target:.5} was missed: the noise floor is \
+                 {floor:.5} at 2 × {n} spp, and the next pass would end after the \
+                 {max} s limit"
+            );
+            return None;
+        }
+    }
+    let left = seconds_per_sample
+        .map(|s| format!(", about {:.0} s left", s * (needed - f64::from(n)).max(0.0)))
+        .unwrap_or_default();
+    let label =
+        format!("2 × {n} → 2 × {next} spp (noise floor {floor:.5}, target {target:.5}{left})");
+    Some((next, label))
+}
+
 /// The reference `request` asks for: from the cache, continued from it, or rendered (then
 /// cached). `best_error` gives the best method's mean error against a reference, for a
 /// target relative to it.
@@ -407,46 +384,16 @@ pub fn reference_images(
     }
     let mut images = current.expect("rendered or cached");
     if let Some(wanted) = request.target_noise {
-        loop {
-            let target = match wanted {
-                NoiseTarget::Absolute(t) => t,
-                NoiseTarget::ShareOfBest(share) => share * best_error(&images),
-            };
-            let floor = images.noise(request.exposure).mean;
+        while let Some((next, label)) = next_pass(
+            &images,
+            wanted,
+            request,
+            limit,
+            start,
+            seconds_per_sample,
+            best_error,
+        ) {
             let n = images.samples_per_half;
-            if floor <= target {
-                break;
-            }
-            if n >= limit {
-                log::warn!(
-                    "reference: the target noise {target:.5} was missed: the noise floor is \
-                     {floor:.5} at 2 × {n} spp, the most samples the reference takes"
-                );
-                break;
-            }
-            // Noise falls at least as 1/√n: the samples that should reach the target, at most
-            // the sampler's limit (a target far below the noise would predict ages).
-            let needed = (f64::from(n) * (floor / target).powi(2))
-                .ceil()
-                .min(f64::from(limit));
-            let next = (2 * n).min(limit);
-            if let (Some(max), Some(per_sample)) = (request.max_seconds, seconds_per_sample) {
-                let elapsed = start.elapsed().as_secs_f64();
-                if elapsed + per_sample * f64::from(next - n) > max {
-                    log::warn!(
-                        "reference: the target noise {target:.5} was missed: the noise floor is \
-                         {floor:.5} at 2 × {n} spp, and the next pass would end after the \
-                         {max} s limit"
-                    );
-                    break;
-                }
-            }
-            let left = seconds_per_sample
-                .map(|s| format!(", about {:.0} s left", s * (needed - f64::from(n)).max(0.0)))
-                .unwrap_or_default();
-            let label = format!(
-                "2 × {n} → 2 × {next} spp (noise floor {floor:.5}, target {target:.5}{left})"
-            );
             let (more, per_sample) = pass(Some(images), next - n, label);
             images = more;
             seconds_per_sample = Some(per_sample);

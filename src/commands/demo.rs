@@ -111,57 +111,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     write_report(&scene, &envs, &options, &args.output)?;
 
     if bundled_scenes {
-        // Glossy materials: shadowed highlights from the lights, prefiltered reflections of
-        // the rest, against the path tracer's Phong lobe.
-        println!("\nthe glossy teapot {GLOSSY_TEAPOT}:");
-        let teapot = load_scene(&bundled(GLOSSY_TEAPOT))?;
-        write_report(&teapot, &envs, &options, &args.output.join("teapot-glossy"))?;
-        println!("\nthe glossy dragon {GLOSSY_DRAGON}:");
-        let dragon = load_scene(&bundled(GLOSSY_DRAGON))?;
-        let dragon_options = ReportOptions {
-            spp: GLOSSY_DRAGON_SPP,
-            target_noise: None,
-            thresholds: vec![0.0, 0.05],
-            frames: 1,
-            ..options.clone()
-        };
-        write_report(
-            &dragon,
-            &[bundled(GLOSSY_DRAGON_MAP)],
-            &dragon_options,
-            &args.output.join("dragon-glossy"),
-        )?;
-    }
-
-    if bundled_scenes {
-        println!("\nthe composite {COMPOSITE}:");
-        let composite = load_scene(&bundled(COMPOSITE))?;
-        let composite_options = ReportOptions {
-            spp: COMPOSITE_SPP,
-            target_noise: None,
-            thresholds: Vec::new(),
-            frames: 1,
-            ..options.clone()
-        };
-        let maps = COMPOSITE_MAPS.map(bundled);
-        write_report(
-            &composite,
-            &maps,
-            &composite_options,
-            &args.output.join("composite"),
-        )?;
-        println!("\nthe composite into a photograph {PHOTO_COMPOSITE}:");
-        let photo = load_scene(&bundled(PHOTO_COMPOSITE))?;
-        let city = bundled(COMPOSITE_MAPS[1]);
-        write_report(
-            &photo,
-            &[city],
-            &composite_options,
-            &args.output.join("composite-photo"),
-        )?;
-    }
-
-    if bundled_scenes {
+        demo_glossy(&args.output, &envs, &options)?;
+        demo_composite(&args.output, &options)?;
         demo_capture(&args.output.join("capture"), &scene, &options)?;
         demo_room(&args.output.join("room"), &options)?;
     }
@@ -183,6 +134,60 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         &sample_options,
         &args.output.join("crate"),
     )
+}
+
+/// Glossy materials: shadowed highlights from the lights, prefiltered reflections of the
+/// rest, against the path tracer's Phong lobe; the teapot under `envs`, the dragon under one.
+fn demo_glossy(output: &Path, envs: &[PathBuf], options: &ReportOptions) -> anyhow::Result<()> {
+    println!("\nthe glossy teapot {GLOSSY_TEAPOT}:");
+    let teapot = load_scene(&bundled(GLOSSY_TEAPOT))?;
+    write_report(&teapot, envs, options, &output.join("teapot-glossy"))?;
+    println!("\nthe glossy dragon {GLOSSY_DRAGON}:");
+    let dragon = load_scene(&bundled(GLOSSY_DRAGON))?;
+    let dragon_options = ReportOptions {
+        spp: GLOSSY_DRAGON_SPP,
+        target_noise: None,
+        thresholds: vec![0.0, 0.05],
+        frames: 1,
+        ..options.clone()
+    };
+    write_report(
+        &dragon,
+        &[bundled(GLOSSY_DRAGON_MAP)],
+        &dragon_options,
+        &output.join("dragon-glossy"),
+    )?;
+    Ok(())
+}
+
+/// The teapot composited into three maps, and into a photograph taken through its camera.
+fn demo_composite(output: &Path, options: &ReportOptions) -> anyhow::Result<()> {
+    println!("\nthe composite {COMPOSITE}:");
+    let composite = load_scene(&bundled(COMPOSITE))?;
+    let composite_options = ReportOptions {
+        spp: COMPOSITE_SPP,
+        target_noise: None,
+        thresholds: Vec::new(),
+        frames: 1,
+        ..options.clone()
+    };
+    let maps = COMPOSITE_MAPS.map(bundled);
+    write_report(
+        &composite,
+        &maps,
+        &composite_options,
+        &output.join("composite"),
+    )?;
+    println!("\nthe composite into a photograph {PHOTO_COMPOSITE}:");
+    let photo = load_scene(&bundled(PHOTO_COMPOSITE))?;
+    let city = bundled(COMPOSITE_MAPS[1]);
+    write_report(
+        &photo,
+        &[city],
+        &composite_options,
+        &output.join("composite-photo"),
+    )?;
+    Ok(())
 }
 
 /// The teapot carried along the bundled room's path, lit by its probes (`hprt report --path`).

@@ -118,22 +118,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let settings = args
         .decompose
         .settings(args.decompose_mode, transfer.settings.order);
-    let mut lighting = match &args.env_sequence {
-        Some(path) => {
-            let sequence = Sequence::load(path)?;
-            lighting_at_frame(&sequence, settings, rotation_deg, args.frame)?
-        }
-        None => {
-            let env = args.environment.choose(&scene)?;
-            let mut lighting = EnvironmentLighting::new(&env.loaded.map, settings)?;
-            lighting.set_rotation(rotation_deg);
-            lighting
-        }
-    };
-    lighting.set_median_cut_lights(args.render.lights)?;
-    if scene.geometry.is_glossy() {
-        lighting.enable_reflections(Some(runtime::render::DEFAULT_REFLECTION_SIZE));
-    }
+    let mut lighting = environment_lighting(&args, &scene, settings, rotation_deg)?;
     let frame = lighting.frame(args.render.mode, args.render.lights_indirect());
     let gpu = GpuContext::headless(args.render.backend)?;
     println!("adapter: {}", gpu.description());
@@ -146,18 +131,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         (lighting.map(), rotation_deg),
         &frame.lighting,
     )?;
-    // The renderer's target is half float: radiance above its largest value is clipped.
-    let clipped = image
-        .pixels
-        .iter()
-        .filter(|p| p.max_element() >= 65504.0)
-        .count();
-    if clipped > 0 && args.exr.is_some() {
-        log::warn!(
-            "{clipped} pixel(s) reached 65504, the largest value of the renderer's half-float \
-             target: the EXR holds them clipped"
-        );
-    }
+    warn_if_clipped(&args, &image);
     let exposure = args
         .exposure
         .unwrap_or_else(|| default_exposure(lighting.map()));
@@ -176,6 +150,49 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// The lighting the image is drawn under: the sequence's frame or the chosen map, turned by
+/// `rotation_deg`, with the render options' lights and, for glossy objects, reflections.
+fn environment_lighting(
+    args: &RenderArgs,
+    scene: &foundation::scene::Scene,
+    settings: runtime::DecomposeSettings,
+    rotation_deg: f32,
+) -> anyhow::Result<EnvironmentLighting> {
+    let mut lighting = match &args.env_sequence {
+        Some(path) => {
+            let sequence = Sequence::load(path)?;
+            lighting_at_frame(&sequence, settings, rotation_deg, args.frame)?
+        }
+        None => {
+            let env = args.environment.choose(scene)?;
+            let mut lighting = EnvironmentLighting::new(&env.loaded.map, settings)?;
+            lighting.set_rotation(rotation_deg);
+            lighting
+        }
+    };
+    lighting.set_median_cut_lights(args.render.lights)?;
+    if scene.geometry.is_glossy() {
+        lighting.enable_reflections(Some(runtime::render::DEFAULT_REFLECTION_SIZE));
+    }
+    Ok(lighting)
+}
+
+/// Warns when `--exr` will hold pixels clipped at the half-float target's largest value.
+fn warn_if_clipped(args: &RenderArgs, image: &RgbImageF32) {
+    // The renderer's target is half float: radiance above its largest value is clipped.
+    let clipped = image
+        .pixels
+        .iter()
+        .filter(|p| p.max_element() >= 65504.0)
+        .count();
+    if clipped > 0 && args.exr.is_some() {
+        log::warn!(
+            "{clipped} pixel(s) reached 65504, the largest value of the renderer's half-float \
+             target: the EXR holds them clipped"
+        );
+    }
 }
 
 /// The files `--layers DIR` will write (none without it); refused for a scene that does not

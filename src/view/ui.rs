@@ -2,15 +2,15 @@
 //! state in a [`PanelState`], reads the rest of the viewer through a [`PanelInfo`], and
 //! returns what the user asked for as [`PanelAction`]s.
 
+mod environment;
+mod placement;
+
 use super::settings::ViewSettings;
-use foundation::envmap::{EnvMap, direction_of_uv, rotate_y, uv_of_direction};
-use foundation::image_io::{srgb_encode, tonemap};
+use foundation::envmap::EnvMap;
 use precompute::bake::BakeSettings;
 use runtime::render::RenderMode;
 use runtime::{DecomposeMode, Decomposition, TrackedLight};
 use std::path::{Path, PathBuf};
-
-const THUMBNAIL: [usize; 2] = [256, 128];
 
 /// Degrees a press of Q or E, or of the panel's buttons, turns a room's model.
 pub const MODEL_TURN_DEG: f32 = 15.0;
@@ -203,97 +203,6 @@ impl Panel<'_> {
         }
     }
 
-    fn environment_section(&mut self, ui: &mut egui::Ui) {
-        self.heading(ui, "Environment");
-        let file_name = |p: &Path| {
-            p.file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default()
-        };
-        let mut chosen = None;
-        egui::ComboBox::from_label("map")
-            .selected_text(file_name(&self.settings.env))
-            .show_ui(ui, |ui| {
-                for choice in self.info.env_choices {
-                    if ui
-                        .selectable_label(*choice == self.settings.env, file_name(choice))
-                        .clicked()
-                    {
-                        chosen = Some(choice.clone());
-                    }
-                }
-            });
-        ui.horizontal(|ui| {
-            ui.text_edit_singleline(&mut self.state.env_path_text);
-            if ui.button("Load").clicked() {
-                chosen = Some(self.state.env_path_text.clone().into());
-            }
-        });
-        if let Some(path) = chosen {
-            self.state.env_path_text = path.display().to_string();
-            self.actions.push(PanelAction::LoadEnvironment(path));
-        }
-        ui.add(
-            egui::Slider::new(&mut self.settings.rotation_deg, -180.0..=180.0).text("rotation °"),
-        );
-        ui.horizontal(|ui| {
-            ui.checkbox(&mut self.settings.animate, "animate");
-            ui.add(egui::Slider::new(&mut self.settings.animate_speed, 1.0..=90.0).text("°/s"));
-        });
-        self.thumbnail(ui);
-    }
-
-    /// The map as the scene sees it (rotated), with the lights marked.
-    fn thumbnail(&mut self, ui: &mut egui::Ui) {
-        let Some(map) = self.info.environment else {
-            return;
-        };
-        let key = (
-            self.settings.env.clone(),
-            (self.settings.rotation_deg * 2.0).round() as i32,
-        );
-        if self.state.thumbnail_for.as_ref() != Some(&key) {
-            let image = thumbnail_image(
-                map,
-                self.settings.rotation_deg.to_radians(),
-                self.settings.exposure,
-            );
-            match &mut self.state.thumbnail {
-                Some(handle) => handle.set(image, egui::TextureOptions::NEAREST),
-                None => {
-                    self.state.thumbnail = Some(ui.ctx().load_texture(
-                        "environment",
-                        image,
-                        egui::TextureOptions::NEAREST,
-                    ))
-                }
-            }
-            self.state.thumbnail_for = Some(key);
-        }
-        let Some(texture) = &self.state.thumbnail else {
-            return;
-        };
-        let width = ui.available_width().min(280.0);
-        let size = egui::vec2(width, width / 2.0);
-        let rect = ui.add(egui::Image::new((texture.id(), size))).rect;
-        let painter = ui.painter_at(rect);
-        let Some(decomposition) = self.info.decomposition else {
-            return;
-        };
-        let colours = [
-            egui::Color32::RED,
-            egui::Color32::GREEN,
-            egui::Color32::LIGHT_BLUE,
-            egui::Color32::YELLOW,
-        ];
-        for (k, light) in decomposition.lights.iter().enumerate() {
-            let (u, v) = uv_of_direction(light.direction);
-            let centre = rect.min + egui::vec2(u * rect.width(), v * rect.height());
-            let radius = (light.cap_radius / std::f32::consts::PI * rect.height()).max(3.0);
-            painter.circle_stroke(centre, radius, egui::Stroke::new(1.5, colours[k % 4]));
-        }
-    }
-
     fn decomposition_section(&mut self, ui: &mut egui::Ui) {
         self.heading(ui, "Decomposition");
         let mut mode = self.settings.decompose_mode;
@@ -409,97 +318,6 @@ impl Panel<'_> {
         }
     }
 
-    /// The room: where the model is, the path, and what each update of its lighting costs.
-    fn room_section(&mut self, ui: &mut egui::Ui) {
-        let Some(room) = &self.info.room else { return };
-        self.heading(ui, "Room");
-        let c = room.centre;
-        ui.label(format!(
-            "{} probes; the model at ({:.2}, {:.2}, {:.2}), turned {:.0}°",
-            room.probes, c.x, c.y, c.z, room.turn_deg
-        ));
-        let soft = format!(
-            "its soft shadow and bounce on the room ({:.2} ms)",
-            room.shadow_ms
-        );
-        ui.checkbox(&mut self.settings.soft_shadow, soft)
-            .on_hover_text(
-                "The model's occlusion of the room's SH light and the light it bounces onto \
-                 the room, traced from the room's vertices at each position (the lights' \
-                 shadows come from their shadow maps)",
-            );
-        ui.horizontal(|ui| {
-            ui.label("turn the model");
-            for degrees in [-MODEL_TURN_DEG, MODEL_TURN_DEG] {
-                if (ui.button(format!("{degrees:+.0}°")))
-                    .on_hover_text("About the vertical through its centre; its bake turns with it")
-                    .clicked()
-                {
-                    self.actions.push(PanelAction::TurnModel(degrees));
-                }
-            }
-        });
-        if let Some((frame, frames)) = room.path {
-            ui.checkbox(&mut self.settings.play_path, "play the path")
-                .on_hover_text("The scene's [path], one frame per drawn frame, looping");
-            ui.label(format!("path frame {frame} of {frames}"));
-        }
-        if let Some(last) = room.last {
-            ui.label(format!(
-                "local map {:.2} ms + decomposition {:.2} ms = {:.2} ms per update",
-                last.fuse_ms,
-                last.decompose_ms,
-                last.fuse_ms + last.decompose_ms
-            ))
-            .on_hover_text(
-                "The local map fused from the probes at the model's centre, then decomposed \
-                 with its lights followed (CONVENTIONS.md, \"Light probes\")",
-            );
-            ui.label(format!(
-                "{} lights; {:.1}% of texels seen by no probe",
-                last.lighting.lights.len(),
-                100.0 * last.stats.unseen as f64 / room.texels.max(1) as f64
-            ));
-        }
-        ui.label("arrow keys move the model (Page Up/Down: up and down), Q and E turn it");
-        ui.label(
-            "the empty room's picture is path-traced for the view as the composite turns on: \
-             turn it off and on after moving the camera",
-        );
-    }
-
-    fn composite_section(&mut self, ui: &mut egui::Ui) {
-        self.heading(ui, "Composite");
-        ui.checkbox(&mut self.settings.composite, "into the backplate")
-            .on_hover_text(
-                "The objects, and the change they make to the proxies, over the backplate \
-                 (off: the whole scene, proxies drawn)",
-            );
-        ui.add_enabled(
-            self.settings.composite,
-            egui::Checkbox::new(&mut self.settings.wireframe, "proxy wireframe"),
-        )
-        .on_hover_text("The proxies' edges, to line them up with the picture");
-        ui.horizontal(|ui| {
-            ui.label("move the objects");
-            let step = 0.25;
-            for (label, offset) in [
-                ("-x", glam::Vec3::new(-step, 0.0, 0.0)),
-                ("+x", glam::Vec3::new(step, 0.0, 0.0)),
-                ("-z", glam::Vec3::new(0.0, 0.0, -step)),
-                ("+z", glam::Vec3::new(0.0, 0.0, step)),
-            ] {
-                if ui
-                    .button(label)
-                    .on_hover_text("Moves the virtual objects over the proxies; re-bakes")
-                    .clicked()
-                {
-                    self.actions.push(PanelAction::MoveObjects(offset));
-                }
-            }
-        });
-    }
-
     fn lights_section(&mut self, ui: &mut egui::Ui) {
         self.heading(ui, "Lights");
         if let Some(ms) = self.info.frame_ms {
@@ -564,20 +382,4 @@ impl Panel<'_> {
             println!("{line}");
         }
     }
-}
-
-/// The map as the scene sees it, turned by `rotation` radians and tone-mapped.
-fn thumbnail_image(map: &EnvMap, rotation: f32, exposure: f32) -> egui::ColorImage {
-    let mut rgb = Vec::with_capacity(THUMBNAIL[0] * THUMBNAIL[1] * 3);
-    for j in 0..THUMBNAIL[1] {
-        for i in 0..THUMBNAIL[0] {
-            let w = direction_of_uv(
-                (i as f32 + 0.5) / THUMBNAIL[0] as f32,
-                (j as f32 + 0.5) / THUMBNAIL[1] as f32,
-            );
-            let c = tonemap(map.radiance(rotate_y(w, -rotation)), exposure);
-            rgb.extend(c.to_array().map(|x| (srgb_encode(x) * 255.0) as u8));
-        }
-    }
-    egui::ColorImage::from_rgb(THUMBNAIL, &rgb)
 }

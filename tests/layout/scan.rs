@@ -2,6 +2,7 @@
 //! between files (through `use` and `crate::`/`super::` paths, following re-exports to the file
 //! that defines an item).
 
+use super::imports::{PathRef, absolute, strongly_connected, use_tree};
 use super::tokens::{Tok, Token, is_ident, is_punct, matching, tokens};
 use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
@@ -136,56 +137,6 @@ pub fn prints_outside_tests(toks: &[Token]) -> Vec<usize> {
         .filter(|&i| !tests.iter().any(|&(s, e)| s <= i && i <= e))
         .map(|i| toks[i].line)
         .collect()
-}
-
-/// One path a file refers to, split into segments, and whether it is a re-export.
-struct PathRef {
-    segments: Vec<String>,
-    reexport: bool,
-}
-
-/// Expands a `use` tree starting at `i` (after `use`) into full paths; returns them and the
-/// index of the ending `;`.
-fn use_tree(toks: &[Token], mut i: usize, prefix: &[String], out: &mut Vec<Vec<String>>) -> usize {
-    let mut path = prefix.to_vec();
-    loop {
-        match &toks[i].tok {
-            Tok::Ident(s) if s == "as" => {
-                i += 2; // the alias names the same item
-            }
-            Tok::Ident(s) => {
-                path.push(s.clone());
-                i += 1;
-            }
-            Tok::PathSep => i += 1,
-            Tok::Punct('*') => {
-                path.push("*".into());
-                i += 1;
-            }
-            Tok::Punct('{') => {
-                i += 1;
-                loop {
-                    if is_punct(&toks[i], '}') {
-                        break;
-                    }
-                    i = use_tree(toks, i, &path, out);
-                    if is_punct(&toks[i], ',') {
-                        i += 1;
-                    }
-                }
-                return i + 1;
-            }
-            _ => {
-                if path.len() > prefix.len() {
-                    if path.last().is_some_and(|s| s == "self") {
-                        path.pop();
-                    }
-                    out.push(path);
-                }
-                return i;
-            }
-        }
-    }
 }
 
 /// The paths a file refers to outside its test code: `use` trees, and paths in code that
@@ -369,34 +320,6 @@ impl SourceTree {
     }
 }
 
-/// `segments` (as written in module `module`) as a path from the crate root; `None` for paths
-/// into other crates.
-fn absolute(
-    module: &[String],
-    segments: &[String],
-    children: &BTreeSet<String>,
-) -> Option<Vec<String>> {
-    let mut base: Vec<String> = module.to_vec();
-    let mut rest = segments;
-    match segments.first().map(String::as_str) {
-        Some("crate") => {
-            base.clear();
-            rest = &segments[1..];
-        }
-        Some("self") => rest = &segments[1..],
-        Some("super") => {
-            while rest.first().is_some_and(|s| s == "super") {
-                base.pop()?;
-                rest = &rest[1..];
-            }
-        }
-        Some(first) if children.contains(first) => {}
-        _ => return None,
-    }
-    base.extend(rest.iter().filter(|s| *s != "*").cloned());
-    Some(base)
-}
-
 fn rust_files(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -466,61 +389,4 @@ fn collect_module(
             );
         }
     }
-}
-
-/// Tarjan's strongly connected components.
-fn strongly_connected(n: usize, edges: &[BTreeSet<usize>]) -> Vec<Vec<usize>> {
-    struct State<'a> {
-        edges: &'a [BTreeSet<usize>],
-        index: Vec<Option<usize>>,
-        low: Vec<usize>,
-        on_stack: Vec<bool>,
-        stack: Vec<usize>,
-        next: usize,
-        out: Vec<Vec<usize>>,
-    }
-    fn visit(s: &mut State, v: usize) {
-        s.index[v] = Some(s.next);
-        s.low[v] = s.next;
-        s.next += 1;
-        s.stack.push(v);
-        s.on_stack[v] = true;
-        for &w in s.edges[v].clone().iter() {
-            match s.index[w] {
-                None => {
-                    visit(s, w);
-                    s.low[v] = s.low[v].min(s.low[w]);
-                }
-                Some(iw) if s.on_stack[w] => s.low[v] = s.low[v].min(iw),
-                _ => {}
-            }
-        }
-        if Some(s.low[v]) == s.index[v] {
-            let mut comp = Vec::new();
-            while let Some(w) = s.stack.pop() {
-                s.on_stack[w] = false;
-                comp.push(w);
-                if w == v {
-                    break;
-                }
-            }
-            comp.sort();
-            s.out.push(comp);
-        }
-    }
-    let mut s = State {
-        edges,
-        index: vec![None; n],
-        low: vec![0; n],
-        on_stack: vec![false; n],
-        stack: Vec::new(),
-        next: 0,
-        out: Vec::new(),
-    };
-    for v in 0..n {
-        if s.index[v].is_none() {
-            visit(&mut s, v);
-        }
-    }
-    s.out
 }

@@ -66,7 +66,42 @@ pub(super) fn bench_capture(args: BenchCaptureArgs) -> anyhow::Result<()> {
             args.times
         );
     }
-    let plan = CapturePlan {
+    let plan = capture_plan(&args, (w, h));
+    let start = Instant::now();
+    let description = write_capture(&map, &plan, &dir)
+        .with_context(|| format!("cannot write photographs into {}", dir.display()))?;
+    let shots = (plan.orientations.len() + plan.ball_yaws.len()) * plan.times.len();
+    println!(
+        "{shots} photographs of {w}x{h} ({:.1} megapixels) written in {:.1} s",
+        (w * h) as f64 / 1e6,
+        start.elapsed().as_secs_f64()
+    );
+    let output = dir.join("captured.exr");
+    let run: Run = run_hprt(&[
+        "capture".into(),
+        description.display().to_string(),
+        "-o".into(),
+        output.display().to_string(),
+        "--width".into(),
+        args.width.to_string(),
+    ])?;
+    println!(
+        "hprt capture: {:.1} s, peak memory {:.0} MiB",
+        run.seconds, run.peak_mib
+    );
+    let captured = foundation::envmap::load(&output, None)?.map;
+    println!(
+        "median log-radiance error against the map photographed (after one white-balance scale \
+         per channel): {:.1}%",
+        100.0 * median_log_error(&map, &captured)
+    );
+    Ok(())
+}
+
+/// The photographs the benchmark takes: shots or a ball at `(w, h)`, the given exposure times,
+/// through [`RESPONSE`].
+fn capture_plan(args: &BenchCaptureArgs, (w, h): (usize, usize)) -> CapturePlan {
+    CapturePlan {
         size: (w, h),
         orientations: if args.ball {
             Vec::new()
@@ -103,36 +138,7 @@ pub(super) fn bench_capture(args: BenchCaptureArgs) -> anyhow::Result<()> {
                 .map(|k| format!(" --keep {}", k.display()))
                 .unwrap_or_default(),
         ),
-    };
-    let start = Instant::now();
-    let description = write_capture(&map, &plan, &dir)
-        .with_context(|| format!("cannot write photographs into {}", dir.display()))?;
-    let shots = (plan.orientations.len() + plan.ball_yaws.len()) * plan.times.len();
-    println!(
-        "{shots} photographs of {w}x{h} ({:.1} megapixels) written in {:.1} s",
-        (w * h) as f64 / 1e6,
-        start.elapsed().as_secs_f64()
-    );
-    let output = dir.join("captured.exr");
-    let run: Run = run_hprt(&[
-        "capture".into(),
-        description.display().to_string(),
-        "-o".into(),
-        output.display().to_string(),
-        "--width".into(),
-        args.width.to_string(),
-    ])?;
-    println!(
-        "hprt capture: {:.1} s, peak memory {:.0} MiB",
-        run.seconds, run.peak_mib
-    );
-    let captured = foundation::envmap::load(&output, None)?.map;
-    println!(
-        "median log-radiance error against the map photographed (after one white-balance scale \
-         per channel): {:.1}%",
-        100.0 * median_log_error(&map, &captured)
-    );
-    Ok(())
+    }
 }
 
 /// `--keep`'s folder, made, or the temporary one.

@@ -76,6 +76,20 @@ pub(super) fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
     if args.no_mitsuba {
         return Ok(());
     }
+    let last = runs.last().expect("at least one run");
+    compare_with_mitsuba(&args, &scene, &env, camera, seconds, last)
+}
+
+/// Renders the same image with Mitsuba 3, when it is found, and prints its time and mean
+/// radiance beside hprt's (`seconds`, `last`).
+fn compare_with_mitsuba(
+    args: &BenchReferenceArgs,
+    scene: &foundation::scene::Scene,
+    env: &maps::ChosenEnvironment,
+    camera: foundation::camera::Camera,
+    seconds: f64,
+    last: &reference::ReferenceImage,
+) -> anyhow::Result<()> {
     let Some(mitsuba) = crate::commands::mitsuba::Mitsuba::find() else {
         println!(
             "Mitsuba 3 not found (pip install mitsuba, or set HPRT_MITSUBA_PYTHON): no comparison"
@@ -99,7 +113,6 @@ pub(super) fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
     anyhow::ensure!(times.len() >= 2, "Mitsuba reported no timings");
     // The first render compiles the LLVM variant's kernels; the rest are steady state.
     let steady = median(times[1..].to_vec());
-    let last = runs.last().expect("at least one run");
     let difference =
         crate::commands::mitsuba::covered_mean_difference(&last.radiance, &image, &last.coverage);
     println!(

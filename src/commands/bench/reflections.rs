@@ -6,7 +6,8 @@ use clap::Args;
 use foundation::bvh::SceneBvh;
 use foundation::infra::progress::NoProgress;
 use precompute::bake::{self, BakeSettings};
-use runtime::render::ShadowSettings;
+use runtime::render::{Renderer, ShadowSettings};
+use runtime::{FrameLighting, ReflectedEnvironment, SharedCube};
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -28,9 +29,8 @@ pub struct BenchReflectionsArgs {
 }
 
 pub(super) fn bench_reflections(args: BenchReflectionsArgs) -> anyhow::Result<()> {
-    use runtime::render::{GpuContext, RenderMode, Renderer};
+    use runtime::render::{GpuContext, RenderMode};
     use runtime::{DecomposeSettings, EnvironmentLighting};
-    use runtime::{ReflectedEnvironment, SharedCube};
     let scene = load_scene(&args.scene)?;
     anyhow::ensure!(
         scene.geometry.is_glossy(),
@@ -67,26 +67,7 @@ pub(super) fn bench_reflections(args: BenchReflectionsArgs) -> anyhow::Result<()
         let start = std::time::Instant::now();
         let frame = lighting.frame(RenderMode::Hybrid, None).lighting;
         let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
-        let ReflectedEnvironment::Remainder { cube, orientation } = &frame.reflections else {
-            anyhow::bail!("the hybrid frame carries no remainder");
-        };
-        let mut times = Vec::new();
-        for k in 0..=args.repeat {
-            // A new remainder (same content) each time: the maps are prefiltered again.
-            let mut changed = frame.clone();
-            changed.reflections = ReflectedEnvironment::Remainder {
-                cube: SharedCube(std::sync::Arc::new((*cube.0).clone())),
-                orientation: *orientation,
-            };
-            renderer.set_lighting(&changed)?;
-            renderer.wait();
-            let start = std::time::Instant::now();
-            renderer.update_reflections()?;
-            renderer.wait();
-            if k > 0 {
-                times.push(start.elapsed().as_secs_f64() * 1e3);
-            }
-        }
+        let times = time_prefilter(&mut renderer, &frame, args.repeat)?;
         let shininess: Vec<String> = scene
             .geometry
             .objects
@@ -108,4 +89,34 @@ pub(super) fn bench_reflections(args: BenchReflectionsArgs) -> anyhow::Result<()
          clipped in the lights' caps (the first frame; later changes reuse the resampled map)."
     );
     Ok(())
+}
+
+/// Milliseconds of each of `repeat` prefilterings of `frame`'s remainder (after one warm-up),
+/// each of a new copy so the maps are prefiltered again.
+fn time_prefilter(
+    renderer: &mut Renderer,
+    frame: &FrameLighting,
+    repeat: usize,
+) -> anyhow::Result<Vec<f64>> {
+    let ReflectedEnvironment::Remainder { cube, orientation } = &frame.reflections else {
+        anyhow::bail!("the hybrid frame carries no remainder");
+    };
+    let mut times = Vec::new();
+    for k in 0..=repeat {
+        // A new remainder (same content) each time: the maps are prefiltered again.
+        let mut changed = frame.clone();
+        changed.reflections = ReflectedEnvironment::Remainder {
+            cube: SharedCube(std::sync::Arc::new((*cube.0).clone())),
+            orientation: *orientation,
+        };
+        renderer.set_lighting(&changed)?;
+        renderer.wait();
+        let start = std::time::Instant::now();
+        renderer.update_reflections()?;
+        renderer.wait();
+        if k > 0 {
+            times.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    Ok(times)
 }

@@ -142,51 +142,63 @@ pub(super) fn bench_shards(args: BenchShardsArgs) -> anyhow::Result<()> {
         "max MiB / one"
     );
     for &count in &args.counts {
-        let shards = path(&format!("shards-{count}"));
-        let mut runs = Vec::new();
-        for i in 0..count {
-            let shard = format!("{i}/{count}");
-            runs.push(run_hprt(&bake(&[
-                "--shard".into(),
-                shard,
-                "-o".into(),
-                shards.clone(),
-            ]))?);
-        }
-        let merged = path(&format!("merged-{count}.bake"));
-        let merge = run_hprt(&[
-            "bake".into(),
-            "merge".into(),
-            shards.clone(),
-            "-o".into(),
-            merged.clone(),
-        ])?;
-        anyhow::ensure!(
-            std::fs::read(&merged)? == std::fs::read(path("whole.bake"))?,
-            "the merge of {count} shards differs from the one-machine bake"
-        );
-        let range = |f: fn(&Run) -> f64| {
-            let values: Vec<f64> = runs.iter().map(f).collect();
-            let lo = values.iter().cloned().fold(f64::MAX, f64::min);
-            let hi = values.iter().cloned().fold(0.0, f64::max);
-            (lo, hi, values.iter().sum::<f64>())
-        };
-        let (t_lo, t_hi, t_sum) = range(|r| r.seconds);
-        let (m_lo, m_hi, _) = range(|r| r.peak_mib);
-        println!(
-            "{count:>3} {:>22} {:>22} {:>16} {:>14.3} {:>13.3}",
-            format!("{t_lo:.2}-{t_hi:.2}"),
-            format!("{m_lo:.0}-{m_hi:.0}"),
-            format!("{:.2} / {:.0}", merge.seconds, merge.peak_mib),
-            t_sum / whole.seconds,
-            m_hi / whole.peak_mib
-        );
-        std::fs::remove_dir_all(&shards).ok();
-        std::fs::remove_file(&merged).ok();
+        shard_row(count, &bake, &path, &whole)?;
     }
     println!(
         "every merge equals the one-machine bake byte for byte; shard times include each \
          process's scene load, BVH build and cost estimate"
     );
+    Ok(())
+}
+
+/// Bakes `count` shards one after another and merges them, checks the merge against the
+/// one-machine bake, and prints the row of their times and memory against `whole`'s.
+fn shard_row(
+    count: u32,
+    bake: &impl Fn(&[String]) -> Vec<String>,
+    path: &impl Fn(&str) -> String,
+    whole: &Run,
+) -> anyhow::Result<()> {
+    let shards = path(&format!("shards-{count}"));
+    let mut runs = Vec::new();
+    for i in 0..count {
+        let shard = format!("{i}/{count}");
+        runs.push(run_hprt(&bake(&[
+            "--shard".into(),
+            shard,
+            "-o".into(),
+            shards.clone(),
+        ]))?);
+    }
+    let merged = path(&format!("merged-{count}.bake"));
+    let merge = run_hprt(&[
+        "bake".into(),
+        "merge".into(),
+        shards.clone(),
+        "-o".into(),
+        merged.clone(),
+    ])?;
+    anyhow::ensure!(
+        std::fs::read(&merged)? == std::fs::read(path("whole.bake"))?,
+        "the merge of {count} shards differs from the one-machine bake"
+    );
+    let range = |f: fn(&Run) -> f64| {
+        let values: Vec<f64> = runs.iter().map(f).collect();
+        let lo = values.iter().cloned().fold(f64::MAX, f64::min);
+        let hi = values.iter().cloned().fold(0.0, f64::max);
+        (lo, hi, values.iter().sum::<f64>())
+    };
+    let (t_lo, t_hi, t_sum) = range(|r| r.seconds);
+    let (m_lo, m_hi, _) = range(|r| r.peak_mib);
+    println!(
+        "{count:>3} {:>22} {:>22} {:>16} {:>14.3} {:>13.3}",
+        format!("{t_lo:.2}-{t_hi:.2}"),
+        format!("{m_lo:.0}-{m_hi:.0}"),
+        format!("{:.2} / {:.0}", merge.seconds, merge.peak_mib),
+        t_sum / whole.seconds,
+        m_hi / whole.peak_mib
+    );
+    std::fs::remove_dir_all(&shards).ok();
+    std::fs::remove_file(&merged).ok();
     Ok(())
 }
