@@ -18,24 +18,7 @@ struct BakeProgress<'a>(&'a dyn foundation::infra::progress::Progress);
 
 impl report::Observer for BakeProgress<'_> {
     fn progress(&self, _what: &str) -> Box<dyn foundation::infra::progress::Progress + '_> {
-        Box::new(Forward(self.0))
-    }
-}
-
-struct Forward<'a>(&'a dyn foundation::infra::progress::Progress);
-
-impl foundation::infra::progress::Progress for Forward<'_> {
-    fn start(&self, total: u64) {
-        self.0.start(total);
-    }
-    fn advance(&self, steps: u64) {
-        self.0.advance(steps);
-    }
-    fn status(&self, text: &str) {
-        self.0.status(text);
-    }
-    fn cancelled(&self) -> bool {
-        self.0.cancelled()
+        Box::new(self.0)
     }
 }
 

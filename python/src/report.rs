@@ -27,24 +27,6 @@ struct PyObserver<'a> {
     error: Mutex<Option<PyErr>>,
 }
 
-/// The call's progress, lent to one step of the report.
-struct Step<'a>(&'a dyn Progress);
-
-impl Progress for Step<'_> {
-    fn start(&self, total: u64) {
-        self.0.start(total);
-    }
-    fn advance(&self, steps: u64) {
-        self.0.advance(steps);
-    }
-    fn status(&self, text: &str) {
-        self.0.status(text);
-    }
-    fn cancelled(&self) -> bool {
-        self.0.cancelled()
-    }
-}
-
 impl Observer for PyObserver<'_> {
     fn line(&self, text: &str) {
         let Some(log) = &self.log else { return };
@@ -59,7 +41,7 @@ impl Observer for PyObserver<'_> {
 
     fn progress(&self, what: &str) -> Box<dyn Progress + '_> {
         self.progress.status(what);
-        Box::new(Step(self.progress))
+        Box::new(self.progress)
     }
 }
 

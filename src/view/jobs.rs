@@ -57,22 +57,7 @@ impl report::Observer for JobObserver<'_> {
     }
 
     fn progress(&self, _what: &str) -> Box<dyn Progress + '_> {
-        Box::new(Lent(self.0))
-    }
-}
-
-/// The job's progress, lent to one step.
-struct Lent<'a>(&'a dyn Progress);
-
-impl Progress for Lent<'_> {
-    fn start(&self, total: u64) {
-        self.0.start(total);
-    }
-    fn advance(&self, steps: u64) {
-        self.0.advance(steps);
-    }
-    fn status(&self, text: &str) {
-        self.0.status(text);
+        Box::new(self.0)
     }
 }
 

@@ -26,6 +26,26 @@ pub trait Progress: Sync {
     }
 }
 
+/// A borrowed progress is one: work can be lent its caller's (`Box::new(progress)` where a
+/// boxed progress is asked for), cancellation included.
+impl<P: Progress + ?Sized> Progress for &P {
+    fn start(&self, total: u64) {
+        (**self).start(total);
+    }
+    fn advance(&self, steps: u64) {
+        (**self).advance(steps);
+    }
+    fn status(&self, text: &str) {
+        (**self).status(text);
+    }
+    fn finish(&self) {
+        (**self).finish();
+    }
+    fn cancelled(&self) -> bool {
+        (**self).cancelled()
+    }
+}
+
 /// Progress that goes nowhere.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NoProgress;
@@ -63,6 +83,16 @@ impl Progress for SharedProgress {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_borrowed_progress_forwards_everything() {
+        let counted = SharedProgress::default();
+        let lent: Box<dyn Progress + '_> = Box::new(&counted);
+        lent.start(4);
+        lent.advance(1);
+        assert_eq!(counted.fraction(), 0.25);
+        assert!(!lent.cancelled());
+    }
 
     #[test]
     fn shared_progress_counts_from_many_threads() {
