@@ -13,7 +13,9 @@
 use crate::decompose::weber::weber_elbow;
 use crate::decompose::{DecomposeSettings, Decomposition, MAX_CANDIDATES};
 use crate::light::DirectionalLight;
+use foundation::Rgb;
 use foundation::luminance;
+use foundation::sh::ShCoeffs;
 
 /// How lights are followed.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -107,9 +109,22 @@ impl LightTracker {
         let luminances: Vec<f32> = lights.iter().map(|l| luminance(l.power)).collect();
         let entering = weber_elbow(&luminances, threshold);
         let step = 1.0 / self.settings.fade_frames.max(1) as f32;
-        let cos_match = self.settings.match_deg.to_radians().cos();
+        let mut matching = self.match_tracks(lights, step);
+        self.admit(&mut matching, lights, entering, max_lights, step);
+        self.started = true;
+        let sh = sh_with_unemitted(decomposition, &matching);
+        let mut tracks = matching.tracks;
+        tracks.sort_by(|a, b| {
+            luminance(b.light.power * b.weight).total_cmp(&luminance(a.light.power * a.weight))
+        });
+        self.tracks = tracks;
+        self.emitted(decomposition, sh)
+    }
 
-        // Strongest tracks choose first: the nearest unclaimed light within the match angle.
+    /// Strongest tracks choose first: the nearest unclaimed light within the match angle.
+    /// A matched track fades in further, an unmatched one fades out (and ends at weight 0).
+    fn match_tracks(&mut self, lights: &[DirectionalLight], step: f32) -> Matching {
+        let cos_match = self.settings.match_deg.to_radians().cos();
         self.tracks
             .sort_by(|a, b| luminance(b.light.power).total_cmp(&luminance(a.light.power)));
         let mut claimed = vec![false; lights.len()];
@@ -145,13 +160,30 @@ impl LightTracker {
                 tracks.push(next);
             }
         }
+        Matching {
+            tracks,
+            claimed,
+            owner,
+        }
+    }
+
+    /// New tracks for the unclaimed lights among the first `entering` (those passing the
+    /// entering threshold), while fewer than `max_lights` stay.
+    fn admit(
+        &mut self,
+        matching: &mut Matching,
+        lights: &[DirectionalLight],
+        entering: usize,
+        max_lights: usize,
+        step: f32,
+    ) {
         for (i, light) in lights.iter().enumerate() {
-            let staying = tracks.iter().filter(|t| !t.fading_out).count();
-            if claimed[i] || i >= entering || staying >= max_lights {
+            let staying = matching.tracks.iter().filter(|t| !t.fading_out).count();
+            if matching.claimed[i] || i >= entering || staying >= max_lights {
                 continue;
             }
-            owner[i] = Some(tracks.len());
-            tracks.push(TrackedLight {
+            matching.owner[i] = Some(matching.tracks.len());
+            matching.tracks.push(TrackedLight {
                 id: self.next_id,
                 light: *light,
                 // The first frame shows its lights at once.
@@ -160,22 +192,10 @@ impl LightTracker {
             });
             self.next_id += 1;
         }
-        self.started = true;
+    }
 
-        // Energy not emitted by a light goes to (or, for a light fading out of a frame that no
-        // longer holds it, comes from) the SH part.
-        let mut sh = decomposition.sh.clone();
-        for (i, light) in lights.iter().enumerate() {
-            let emitted = owner[i].map_or(0.0, |t| tracks[t].weight);
-            sh.add_delta(light.direction, light.power * (1.0 - emitted));
-        }
-        for track in tracks.iter().filter(|t| t.fading_out) {
-            sh.add_delta(track.light.direction, track.light.power * -track.weight);
-        }
-        tracks.sort_by(|a, b| {
-            luminance(b.light.power * b.weight).total_cmp(&luminance(a.light.power * a.weight))
-        });
-        self.tracks = tracks;
+    /// The frame's lighting: the tracks' emitted lights, each with its share of the total.
+    fn emitted(&self, decomposition: &Decomposition, sh: ShCoeffs<Rgb>) -> Decomposition {
         let total = luminance(decomposition.total_power).max(f32::MIN_POSITIVE);
         Decomposition {
             sh,
@@ -195,6 +215,29 @@ impl LightTracker {
             candidates: decomposition.candidates,
         }
     }
+}
+
+/// A frame's tracks while they are matched to its lights.
+struct Matching {
+    tracks: Vec<TrackedLight>,
+    /// Per light of the frame, whether a track matched it.
+    claimed: Vec<bool>,
+    /// Per light of the frame, the index in `tracks` of the track that emits it.
+    owner: Vec<Option<usize>>,
+}
+
+/// The SH part with the energy no light emits: what a light does not emit goes to it (or, for
+/// a light fading out of a frame that no longer holds it, comes from it).
+fn sh_with_unemitted(decomposition: &Decomposition, matching: &Matching) -> ShCoeffs<Rgb> {
+    let mut sh = decomposition.sh.clone();
+    for (i, light) in decomposition.lights.iter().enumerate() {
+        let emitted = matching.owner[i].map_or(0.0, |t| matching.tracks[t].weight);
+        sh.add_delta(light.direction, light.power * (1.0 - emitted));
+    }
+    for track in matching.tracks.iter().filter(|t| t.fading_out) {
+        sh.add_delta(track.light.direction, track.light.power * -track.weight);
+    }
+    sh
 }
 
 #[cfg(test)]

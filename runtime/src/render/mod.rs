@@ -9,6 +9,8 @@
 //! 4. [`light_pass`]: one additive full-screen pass adds every light with percentage-closer
 //!    filtering and shows the [`environment`] behind the scene (`shaders/lights.wgsl`).
 //!
+//! [`frame`] records them in this order, in one place.
+//!
 //! Glossy scenes add [`materials`] and the [`reflection_maps`] the PRT pass reflects,
 //! prefiltered only when the reflected environment changes.
 //!
@@ -21,6 +23,7 @@ mod composite;
 mod display_pass;
 mod environment_texture;
 mod error;
+mod frame;
 mod gpu;
 mod gpu_scene;
 mod light_pass;
@@ -36,7 +39,6 @@ mod targets;
 mod transfer_pass;
 mod uniforms;
 
-use crate::lighting::ShTransfer;
 use composite::{Compositor, CompositorSource};
 pub use composite::{LiveBackplate, rows_of, with_objects_alone};
 pub use display_pass::{DisplayPass, capture_target};
@@ -52,16 +54,16 @@ use foundation::scene::SceneMesh;
 use foundation::settings::{InvalidSettings, SettingsProblem};
 pub use gpu::{Backend, GpuContext, GpuError};
 use gpu_scene::GpuScene;
-use light_pass::{LightPass, LightPassInputs};
+use light_pass::LightPass;
 use precompute::bake::Transfer;
-use prt_pass::{PrtPass, PrtPassInputs};
+use prt_pass::PrtPass;
 pub use readback::read_texture;
 use reflection_maps::ReflectionMaps;
 pub use shaders::{MAX_GPU_ORDER, MAX_LIGHTS};
 pub use shadow_fit::{BoundingSphere, ShadowFit, ShadowSettings};
 use shadow_maps::ShadowMaps;
 use targets::Targets;
-use uniforms::{FrameBuffers, FrameParameters, FrameUniform};
+use uniforms::FrameBuffers;
 
 pub use crate::lighting::{FrameLighting, RenderMode};
 
@@ -278,13 +280,6 @@ impl Renderer {
         }
     }
 
-    /// Whether the shadow maps hold each light's map of the proxies alone too (compositing
-    /// proxies that can shadow themselves, and do).
-    fn proxy_layers(&self) -> bool {
-        self.casters == ShadowCasters::All
-            && self.composite.as_ref().is_some_and(|c| c.self_shadowing)
-    }
-
     /// Back to drawing the whole scene.
     pub fn disable_composite(&mut self) {
         self.composite = None;
@@ -413,160 +408,6 @@ impl Renderer {
             Some(composite) => composite.image().0,
             None => &self.targets.color,
         }
-    }
-
-    /// Records and submits one frame; returns without waiting for the GPU.
-    pub fn render(&mut self) -> Result<(), RenderError> {
-        let device = self.device.clone();
-        checked(&device, || self.record_frame())
-    }
-
-    fn record_frame(&mut self) -> Result<(), RenderError> {
-        let lighting = self
-            .frame
-            .lighting
-            .clone()
-            .ok_or_else(|| InvalidSettings::new("lighting", SettingsProblem::NoLighting))?;
-        let lights = &lighting.lights;
-        let shadows = lighting.shadows && !lights.is_empty();
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        self.record_reflections(&mut encoder, &lighting);
-        if self.frame.radiance_dirty {
-            self.scene
-                .update_radiance(&self.queue, &mut encoder, &lighting);
-            if let Some(composite) = &self.composite {
-                let (order, vertices) = (self.scene.order, self.scene.vertex_count);
-                composite.update_radiance(&self.queue, &mut encoder, &lighting, order, vertices);
-            }
-            self.frame.radiance_dirty = false;
-        }
-        let shadow = self.shadow_maps.settings();
-        let view_proj = uniforms::camera_view_proj(&self.frame.camera, &self.bounds);
-        let frame = FrameUniform::new(&FrameParameters {
-            camera: &self.frame.camera,
-            view_proj,
-            environment_rotation: self.environment.rotation,
-            light_count: lights.len(),
-            // The composite draws its own backplate.
-            background: self.background && self.composite.is_none(),
-            pcf_taps: shadow.pcf_taps,
-            // 0: no maps of the proxies alone (they cannot shadow themselves).
-            proxy_layers: match self.proxy_layers() {
-                true => lights.len() as u32,
-                false => 0,
-            },
-            sh_per_pixel: (lighting.sh_transfer == ShTransfer::Unshadowed).then_some(&lighting.sh),
-            reflection_to_map: match &lighting.reflections {
-                crate::reflection::ReflectedEnvironment::Remainder { orientation, .. } => {
-                    glam::Mat4::from_quat(orientation.inverse())
-                }
-                _ => glam::Mat4::IDENTITY,
-            },
-        });
-        let fits: Vec<ShadowFit> = lights
-            .iter()
-            .map(|l| {
-                ShadowFit::to_view(l.direction, self.scene.bounds, view_proj, shadow.resolution)
-            })
-            .collect();
-        let light_data = uniforms::light_uniforms(lights, &fits);
-        self.buffers.write(&self.queue, &frame, &light_data);
-        if shadows {
-            let matrices: Vec<_> = light_data.iter().map(|l| l.shadow_matrix()).collect();
-            self.record_shadow_maps(&mut encoder, &matrices);
-        }
-        self.prt_pass.record(
-            &self.device,
-            &mut encoder,
-            &self.targets,
-            &self.scene,
-            &PrtPassInputs {
-                frame: &self.buffers.frame,
-                materials: &self.scene.materials.uniform,
-                reflections: &self.reflections,
-                composite: self.composite.as_ref().map(|c| c.prt_pass_inputs()),
-            },
-        );
-        if self.composite.is_some() {
-            // The proxies' maps and the composite's images are bound afresh each frame.
-            self.light_pass.inputs_changed();
-        }
-        let inputs = LightPassInputs {
-            buffers: &self.buffers,
-            targets: &self.targets,
-            shadow_maps: &self.shadow_maps,
-            environment: &self.environment,
-            materials: &self.scene.materials.uniform,
-            composite: self.composite.as_ref().map(|c| c.light_pass_inputs()),
-        };
-        self.light_pass
-            .record(&self.device, &mut encoder, &inputs, shadows);
-        if let Some(composite) = &self.composite {
-            composite.record(&self.device, &mut encoder, &self.scene, &self.buffers);
-        }
-        self.queue.submit([encoder.finish()]);
-        Ok(())
-    }
-
-    /// Each light's shadow map where its matrix changed; compositing, then each light's map
-    /// of the proxies alone, in the layers after the scene's.
-    fn record_shadow_maps(&mut self, encoder: &mut wgpu::CommandEncoder, matrices: &[glam::Mat4]) {
-        let lights = matrices.len();
-        let layers: Vec<glam::Mat4> = match self.proxy_layers() {
-            true => matrices.iter().chain(matrices).copied().collect(),
-            false => matrices.to_vec(),
-        };
-        if self.shadow_maps.reserve(&self.device, layers.len()) {
-            self.light_pass.inputs_changed();
-        }
-        if self.frame.shadow_layers != Some(lights) {
-            // The proxies' layers moved with the light count.
-            self.shadow_maps.invalidate();
-            self.frame.shadow_layers = Some(lights);
-        }
-        let (scene, composite, casters) = (&self.scene, &self.composite, self.casters);
-        self.shadow_maps.render_stale(
-            &self.queue,
-            encoder,
-            |pass, layer| match (composite, casters) {
-                (Some(c), _) if layer >= lights => c.draw_proxies_depth_only(scene, pass),
-                (_, ShadowCasters::All) => scene.draw_depth_only(pass),
-                (_, ShadowCasters::Objects) => scene.draw_parts_depth_only(pass, &scene.objects),
-            },
-            &layers,
-        );
-    }
-
-    /// Prefilters the reflection maps now, if the lighting or the materials changed them
-    /// (a frame does it otherwise); with [`Self::wait`], what a lighting change costs.
-    pub fn update_reflections(&mut self) -> Result<(), RenderError> {
-        let Some(lighting) = self.frame.lighting.clone() else {
-            return Ok(());
-        };
-        let device = self.device.clone();
-        checked(&device, || {
-            let mut encoder = self.device.create_command_encoder(&Default::default());
-            self.record_reflections(&mut encoder, &lighting);
-            self.queue.submit([encoder.finish()]);
-            Ok(())
-        })
-    }
-
-    fn record_reflections(&mut self, encoder: &mut wgpu::CommandEncoder, lighting: &FrameLighting) {
-        if !(self.frame.reflections_dirty && self.is_glossy()) {
-            return;
-        }
-        let recreated = self.reflections.update(
-            &self.device,
-            &self.queue,
-            encoder,
-            &lighting.reflections,
-            &self.scene.materials.table.shininess,
-        );
-        if recreated {
-            self.prt_pass.inputs_changed();
-        }
-        self.frame.reflections_dirty = false;
     }
 
     /// Waits for the last frame and copies it to the CPU as linear radiance.

@@ -16,9 +16,11 @@
 //! test), as the reference classifies pixels by their centre's ray.
 
 mod passes;
+mod proxies;
+mod transfer;
 
 use super::environment_texture::{mip_chain_of, next_level, upload_mip_chain};
-use super::error::{BakeMismatch, RenderError};
+use super::error::RenderError;
 use super::gpu_scene::{GpuScene, draws_of};
 use super::light_pass::CompositeLightInputs;
 use super::pass_helpers::texture;
@@ -32,10 +34,12 @@ use bytemuck::{Pod, Zeroable};
 use foundation::Rgb;
 use foundation::image_io::RgbImageF32;
 use foundation::scene::{ObjectRole, SceneMesh};
-use foundation::settings::{InvalidSettings, SettingsProblem};
 use passes::CompositePasses;
-use precompute::bake::{Transfer, TransferVectors};
+use precompute::bake::Transfer;
+use proxies::{check_proxies, proxies_may_shadow_themselves, proxy_edges, proxy_flags};
 use std::ops::Range;
+use transfer::without_transfer;
+pub use transfer::{rows_of, with_objects_alone};
 
 /// The picture the live composite draws into.
 #[derive(Debug, Clone)]
@@ -51,211 +55,6 @@ pub enum LiveBackplate {
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(crate) struct BackplateUniform {
     params: [f32; 4],
-}
-
-/// The proxies' bake over the whole scene's vertices: theirs on the proxies' vertices, zero on
-/// the objects' (never drawn). `proxies` is the bake of [`SceneMesh::subset`] of the proxies,
-/// whose vertices are the proxies' in scene order.
-fn without_transfer(
-    geometry: &SceneMesh,
-    proxies: &Transfer,
-    order: usize,
-) -> Result<Transfer, BakeMismatch> {
-    spread_over(geometry, ObjectRole::Proxy, proxies, order)
-}
-
-/// The rows of `whole` (a bake of the whole scene) on the vertices of the objects with
-/// `role`, in scene order: the bake of [`SceneMesh::subset`] of them, as [`spread_over`] takes.
-pub fn rows_of(
-    geometry: &SceneMesh,
-    role: ObjectRole,
-    whole: &Transfer,
-) -> Result<Transfer, BakeMismatch> {
-    if whole.direct.vertex_count() != geometry.mesh.vertex_count() {
-        return Err(BakeMismatch::VertexCount {
-            bake: whole.direct.vertex_count(),
-            scene: geometry.mesh.vertex_count(),
-        });
-    }
-    let order = whole.settings.order;
-    let parts: Vec<Range<usize>> = (geometry.objects.iter())
-        .filter(|o| o.role == role)
-        .map(|o| o.vertices.start as usize..o.vertices.end as usize)
-        .collect();
-    let count: usize = parts.iter().map(|r| r.len()).sum();
-    let gather = |vectors: &TransferVectors| {
-        let stride = vectors.stride();
-        let data: Vec<f32> = (parts.iter())
-            .flat_map(|r| &vectors.as_slice()[r.start * stride..r.end * stride])
-            .copied()
-            .collect();
-        TransferVectors::from_raw(order, count, data)
-            .unwrap_or_else(|| TransferVectors::zeros(order, count))
-    };
-    Ok(Transfer {
-        settings: whole.settings,
-        direct: gather(&whole.direct),
-        indirect: gather(&whole.indirect),
-        textured_vertices: whole.textured_vertices,
-    })
-}
-
-/// `whole` (a bake of the whole scene) with the objects' rows taken from `objects` (their bake
-/// alone): the room with the model where it rests, which takes the model's soft shadow and
-/// bounce light, and the model lit by a local map that already holds the room.
-pub fn with_objects_alone(
-    geometry: &SceneMesh,
-    whole: &Transfer,
-    objects: &Transfer,
-) -> Result<Transfer, BakeMismatch> {
-    let order = whole.settings.order;
-    let on_objects = spread_over(geometry, ObjectRole::Object, objects, order)?;
-    if whole.direct.vertex_count() != geometry.mesh.vertex_count() {
-        return Err(BakeMismatch::VertexCount {
-            bake: whole.direct.vertex_count(),
-            scene: geometry.mesh.vertex_count(),
-        });
-    }
-    let mut out = whole.clone();
-    let stride = out.direct.stride();
-    let copy = |to: &mut TransferVectors, from: &TransferVectors| {
-        for o in geometry
-            .objects
-            .iter()
-            .filter(|o| o.role == ObjectRole::Object)
-        {
-            let rows = o.vertices.start as usize * stride..o.vertices.end as usize * stride;
-            to.as_mut_slice()[rows.clone()].copy_from_slice(&from.as_slice()[rows]);
-        }
-    };
-    copy(&mut out.direct, &on_objects.direct);
-    copy(&mut out.indirect, &on_objects.indirect);
-    Ok(out)
-}
-
-/// `part`'s bake (of [`SceneMesh::subset`] of the objects with `role`, whose vertices are
-/// theirs in scene order) on those vertices of the whole scene, zero elsewhere.
-fn spread_over(
-    geometry: &SceneMesh,
-    role: ObjectRole,
-    part: &Transfer,
-    order: usize,
-) -> Result<Transfer, BakeMismatch> {
-    let parts: Vec<Range<usize>> = geometry
-        .objects
-        .iter()
-        .filter(|o| o.role == role)
-        .map(|o| o.vertices.start as usize..o.vertices.end as usize)
-        .collect();
-    let count: usize = parts.iter().map(|r| r.len()).sum();
-    if part.direct.vertex_count() != count || part.settings.order != order {
-        return Err(BakeMismatch::Part {
-            part: match role {
-                ObjectRole::Object => "objects",
-                ObjectRole::Proxy => "proxies",
-            },
-            bake: part.direct.vertex_count(),
-            bake_order: part.settings.order,
-            scene: count,
-            scene_order: order,
-        });
-    }
-    let spread = |vectors: &TransferVectors| {
-        let mut out = TransferVectors::zeros(order, geometry.mesh.vertex_count());
-        let stride = vectors.stride();
-        let mut from = 0;
-        for part in &parts {
-            let span = part.len() * stride;
-            out.as_mut_slice()[part.start * stride..part.start * stride + span]
-                .copy_from_slice(&vectors.as_slice()[from..from + span]);
-            from += span;
-        }
-        out
-    };
-    Ok(Transfer {
-        settings: part.settings,
-        direct: spread(&part.direct),
-        indirect: spread(&part.indirect),
-        textured_vertices: part.textured_vertices,
-    })
-}
-
-/// Most vertex-plane tests [`proxies_may_shadow_themselves`] makes before it assumes they may
-/// (distinct planes times vertices).
-const MAX_CONVEXITY_TESTS: usize = 10_000_000;
-
-/// Whether the proxies can cast shadows on themselves. They cannot when they all lie in one
-/// plane, or when they are the closed surface of one convex body (a floor slab): every proxy
-/// vertex on one side of each proxy triangle's plane, and the triangles' oriented areas
-/// summing to nothing. A point on such a body's outside that faces a light sees it past the
-/// body (only its inside, unseen, is shadowed). Then their own shadow maps would be all light
-/// and are not drawn.
-fn proxies_may_shadow_themselves(geometry: &SceneMesh) -> bool {
-    let proxies: Vec<&foundation::scene::SceneObject> = geometry
-        .objects
-        .iter()
-        .filter(|o| o.role == ObjectRole::Proxy)
-        .collect();
-    let points: Vec<glam::Vec3> = proxies
-        .iter()
-        .flat_map(|o| &geometry.mesh.positions[o.vertices.start as usize..o.vertices.end as usize])
-        .copied()
-        .collect();
-    let triangles: Vec<[glam::Vec3; 3]> = proxies
-        .iter()
-        .flat_map(|o| {
-            &geometry.mesh.triangles[o.triangles.start as usize..o.triangles.end as usize]
-        })
-        .map(|t| t.map(|i| geometry.mesh.positions[i as usize]))
-        .collect();
-    let tolerance = 1e-5 * geometry.diagonal().max(f32::MIN_POSITIVE);
-    // The triangles' planes, each once (a subdivided slab has six).
-    let mut planes: Vec<(glam::Vec3, f32)> = Vec::new();
-    let (mut oriented, mut total) = (glam::Vec3::ZERO, 0.0f32);
-    for [a, b, c] in &triangles {
-        let area = (*b - *a).cross(*c - *a);
-        oriented += area;
-        total += area.length();
-        let normal = area.normalize_or_zero();
-        let plane = (normal, normal.dot(*a));
-        let same = |(n, d): &(glam::Vec3, f32)| {
-            (*n - plane.0).length() < 1e-4 && (d - plane.1).abs() < tolerance
-        };
-        if normal != glam::Vec3::ZERO && !planes.iter().any(same) {
-            if planes.len().saturating_mul(points.len()) >= MAX_CONVEXITY_TESTS {
-                return true;
-            }
-            planes.push(plane);
-        }
-    }
-    let (mut convex, mut coplanar) = (true, true);
-    for (normal, offset) in &planes {
-        let (below, above) = points.iter().fold((false, false), |(below, above), p| {
-            let d = normal.dot(*p) - offset;
-            (below || d < -tolerance, above || d > tolerance)
-        });
-        convex &= !(below && above);
-        coplanar &= !(below || above);
-    }
-    let closed = oriented.length() <= 1e-4 * total;
-    !(coplanar || (convex && closed))
-}
-
-/// Each edge of the proxies' triangles once, as index pairs (the wireframe).
-fn proxy_edges(geometry: &SceneMesh) -> Vec<u32> {
-    let mut edges: Vec<(u32, u32)> = geometry
-        .objects
-        .iter()
-        .filter(|o| o.role == ObjectRole::Proxy)
-        .flat_map(|o| {
-            &geometry.mesh.triangles[o.triangles.start as usize..o.triangles.end as usize]
-        })
-        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
-        .map(|(a, b)| (a.min(b), a.max(b)))
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
-    edges.into_iter().flat_map(|(a, b)| [a, b]).collect()
 }
 
 /// A photograph as a mipmapped texture no larger than the adapter allows (halved until it
@@ -289,39 +88,72 @@ fn photograph_texture(
     )
 }
 
-/// Refuses geometry the live composite cannot draw: no proxies, or glossy ones.
-fn check_proxies(geometry: &SceneMesh) -> Result<(), InvalidSettings> {
-    if !geometry.has_proxies() {
-        return Err(InvalidSettings::new(
-            "composite",
-            SettingsProblem::NoProxies,
-        ));
-    }
-    match geometry
-        .objects
-        .iter()
-        .find(|o| o.role == ObjectRole::Proxy && o.material.is_glossy())
-    {
-        Some(o) => Err(InvalidSettings::new(
-            "composite",
-            SettingsProblem::GlossyProxy {
-                proxy: o.name.clone(),
-            },
-        )),
-        None => Ok(()),
-    }
+/// The proxies' vertex radiance without the objects (vec4 per vertex) and the transfer pass
+/// that writes it from `transfer`, their bake spread over the scene.
+fn without_objects_pass(
+    device: &wgpu::Device,
+    transfer: &Transfer,
+    vertex_count: u32,
+) -> (wgpu::Buffer, TransferPass) {
+    let vertex_bytes = u64::from(vertex_count) * 16;
+    let buffer = |label| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: vertex_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
+            mapped_at_creation: false,
+        })
+    };
+    let without_radiance = buffer("vertex radiance without the objects");
+    // The pass writes an interreflected part too, which the proxies do not need.
+    let unused_indirect = buffer("indirect radiance without the objects (unused)");
+    let transfer_pass = TransferPass::new(device, transfer, &without_radiance, &unused_indirect);
+    (without_radiance, transfer_pass)
 }
 
-/// Per vertex, 1 for a proxy's, 0 for an object's.
-fn proxy_flags(geometry: &SceneMesh) -> Vec<f32> {
-    geometry
-        .objects
-        .iter()
-        .flat_map(|o| {
-            let flag = f32::from(u8::from(o.role == ObjectRole::Proxy));
-            std::iter::repeat_n(flag, o.vertices.len())
-        })
-        .collect()
+/// The backplate's photograph texture and its uniform buffer, written.
+fn backplate_resources(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    backplate: &LiveBackplate,
+) -> (wgpu::Texture, wgpu::Buffer) {
+    let (photograph, uniform) = photograph_texture(device, queue, backplate);
+    let backplate_uniform = writable_buffer(
+        device,
+        "backplate",
+        size_of::<BackplateUniform>(),
+        wgpu::BufferUsages::UNIFORM,
+    );
+    queue.write_buffer(&backplate_uniform, 0, bytemuck::bytes_of(&uniform));
+    (photograph, backplate_uniform)
+}
+
+/// The per-vertex proxy flags (a vertex buffer) and the proxies' edges (an index buffer, with
+/// its index count).
+fn proxy_buffers(device: &wgpu::Device, geometry: &SceneMesh) -> (wgpu::Buffer, wgpu::Buffer, u32) {
+    let flags = proxy_flags(geometry);
+    let init = |label, contents: &[u8], usage| {
+        wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            },
+        )
+    };
+    let proxy_flags = init(
+        "proxy flags",
+        bytemuck::cast_slice(&flags),
+        wgpu::BufferUsages::VERTEX,
+    );
+    let edges = proxy_edges(geometry);
+    let edge_buffer = init(
+        "proxy edges",
+        bytemuck::cast_slice(&edges),
+        wgpu::BufferUsages::INDEX,
+    );
+    (proxy_flags, edge_buffer, edges.len() as u32)
 }
 
 /// The images of the composite at one size.
@@ -401,56 +233,16 @@ impl Compositor {
         let is_proxy = |o: &foundation::scene::SceneObject| o.role == ObjectRole::Proxy;
         check_proxies(geometry)?;
         let transfer = without_transfer(geometry, source.proxies_transfer, source.scene.order)?;
-        let vertex_bytes = u64::from(source.scene.vertex_count) * 16;
-        let buffer = |label| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: vertex_bytes,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
-                mapped_at_creation: false,
-            })
-        };
-        let without_radiance = buffer("vertex radiance without the objects");
-        // The pass writes an interreflected part too, which the proxies do not need.
-        let unused_indirect = buffer("indirect radiance without the objects (unused)");
-        let transfer_pass =
-            TransferPass::new(device, &transfer, &without_radiance, &unused_indirect);
-        let (photograph, uniform) = photograph_texture(device, queue, source.backplate);
-        let backplate_uniform = writable_buffer(
-            device,
-            "backplate",
-            size_of::<BackplateUniform>(),
-            wgpu::BufferUsages::UNIFORM,
-        );
-        queue.write_buffer(&backplate_uniform, 0, bytemuck::bytes_of(&uniform));
+        let (without_radiance, transfer_pass) =
+            without_objects_pass(device, &transfer, source.scene.vertex_count);
+        let (photograph, backplate_uniform) = backplate_resources(device, queue, source.backplate);
         let floor_sums = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("composite floor sums"),
             size: (super::shaders::FLOOR_SUMS * 16) as u64,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::UNIFORM,
             mapped_at_creation: false,
         });
-        let flags = proxy_flags(geometry);
-        let init = |label, contents: &[u8], usage| {
-            wgpu::util::DeviceExt::create_buffer_init(
-                device,
-                &wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage,
-                },
-            )
-        };
-        let proxy_flags = init(
-            "proxy flags",
-            bytemuck::cast_slice(&flags),
-            wgpu::BufferUsages::VERTEX,
-        );
-        let edges = proxy_edges(geometry);
-        let edge_buffer = init(
-            "proxy edges",
-            bytemuck::cast_slice(&edges),
-            wgpu::BufferUsages::INDEX,
-        );
+        let (proxy_flags, edge_buffer, edge_indices) = proxy_buffers(device, geometry);
         Ok(Self {
             proxies: draws_of(geometry, is_proxy),
             self_shadowing: proxies_may_shadow_themselves(geometry),
@@ -470,7 +262,7 @@ impl Compositor {
             backplate_uniform,
             floor_sums,
             edges: edge_buffer,
-            edge_indices: edges.len() as u32,
+            edge_indices,
             wireframe: false,
         })
     }

@@ -4,7 +4,7 @@
 use super::*;
 use foundation::mesh::TriangleMesh;
 use glam::Vec3;
-use precompute::bake::BakeSettings;
+use precompute::bake::{BakeSettings, TransferVectors};
 
 fn square(y: f32) -> TriangleMesh {
     TriangleMesh {
