@@ -282,7 +282,7 @@ fn map_section(html: &mut String, map: &MapReport, out: &Path) -> Result<()> {
 }
 
 /// The page for `report`, whose images lie under `out`.
-pub fn page(report: &Report, out: &Path) -> Result<String> {
+pub(crate) fn page(report: &Report, out: &Path) -> Result<String> {
     let mut html = String::new();
     let s = &report.settings;
     let _ = write!(

@@ -4,6 +4,8 @@
 //! `stats.csv`; and a scene's composite drawn by the GPU methods. The command line and the
 //! Python module call it; it prints nothing (an [`Observer`] receives what it says).
 
+#![deny(unreachable_pub)]
+
 mod bake;
 pub mod composite;
 mod composite_truth;

@@ -7,10 +7,10 @@ use foundation::luminance;
 /// A frame pops when its temporal error is more than this multiple of its neighbours' (a
 /// spike: a light or shadow appearing or vanishing at once, not the steady change of a moving
 /// map)...
-pub const POP_SPIKE: f64 = 2.0;
+pub(crate) const POP_SPIKE: f64 = 2.0;
 /// ... and above this (tone-mapped luminance), so that a near-static sequence's noise does not
 /// count.
-pub const POP_FLOOR: f64 = 0.002;
+pub(crate) const POP_FLOOR: f64 = 0.002;
 
 /// Tone-mapped luminance of every pixel.
 pub(crate) fn tonemapped_luminance(image: &RgbImageF32, exposure: f32) -> Vec<f32> {
