@@ -92,16 +92,7 @@ pub fn files_with_extension(
     Ok(files)
 }
 
-/// Median of a non-empty sample.
-pub fn median(mut xs: Vec<f64>) -> f64 {
-    xs.sort_by(f64::total_cmp);
-    let n = xs.len();
-    if n % 2 == 1 {
-        xs[n / 2]
-    } else {
-        0.5 * (xs[n / 2 - 1] + xs[n / 2])
-    }
-}
+pub use report::maps::median;
 
 /// A progress bar with ETA on a terminal; draws nothing when stderr is not a terminal.
 pub struct TerminalProgress(ProgressBar);
@@ -145,16 +136,5 @@ impl Progress for TerminalProgress {
     }
     fn finish(&self) {
         self.0.finish_and_clear();
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn median_of_odd_and_even_samples() {
-        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), 2.5);
     }
 }

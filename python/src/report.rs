@@ -201,12 +201,10 @@ impl ReportJob<'_> {
                     thresholds: Vec::new(),
                     ..self.settings(transfer.settings.bounces)
                 };
-                let camera = scene.camera.with_size(settings.width, settings.height);
                 let report = report::sequence::write_sequence_report(
                     scene,
                     (path, &sequence),
                     &transfer,
-                    camera,
                     &settings,
                     folder,
                     observer,

@@ -32,7 +32,7 @@ pub fn create_folder(dir: &Path) -> Result<()> {
 }
 
 /// Median of a non-empty sample.
-pub(crate) fn median(mut xs: Vec<f64>) -> f64 {
+pub fn median(mut xs: Vec<f64>) -> f64 {
     xs.sort_by(f64::total_cmp);
     let n = xs.len();
     if n % 2 == 1 {

@@ -227,7 +227,6 @@ fn write_sequence_report(
             scene,
             (sequence_path, &sequence),
             &transfer,
-            camera,
             &settings,
             folder,
             &TerminalObserver,

@@ -16,9 +16,9 @@ use crate::env_sequence::Sequence;
 use crate::error::{ReportError, Result};
 use crate::maps::{default_exposure, scene_rotation};
 use crate::observer::Observer;
+use crate::per_map::report_renderer;
 use crate::stats::error_stats;
 use crate::{ReferenceImages, ReferenceRequest, ReportSettings, reference_images};
-use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::envmap::animated::SunDisc;
 use foundation::image_io::{RgbImageF32, check_finite};
@@ -28,7 +28,7 @@ use output::{side_by_side, write_outputs};
 use precompute::bake::Transfer;
 use results::{FrameResult, SequenceFrame, SequenceMethod, SunAccuracy, summarise};
 use runtime::DirectionalLight;
-use runtime::render::{GpuContext, Renderer, ShadowSettings};
+use runtime::render::Renderer;
 use runtime::{DecomposeSettings, EnvironmentLighting, TrackingSettings};
 use std::path::Path;
 use temporal::{temporal, tonemapped_luminance};
@@ -38,21 +38,12 @@ pub fn write_sequence_report(
     scene: &Scene,
     (sequence_path, sequence): (&Path, &Sequence),
     transfer: &Transfer,
-    camera: Camera,
     settings: &ReportSettings,
     out: &Path,
     observer: &dyn Observer,
 ) -> Result<SequenceReport> {
     crate::maps::create_folder(out)?;
-    let gpu = GpuContext::headless(settings.backend)?;
-    observer.line(&format!("adapter: {}", gpu.description()));
-    let renderer = Renderer::new(
-        &gpu,
-        &scene.geometry,
-        transfer,
-        &camera,
-        ShadowSettings::default(),
-    )?;
+    let (_gpu, camera, renderer) = report_renderer(scene, transfer, settings, observer)?;
     let rotation = scene_rotation(scene, None);
     let first = sequence.frame(0)?;
     let exposure = default_exposure(&first);
