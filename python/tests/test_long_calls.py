@@ -30,10 +30,16 @@ def record(stage: str, done: int, total: int) -> None:
     seen[0] = done / max(total, 1)
 
 progress = record if sys.argv[3] == "callback" else None
+small = hprt.bake(scene, samples=16, bounces=0, order=3) if sys.argv[2] == "report" else None
 print("started", flush=True)
 try:
     if sys.argv[2] == "bake":
         hprt.bake(scene, samples=4096, bounces=1, order=4, progress=progress)
+    elif sys.argv[2] == "report":
+        # Its lines on stdout: the test interrupts the path tracer, once it has started.
+        hprt.report(scene, sys.argv[5], maps=[sys.argv[4]], bake=small, spp=4096, width=320,
+                    height=240, frames=1, thresholds=[0.05], progress=progress,
+                    log=lambda line: print(line, flush=True))
     else:
         hprt.reference(scene, sys.argv[4], spp=4096, width=320, height=240, progress=progress)
 except KeyboardInterrupt:
@@ -44,15 +50,21 @@ print("finished", flush=True)
 
 
 @pytest.mark.parametrize("callback", ["none", "callback"])
-@pytest.mark.parametrize("call", ["bake", "reference"])
-def test_ctrl_c_stops_a_long_call(call: str, callback: str) -> None:
-    env = {**os.environ, "RAYON_NUM_THREADS": "1"}
-    args = [sys.executable, "-c", CHILD, str(TEAPOT), call, callback, str(INTERIOR)]
+@pytest.mark.parametrize("call", ["bake", "reference", "report"])
+def test_ctrl_c_stops_a_long_call(call: str, callback: str, tmp_path: Path) -> None:
+    # Each its own cache: a report must render its reference, not find it.
+    env = {**os.environ, "RAYON_NUM_THREADS": "1", "HPRT_CACHE": str(tmp_path / "cache")}
+    output = str(tmp_path / "report")
+    args = [sys.executable, "-c", CHILD, str(TEAPOT), call, callback, str(INTERIOR), output]
     child = subprocess.Popen(
         args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
     )
     assert child.stdout is not None
     assert child.stdout.readline().strip() == "started"
+    if call == "report":
+        # The GPU methods come first and run to their end; the path tracer stops.
+        while not child.stdout.readline().startswith("reference:"):
+            pass
     time.sleep(1.0)
     interrupted = time.monotonic()
     child.send_signal(signal.SIGINT)
@@ -69,6 +81,7 @@ def test_ctrl_c_stops_a_long_call(call: str, callback: str) -> None:
     assert child.returncode != 0
     # A chunk of vertices or an image row, then the next check (every 50 ms).
     assert stopped < 3.0, f"{stopped:.2f} s"
+    assert not Path(output).exists(), "an interrupted report writes nothing"
     if callback == "callback":
         fraction = float(out.split("interrupted at ")[1])
         assert fraction < 0.5, out

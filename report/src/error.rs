@@ -26,6 +26,9 @@ pub enum ReportError {
     MedianCut(#[from] runtime::MedianCutError),
     #[error(transparent)]
     Cache(#[from] precompute::cache::CacheError),
+    /// The path tracer stopped because its progress asked (Ctrl-C from Python).
+    #[error(transparent)]
+    PathTraceCancelled(#[from] reference::RenderError),
     #[error(transparent)]
     BakeFile(#[from] precompute::bakefile::BakeFileError),
     /// A map that cannot be loaded.

@@ -8,7 +8,7 @@ mod request;
 pub(crate) use request::hash_view;
 pub use request::{NoiseTarget, ReferenceRequest};
 
-use crate::error::Result;
+use crate::error::{ReportError, Result};
 use crate::observer::Observer;
 use crate::stats::{Masks, NoiseFloor, noise_floor};
 use foundation::bvh::SceneBvh;
@@ -211,7 +211,7 @@ fn render_pass(
     current: Option<ReferenceImages>,
     count: u32,
     progress: &dyn Progress,
-) -> ReferenceImages {
+) -> Result<ReferenceImages, reference::RenderError> {
     let first = current.as_ref().map_or(0, |c| c.samples_per_half);
     let passes: Vec<ReferenceImage> = (0..2)
         .map(|k| {
@@ -220,7 +220,8 @@ fn render_pass(
                 first_sample: first,
                 ..ReferenceSettings::new(count, request.bounces, half_seed(request.seed, k))
             };
-            reference::render(
+            // Stopped when `progress` asks (Ctrl-C from Python); the same image otherwise.
+            reference::try_render(
                 &view.scene.geometry,
                 &view.bvh,
                 &view.light,
@@ -229,7 +230,7 @@ fn render_pass(
                 progress,
             )
         })
-        .collect();
+        .collect::<Result<_, _>>()?;
     let [a, b]: [ReferenceImage; 2] = passes.try_into().ok().expect("two halves");
     let visibility = weighted(&a.visibility, 1, &b.visibility, 1);
     let specular = view
@@ -251,7 +252,7 @@ fn render_pass(
             weighted(&c.visibility, first, &visibility, count),
         ),
     };
-    ReferenceImages {
+    Ok(ReferenceImages {
         radiance: weighted_image(&halves[0], 1, &halves[1], 1),
         halves,
         coverage: a.coverage,
@@ -260,7 +261,7 @@ fn render_pass(
         samples_per_half: first + count,
         cached: false,
         seconds: 0.0,
-    }
+    })
 }
 
 /// The cached reference at `paths`, if there is a readable one.
@@ -368,17 +369,17 @@ pub fn reference_images(
             bvh: SceneBvh::build(&scene.geometry.mesh),
             light: EnvironmentLight::new(map, rotation_deg),
         });
-        let images = render_pass(view, request, current, count, progress.as_ref());
-        (
+        let images = render_pass(view, request, current, count, progress.as_ref())?;
+        Ok::<_, ReportError>((
             images,
             pass_start.elapsed().as_secs_f64() / f64::from(count),
-        )
+        ))
     };
     let wanted = request.spp.div_ceil(2).max(1);
     let have = current.as_ref().map_or(0, |c| c.samples_per_half);
     if have < wanted {
         let label = format!("2 × {have} → 2 × {wanted} spp");
-        let (images, per_sample) = pass(current, wanted - have, label);
+        let (images, per_sample) = pass(current, wanted - have, label)?;
         current = Some(images);
         seconds_per_sample = Some(per_sample);
     }
@@ -394,7 +395,7 @@ pub fn reference_images(
             best_error,
         ) {
             let n = images.samples_per_half;
-            let (more, per_sample) = pass(Some(images), next - n, label);
+            let (more, per_sample) = pass(Some(images), next - n, label)?;
             images = more;
             seconds_per_sample = Some(per_sample);
         }
