@@ -87,7 +87,7 @@ pub(crate) fn report_json(
     let thresholds = thresholds.unwrap_or_else(|| vec![0.0, 0.02, 0.05, 0.1, 0.2, 0.4]);
     check_numbers(&thresholds, frames, positions, probe_spp)?;
     let backend: Backend = crate::errors::parse_choice("backend", backend)?;
-    check_output(&data, &kind, bake, &output)?;
+    check_output(&data, &kind, &output)?;
     let given = bake.map(|b| Arc::clone(&b.transfer));
     let settings = ReportSettings {
         width: camera.width,
@@ -329,13 +329,8 @@ fn check_numbers(
 }
 
 /// Refuses an output folder that holds what the report reads (it is replaced whole).
-fn check_output(
-    scene: &SceneData,
-    kind: &Kind,
-    bake: Option<&Bake>,
-    output: &Path,
-) -> PyResult<()> {
-    let _ = bake; // a `Bake` lives in memory: no file of it to spare
+fn check_output(scene: &SceneData, kind: &Kind, output: &Path) -> PyResult<()> {
+    // A `Bake` lives in memory: there is no file of it to spare.
     let mut inputs = report::output::scene_inputs(scene, &[]);
     match kind {
         Kind::Maps(maps) => inputs.extend(maps.iter().map(PathBuf::as_path)),

@@ -116,11 +116,14 @@ impl App {
             || jobs.room.is_some()
             || jobs.room_picture.is_some();
         let compositing = (self.window.renderer.as_ref()).is_some_and(|r| r.is_compositing());
-        let composite_pending = self.settings.composite
-            && (self.scene.backplate.is_some() || self.room.is_some())
-            && self.bake.transfer.is_some()
-            && !compositing;
+        let composite_pending =
+            self.composite_wanted() && self.bake.transfer.is_some() && !compositing;
         running || composite_pending
+    }
+
+    /// Whether the settings ask for a composite the scene can make (a backplate or a room).
+    fn composite_wanted(&self) -> bool {
+        self.settings.composite && (self.scene.backplate.is_some() || self.room.is_some())
     }
 
     fn composite_failed(&mut self, e: &anyhow::Error) {
@@ -230,8 +233,7 @@ impl App {
         {
             return Ok(());
         }
-        let wanted =
-            self.settings.composite && (self.scene.backplate.is_some() || self.room.is_some());
+        let wanted = self.composite_wanted();
         if self.window.renderer.is_none() || self.bake.transfer.is_none() {
             return Ok(());
         }
