@@ -4,14 +4,15 @@
 //! objects, over the changed region (proxy pixels the objects change by more than 2%) and over
 //! the whole frame, beside the truth's own noise there.
 
+use crate::ReportSettings;
 use crate::composite_truth::{Regions, Truth, true_composite};
 use crate::error::{ReportError, Result};
 use crate::gpu_composite::{CompositeForm, CompositeInputs, composite_frame};
 use crate::maps::{default_exposure, load_map, scene_rotation};
 use crate::method_lighting::method_lighting;
+use crate::methods::{Method, Technique, per_map_methods};
 use crate::observer::Observer;
 use crate::per_map::{report_renderer, unique_map_names};
-use crate::{Method, ReportSettings};
 use foundation::Rgb;
 use foundation::color::luminance;
 use foundation::image_io::{RgbImageF32, write_exr, write_png};
@@ -95,16 +96,25 @@ fn region_errors(image: &[Rgb], truth: &[Rgb], regions: &Regions) -> RegionError
 /// The methods composited, with their images' file stems: every report method in the
 /// differential form, and the mobile-AR paper's occlusion peer lit by the hybrid.
 fn methods() -> Vec<(&'static str, &'static str, Method, CompositeForm)> {
-    let mut all: Vec<_> = Method::ALL
-        .iter()
-        .map(|m| (m.name(), m.file_stem(), *m, CompositeForm::Differential))
+    let mut all: Vec<_> = per_map_methods()
+        .into_iter()
+        .map(|m| (m.name, m.file_stem, m, CompositeForm::Differential))
         .collect();
-    all.push((
-        "occlusion (mobile AR)",
-        "occlusion",
-        Method::Hybrid(DecomposeMode::Consistent),
-        CompositeForm::Occlusion,
-    ));
+    let consistent = |m: &Method| {
+        m.technique
+            == Technique::Hybrid {
+                mode: DecomposeMode::Consistent,
+                tracked: false,
+            }
+    };
+    if let Some(hybrid) = per_map_methods().into_iter().find(consistent) {
+        all.push((
+            "occlusion (mobile AR)",
+            "occlusion",
+            hybrid,
+            CompositeForm::Occlusion,
+        ));
+    }
     all
 }
 

@@ -1,8 +1,9 @@
 //! `report.html`: one self-contained page (PNGs embedded as base64, plots as inline SVG), so
 //! it can be mailed or archived on its own.
 
-use super::{MapReport, MapStatus, Method, MethodResult, Report};
+use super::{MapReport, MapStatus, MethodResult, Report};
 use crate::error::{ReportError, Result};
+use crate::methods::per_map_methods;
 use base64::Engine;
 use std::fmt::Write;
 use std::path::Path;
@@ -250,21 +251,21 @@ fn map_section(html: &mut String, map: &MapReport, out: &Path) -> Result<()> {
         &embedded_png(&dir.join("reference.png"))?,
         "reference (path traced)",
     );
-    for method in Method::ALL {
-        let png = dir.join(format!("{}.png", method.file_stem()));
-        figure(html, &embedded_png(&png)?, method.name());
+    for method in per_map_methods() {
+        let png = dir.join(format!("{}.png", method.file_stem));
+        figure(html, &embedded_png(&png)?, method.name);
     }
     html.push_str(
         "</div><div class=\"grid\"><p class=\"note\">Below each method: its error against the \
          reference, |ΔY| after tone mapping. One scale per map (the 99th percentile of PRT's \
          errors; larger errors saturate); grey pixels see no geometry.</p>",
     );
-    for method in Method::ALL {
-        let png = dir.join(format!("error-{}.png", method.file_stem()));
+    for method in per_map_methods() {
+        let png = dir.join(format!("error-{}.png", method.file_stem));
         figure(
             html,
             &embedded_png(&png)?,
-            &format!("|ΔY| after tone mapping, {}", method.name()),
+            &format!("|ΔY| after tone mapping, {}", method.name),
         );
     }
     html.push_str("</div>");

@@ -17,6 +17,7 @@ pub mod gpu_composite;
 mod html;
 pub mod maps;
 mod method_lighting;
+pub mod methods;
 mod observer;
 pub mod output;
 pub mod path;
@@ -31,8 +32,9 @@ mod truth;
 
 pub use bake::{bake_stats_lines, cached_bake};
 pub use error::{ReportError, error_chain};
+pub use methods::{Method, PEERS, Peer, Technique};
 pub use observer::{Observer, Silent};
 pub use per_map::{run_report, summary_lines};
-pub use results::{MapReport, MapStatus, Method, MethodResult, Report, SweepPoint};
+pub use results::{MapReport, MapStatus, MethodResult, Report, SweepPoint};
 pub use settings::ReportSettings;
 pub use truth::{NoiseTarget, ReferenceImages, ReferenceRequest, reference_images};

@@ -2,9 +2,9 @@
 //! making it cost on a first frame and on a later frame of a changing map.
 
 use crate::error::Result;
-use crate::results::Method;
-use runtime::render::{FrameLighting, RenderMode};
-use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
+use crate::methods::Method;
+use runtime::EnvironmentLighting;
+use runtime::render::FrameLighting;
 
 /// What making a method's lighting cost, in milliseconds.
 #[derive(Debug, Clone, Copy)]
@@ -37,26 +37,6 @@ pub(crate) fn first_frame_lighting(
     method: Method,
     threshold: f32,
 ) -> Result<(FrameLighting, usize, f64)> {
-    let (mode, render_mode) = match method {
-        Method::Prt => (DecomposeMode::Consistent, RenderMode::Prt),
-        Method::Hybrid(mode) => (mode, RenderMode::Hybrid),
-        Method::MedianCut8 | Method::MedianCut32 | Method::ShSun => {
-            let (mode, count) = match method {
-                Method::MedianCut8 => (RenderMode::MedianCut, 8),
-                Method::MedianCut32 => (RenderMode::MedianCut, 32),
-                _ => (RenderMode::ShSun, 1),
-            };
-            lighting.set_median_cut_lights(count)?;
-            let frame = lighting.frame(mode, None);
-            let lights = frame.lighting.lights.len();
-            return Ok((frame.lighting, lights, frame.ms));
-        }
-    };
-    lighting.set_settings(DecomposeSettings {
-        threshold,
-        ..DecomposeSettings::for_mode(mode, order)
-    })?;
-    let frame = lighting.frame(render_mode, None);
-    let lights = frame.lighting.lights.len();
-    Ok((frame.lighting, lights, frame.ms))
+    method.technique.configure(lighting, order, threshold)?;
+    Ok(method.technique.frame(lighting))
 }

@@ -7,8 +7,9 @@ use crate::error::{Result, error_chain};
 use crate::figures::{self, Curve};
 use crate::maps::{default_exposure, load_map, median, scene_rotation};
 use crate::method_lighting::{LightingCost, first_frame_lighting, method_lighting};
+use crate::methods::{Method, per_map_methods};
 use crate::observer::Observer;
-use crate::results::{MapReport, MapStatus, Method, MethodResult, Report, SweepPoint};
+use crate::results::{MapReport, MapStatus, MethodResult, Report, SweepPoint};
 use crate::settings::ReportSettings;
 use crate::stats::{self, Masks, NoiseFloor, error_stats};
 use crate::truth::{ReferenceImages, reference_images};
@@ -110,10 +111,10 @@ fn write_heat_maps(
         .map(|image| stats::error_image(image, reference, exposure))
         .collect();
     let scale = stats::covered_percentile(&errors[0], &masks.covered, 0.99).max(1e-3);
-    for (method, errors) in Method::ALL.iter().zip(&errors) {
+    for (method, errors) in per_map_methods().iter().zip(&errors) {
         let (w, h) = (reference.width as u32, reference.height as u32);
-        let png = figures::heat_map(errors, &masks.covered, w, h, scale, method.name())?;
-        write_atomic(&dir.join(format!("error-{}.png", method.file_stem())), &png)?;
+        let png = figures::heat_map(errors, &masks.covered, w, h, scale, method.name)?;
+        write_atomic(&dir.join(format!("error-{}.png", method.file_stem)), &png)?;
     }
     Ok(())
 }
@@ -164,7 +165,7 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> Result<MapReport> {
         .map(|(rendered, image)| {
             let stats = error_stats(image, &reference.radiance, &masks, exposure);
             MethodResult {
-                method: rendered.method.name().to_owned(),
+                method: rendered.method.name.to_owned(),
                 relative_rmse_corrected: stats::corrected_relative_rmse(
                     stats.relative_rmse,
                     &noise,
@@ -220,12 +221,12 @@ fn render_methods(
     let default_threshold = DecomposeSettings::default().threshold;
     let mut rendered = Vec::new();
     let mut images = Vec::new();
-    for method in Method::ALL {
+    for method in per_map_methods() {
         let (frame, lights, cost) = method_lighting(lighting, order, method, default_threshold)?;
         let (image, frame_ms) = render_timed(job.renderer, &frame, job.settings.frames)?;
-        write_exr(&dir.join(format!("{}.exr", method.file_stem())), &image)?;
+        write_exr(&dir.join(format!("{}.exr", method.file_stem)), &image)?;
         write_png(
-            &dir.join(format!("{}.png", method.file_stem())),
+            &dir.join(format!("{}.png", method.file_stem)),
             &image,
             exposure,
         )?;
@@ -275,7 +276,7 @@ fn threshold_sweep(
     let order = job.renderer.order();
     let mut sweep = Vec::new();
     let mut curves = Vec::new();
-    for method in Method::ALL.iter().filter(|m| m.is_hybrid()) {
+    for method in per_map_methods().iter().filter(|m| m.is_hybrid()) {
         let mut points = Vec::new();
         for &threshold in &job.settings.thresholds {
             let (frame, lights, _) = first_frame_lighting(lighting, order, *method, threshold)?;
@@ -292,13 +293,13 @@ fn threshold_sweep(
             });
         }
         curves.push(Curve {
-            label: method.name().to_owned(),
+            label: method.name.to_owned(),
             points: points
                 .iter()
                 .map(|p| (p.threshold, p.mean, p.lights))
                 .collect(),
         });
-        sweep.push((method.name().to_owned(), points));
+        sweep.push((method.name.to_owned(), points));
     }
     Ok((sweep, curves))
 }

@@ -3,61 +3,6 @@
 
 use super::settings::ReportSettings;
 use super::stats::{ErrorStats, NoiseFloor};
-use runtime::DecomposeMode;
-
-/// The methods of the comparison, in the table's order.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    /// The SH projection of the whole map (the thesis' baseline).
-    Prt,
-    /// SH part + shadow-mapped lights, from a decomposition in the given mode.
-    Hybrid(DecomposeMode),
-    /// Peer: 8 median-cut lights, shadow-mapped, nothing else.
-    MedianCut8,
-    /// Peer: 32 median-cut lights.
-    MedianCut32,
-    /// Peer: one shadowed light plus unshadowed order-3 SH irradiance.
-    ShSun,
-}
-
-impl Method {
-    pub const ALL: [Method; 6] = [
-        Method::Prt,
-        Method::Hybrid(DecomposeMode::Thesis),
-        Method::Hybrid(DecomposeMode::Consistent),
-        Method::MedianCut8,
-        Method::MedianCut32,
-        Method::ShSun,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Prt => "prt",
-            Method::Hybrid(DecomposeMode::Thesis) => "hybrid/thesis",
-            Method::Hybrid(DecomposeMode::Consistent) => "hybrid/consistent",
-            Method::MedianCut8 => "median-cut/8",
-            Method::MedianCut32 => "median-cut/32",
-            Method::ShSun => "sh-sun",
-        }
-    }
-
-    /// The method's name in file names.
-    pub fn file_stem(self) -> &'static str {
-        match self {
-            Method::Prt => "prt",
-            Method::Hybrid(DecomposeMode::Thesis) => "hybrid-thesis",
-            Method::Hybrid(DecomposeMode::Consistent) => "hybrid-consistent",
-            Method::MedianCut8 => "median-cut-8",
-            Method::MedianCut32 => "median-cut-32",
-            Method::ShSun => "sh-sun",
-        }
-    }
-
-    /// Whether the method depends on the Weber threshold (the sweep's methods).
-    pub fn is_hybrid(self) -> bool {
-        matches!(self, Method::Hybrid(_))
-    }
-}
 
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct MethodResult {

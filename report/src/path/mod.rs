@@ -16,6 +16,7 @@ pub use results::PathReport;
 use crate::error::{ReportError, Result};
 use crate::gpu_composite::PrimaryHits;
 use crate::maps::default_exposure;
+use crate::methods::{PathMap, PathMethod, TRACKED, path_methods};
 use crate::observer::Observer;
 use crate::room::{PosedModel, RoomModel};
 use crate::sequence::output::side_by_side;
@@ -29,15 +30,10 @@ use foundation::probe::Probe;
 use foundation::scene::{ObjectRole, Pose, Scene, SceneMesh, mesh_crosses};
 use glam::Vec3;
 use reference::composite::{PixelKind, composite, pixel_kinds};
-use results::{PathMethod, PathPosition, PositionResult, summarise};
-use runtime::render::{
-    FrameLighting, GpuContext, RenderMode, Renderer, ShadowCasters, ShadowSettings,
-};
-use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting, TrackingSettings};
+use results::{PathPosition, PositionResult, summarise};
+use runtime::render::{FrameLighting, GpuContext, Renderer, ShadowCasters, ShadowSettings};
+use runtime::{DecomposeMode, DecomposeSettings, EnvironmentLighting};
 use std::path::Path;
-
-/// Median-cut lights of the fusion thesis' own method.
-const MEDIAN_CUT_LIGHTS: usize = 32;
 
 /// What a path report measures besides the report's own settings.
 pub struct PathOptions {
@@ -96,7 +92,7 @@ pub fn write_path_report(
     let report = summarise(
         scene.path.display().to_string(),
         settings,
-        options.probe_spp,
+        (&path_methods(), options.probe_spp),
         per_position,
     );
     let gif_size = (camera.width * 4, camera.height);
@@ -140,7 +136,7 @@ struct PathRun {
 /// the model covered or changed there.
 struct Previous {
     truth: Vec<f32>,
-    methods: Vec<Vec<f32>>,
+    methods: Vec<(PathMethod, Vec<f32>)>,
     covered: Vec<bool>,
 }
 
@@ -166,7 +162,7 @@ impl PathRun {
         let room_centre = (room_geometry.mesh.bounds()).map_or(Vec3::ZERO, |(a, b)| 0.5 * (a + b));
         // The probe nearest the room's centre: method (a)'s.
         let one_probe = nearest(probes, room_centre);
-        let lightings = MethodLightings::new(probes, one_probe, decompose)?;
+        let lightings = MethodLightings::new(probes, one_probe, decompose.order)?;
         // The room's own light sets the exposure, as the map's does for a model in the open.
         let exposure = default_exposure(&probes[one_probe].radiance);
         let request = ReferenceRequest {
@@ -234,27 +230,30 @@ impl PathRun {
         }
         let truth_y = tonemapped_luminance(&truth.radiance, self.exposure);
         let (mut results, mut ys, mut images) = (Vec::new(), Vec::new(), Vec::new());
-        for (m, lighting) in lightings.iter().enumerate() {
+        for (method, lighting) in &lightings {
+            let name = method.method.name;
             let image = self.composite_with(&kinds, &posed, lighting)?;
             check_finite(&image, "frame").map_err(|error| ReportError::Frame {
                 frame,
-                method: PathMethod::ALL[m].name(),
+                method: name,
                 error,
             })?;
             let errors = error_image(&image, &truth.radiance, self.exposure);
             let y = tonemapped_luminance(&image, self.exposure);
-            let temporal = (self.previous.as_ref())
-                .map(|before| temporal(&y, &before.methods[m], &truth_y, &before.truth, &covered));
+            let temporal = (self.previous.as_ref()).and_then(|before| {
+                let (_, y_before) = before.methods.iter().find(|(m, _)| m == method)?;
+                Some(temporal(&y, y_before, &truth_y, &before.truth, &covered))
+            });
             results.push(PositionResult {
-                method: PathMethod::ALL[m].name().to_owned(),
+                method: name.to_owned(),
                 model: masked_mean(&errors, &on_model),
                 changed: masked_mean(&errors, &changed),
                 temporal,
                 popping: false,
                 lights: lighting.lights.len(),
             });
-            ys.push(y);
-            images.push(image);
+            ys.push((*method, y));
+            images.push((*method, image));
         }
         let model_mesh = geometry.of_role(ObjectRole::Object).mesh;
         let position = PathPosition {
@@ -273,9 +272,14 @@ impl PathRun {
             methods: ys,
             covered: here,
         });
-        let mut images = images.into_iter();
-        let mut next = || images.next().unwrap_or_else(|| truth.radiance.clone());
-        let (one, nearest, fused) = (next(), next(), next());
+        // The GIF: the tracked hybrid on one probe, on the nearest probe, on the fused map.
+        let hybrid_on = |map: PathMap| {
+            (images.iter())
+                .find(|(m, _)| m.map == map && m.method.technique == TRACKED)
+                .map_or_else(|| truth.radiance.clone(), |(_, image)| image.clone())
+        };
+        let gif = [PathMap::OneProbe, PathMap::NearestProbe, PathMap::Fused].map(hybrid_on);
+        let [one, nearest, fused] = gif;
         Ok((position, [one, nearest, fused, truth.radiance.clone()]))
     }
 
@@ -349,63 +353,84 @@ fn masked_mean(values: &[f32], mask: &[bool]) -> f64 {
     sum / count.max(1) as f64
 }
 
-/// The lighting of the methods other than the fused map's own (which `RoomModel` follows):
-/// each a map decomposed with the lights followed from position to position.
+/// Each path method's lighting, from position to position: the tracked hybrid on the fused
+/// map is the room model's own; every other method keeps its lighting and the probe it holds.
 struct MethodLightings {
-    one: EnvironmentLighting,
-    nearest: EnvironmentLighting,
-    nearest_index: usize,
-    truth: EnvironmentLighting,
-    median_cut: EnvironmentLighting,
+    methods: Vec<(PathMethod, Option<MethodLighting>)>,
+    /// The probe nearest the room's centre.
+    one: usize,
+}
+
+/// A path method's own lighting, and the probe whose map it holds (none: a map of its own
+/// position, the fused or the true probe's).
+struct MethodLighting {
+    lighting: EnvironmentLighting,
+    probe: Option<usize>,
 }
 
 impl MethodLightings {
-    fn new(probes: &[Probe], one: usize, settings: DecomposeSettings) -> Result<Self> {
-        let tracked = |map: &EnvMap| -> Result<EnvironmentLighting> {
-            let mut lighting = EnvironmentLighting::new(map, settings.clone())?;
-            lighting.enable_tracking(Some(TrackingSettings::default()))?;
-            Ok(lighting)
-        };
-        let mut median_cut = EnvironmentLighting::new(&probes[one].radiance, settings.clone())?;
-        median_cut.set_median_cut_lights(MEDIAN_CUT_LIGHTS)?;
-        Ok(Self {
-            one: tracked(&probes[one].radiance)?,
-            nearest: tracked(&probes[one].radiance)?,
-            nearest_index: one,
-            truth: tracked(&probes[one].radiance)?,
-            median_cut,
-        })
+    fn new(probes: &[Probe], one: usize, order: usize) -> Result<Self> {
+        let methods = (path_methods().into_iter())
+            .map(|method| {
+                if is_room_model(method) {
+                    return Ok((method, None));
+                }
+                let technique = method.method.technique;
+                let lighting = technique.start(&probes[one].radiance, order, 0.0)?;
+                Ok((
+                    method,
+                    Some(MethodLighting {
+                        lighting,
+                        probe: Some(one),
+                    }),
+                ))
+            })
+            .collect::<Result<_>>()?;
+        Ok(Self { methods, one })
     }
 
-    /// Every method's lighting at `centre`, in [`PathMethod::ALL`]'s order.
+    /// Every method's lighting at `centre`, in [`path_methods`]' order.
     fn at(
         &mut self,
         model: &mut RoomModel,
         centre: Vec3,
         true_probe: &Probe,
-    ) -> Result<Vec<FrameLighting>> {
+    ) -> Result<Vec<(PathMethod, FrameLighting)>> {
         let probes = model.lighting.probes();
         let near = nearest(probes, centre);
-        if near != self.nearest_index {
-            self.nearest.set_map(probes[near].radiance.clone());
-            self.nearest_index = near;
-        }
         let (cube, _) = model.lighting.local_map(centre);
         let geometry = model.lighting.geometry();
         let (w, h) = (true_probe.radiance.width(), true_probe.radiance.height());
         let fused_map = EnvMap::from_fn(w, h, 1, |d| cube.texels()[geometry.texel_of(d)]);
-        self.median_cut.set_map(fused_map);
-        self.truth.set_map(true_probe.radiance.clone());
-        let (fused, _) = model.update(centre);
-        let hybrid = |l: &mut EnvironmentLighting| l.frame(RenderMode::Hybrid, None).lighting;
-        Ok(vec![
-            hybrid(&mut self.one),
-            hybrid(&mut self.nearest),
-            fused,
-            hybrid(&mut self.truth),
-            (self.median_cut.frame(RenderMode::MedianCut, None)).lighting,
-        ])
+        let mut lightings = Vec::new();
+        for (method, own) in &mut self.methods {
+            let Some(own) = own else {
+                lightings.push((*method, model.update(centre).0));
+                continue;
+            };
+            let probes = model.lighting.probes();
+            let probe = match method.map {
+                PathMap::OneProbe => Some(self.one),
+                PathMap::NearestProbe => Some(near),
+                PathMap::Fused | PathMap::TrueProbe => None,
+            };
+            if probe.is_none() || probe != own.probe {
+                own.lighting.set_map(match (method.map, probe) {
+                    (_, Some(k)) => probes[k].radiance.clone(),
+                    (PathMap::TrueProbe, None) => true_probe.radiance.clone(),
+                    _ => fused_map.clone(),
+                });
+                own.probe = probe;
+            }
+            lightings.push((*method, method.method.technique.frame(&mut own.lighting).0));
+        }
+        Ok(lightings)
     }
+}
+
+/// Whether `method` is the room model's own: the tracked hybrid on the fused map.
+fn is_room_model(method: PathMethod) -> bool {
+    method.map == PathMap::Fused && method.method.technique == TRACKED
 }
 
 /// One position's model errors, for the terminal.

@@ -1,9 +1,10 @@
 //! The path report's files: `report.html`, `path.json`, `path.csv`, the plots along the path
 //! and the animated GIF; and its summary on the terminal.
 
-use super::results::{PathMethod, PathReport, PositionResult};
+use super::results::{PathReport, PositionResult};
 use crate::error::{ReportError, Result};
 use crate::figures;
+use crate::methods::series_by_method;
 use base64::Engine;
 use foundation::infra::atomic_file::write_atomic;
 use std::fmt::Write;
@@ -19,14 +20,11 @@ pub(super) fn write_outputs(
     out: &Path,
 ) -> Result<()> {
     let series = |value: &dyn Fn(&PositionResult) -> Option<f64>| -> Vec<(String, Vec<f64>)> {
-        (PathMethod::ALL.iter().enumerate())
-            .map(|(m, method)| {
-                let values = (report.per_position.iter())
-                    .map(|p| value(&p.methods[m]).unwrap_or(f64::NAN))
-                    .collect();
-                (method.name().to_owned(), values)
-            })
-            .collect()
+        let names = report.methods.iter().map(|m| m.method.as_str());
+        let rows: Vec<&[PositionResult]> = (report.per_position.iter())
+            .map(|p| p.methods.as_slice())
+            .collect();
+        series_by_method(names, &rows, |r| &r.method, value)
     };
     let plots = [
         (

@@ -1,44 +1,8 @@
 //! What a path report found, per position and per method.
 
+use crate::methods::{PathMap, PathMethod, TRACKED, result_of};
 use crate::sequence::temporal::{POP_FLOOR, POP_SPIKE, mark_popping};
 use crate::settings::ReportSettings;
-
-/// The lighting each method gives the model at a position of the path.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum PathMethod {
-    /// The map of the probe nearest the room's centre, everywhere: what a single capture
-    /// gives.
-    OneProbe,
-    /// The map of the probe nearest the model.
-    NearestProbe,
-    /// The local map fused from every probe at the model's centre (the fusion thesis).
-    Fused,
-    /// The true probe, path-traced at the model's centre: the best a distant-light method
-    /// can do.
-    TrueProbe,
-    /// Median cut (32 lights, no SH part) on the fused map: the fusion thesis' own choice.
-    MedianCutFused,
-}
-
-impl PathMethod {
-    pub(super) const ALL: [PathMethod; 5] = [
-        PathMethod::OneProbe,
-        PathMethod::NearestProbe,
-        PathMethod::Fused,
-        PathMethod::TrueProbe,
-        PathMethod::MedianCutFused,
-    ];
-
-    pub(super) fn name(self) -> &'static str {
-        match self {
-            PathMethod::OneProbe => "one probe",
-            PathMethod::NearestProbe => "nearest probe",
-            PathMethod::Fused => "fused",
-            PathMethod::TrueProbe => "true probe",
-            PathMethod::MedianCutFused => "median cut (fused)",
-        }
-    }
-}
 
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct PositionResult {
@@ -95,30 +59,34 @@ pub struct PathReport {
     pub per_position: Vec<PathPosition>,
 }
 
-/// Marks the popping positions and sums up each method.
+/// Marks the popping positions and sums up each of `methods`.
 pub(super) fn summarise(
     scene: String,
     settings: &ReportSettings,
-    probe_spp: u32,
+    (methods, probe_spp): (&[PathMethod], u32),
     mut per_position: Vec<PathPosition>,
 ) -> PathReport {
-    for m in 0..PathMethod::ALL.len() {
+    let names: Vec<&str> = methods.iter().map(|m| m.method.name).collect();
+    for name in &names {
         let temporal: Vec<Option<f64>> = (per_position.iter())
-            .map(|p| p.methods[m].temporal)
+            .map(|p| result_of(&p.methods, name, |r| &r.method).and_then(|r| r.temporal))
             .collect();
         for (position, popping) in per_position.iter_mut().zip(mark_popping(&temporal)) {
-            position.methods[m].popping = popping;
+            if let Some(r) = position.methods.iter_mut().find(|r| r.method == *name) {
+                r.popping = popping;
+            }
         }
     }
     let mean = |values: &mut dyn Iterator<Item = f64>| {
         let (sum, count) = values.fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
         sum / count.max(1) as f64
     };
-    let methods: Vec<MethodSummary> = (PathMethod::ALL.iter().enumerate())
-        .map(|(m, method)| {
-            let results = || per_position.iter().map(move |p| &p.methods[m]);
+    let summaries: Vec<MethodSummary> = (names.iter())
+        .map(|name| {
+            let results =
+                || (per_position.iter()).filter_map(|p| result_of(&p.methods, name, |r| &r.method));
             MethodSummary {
-                method: method.name().to_owned(),
+                method: (*name).to_owned(),
                 mean_model_error: mean(&mut results().map(|r| r.model)),
                 mean_changed_error: mean(&mut results().map(|r| r.changed)),
                 mean_temporal_error: mean(&mut results().filter_map(|r| r.temporal)),
@@ -126,19 +94,34 @@ pub(super) fn summarise(
             }
         })
         .collect();
-    let index = |method: PathMethod| PathMethod::ALL.iter().position(|m| *m == method);
-    let (one, nearest, fused, truth) = (
-        index(PathMethod::OneProbe).unwrap_or(0),
-        index(PathMethod::NearestProbe).unwrap_or(0),
-        index(PathMethod::Fused).unwrap_or(0),
-        index(PathMethod::TrueProbe).unwrap_or(0),
-    );
+    // The hybrid's map choices: one probe, the nearest, the fused map and the true probe.
+    let hybrid_on = |map: PathMap| {
+        (methods.iter())
+            .find(|m| m.map == map && m.method.technique == TRACKED)
+            .map(|m| m.method.name)
+    };
+    let error = |p: &PathPosition, map| {
+        let name = hybrid_on(map)?;
+        result_of(&p.methods, name, |r| &r.method).map(|r| r.model)
+    };
     let fused_beats_probes = (per_position.iter())
         .filter(|p| {
-            let error = |m: usize| p.methods[m].model;
-            error(fused) < error(one) && error(fused) < error(nearest)
+            let (Some(fused), Some(one), Some(nearest)) = (
+                error(p, PathMap::Fused),
+                error(p, PathMap::OneProbe),
+                error(p, PathMap::NearestProbe),
+            ) else {
+                return false;
+            };
+            fused < one && fused < nearest
         })
         .count();
+    let summary_error = |map| {
+        let name = hybrid_on(map)?;
+        result_of(&summaries, name, |s| &s.method).map(|s| s.mean_model_error)
+    };
+    let fused = summary_error(PathMap::Fused).unwrap_or(0.0);
+    let truth = summary_error(PathMap::TrueProbe).unwrap_or(0.0);
     PathReport {
         scene,
         frames: per_position.len(),
@@ -146,10 +129,9 @@ pub(super) fn summarise(
         probe_spp,
         pop_spike: POP_SPIKE,
         pop_floor: POP_FLOOR,
-        fused_over_true: methods[fused].mean_model_error
-            / methods[truth].mean_model_error.max(f64::MIN_POSITIVE),
+        fused_over_true: fused / truth.max(f64::MIN_POSITIVE),
         fused_beats_probes,
-        methods,
+        methods: summaries,
         per_position,
     }
 }

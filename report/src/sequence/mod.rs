@@ -15,6 +15,7 @@ pub use results::SequenceReport;
 use crate::env_sequence::Sequence;
 use crate::error::{ReportError, Result};
 use crate::maps::{default_exposure, scene_rotation};
+use crate::methods::{Method, TRACKED, Technique, sequence_methods};
 use crate::observer::Observer;
 use crate::per_map::report_renderer;
 use crate::stats::error_stats;
@@ -26,10 +27,10 @@ use foundation::luminance;
 use foundation::scene::Scene;
 use output::{side_by_side, write_outputs};
 use precompute::bake::Transfer;
-use results::{FrameResult, SequenceFrame, SequenceMethod, SunAccuracy, summarise};
+use results::{FrameResult, SequenceFrame, SunAccuracy, summarise};
 use runtime::DirectionalLight;
 use runtime::render::Renderer;
-use runtime::{DecomposeSettings, EnvironmentLighting, TrackingSettings};
+use runtime::{DecomposeSettings, EnvironmentLighting};
 use std::path::Path;
 use temporal::{temporal, tonemapped_luminance};
 
@@ -47,17 +48,17 @@ pub fn write_sequence_report(
     let rotation = scene_rotation(scene, None);
     let first = sequence.frame(0)?;
     let exposure = default_exposure(&first);
-    let (lightings, base_lighting) =
-        method_lightings(sequence, &first, transfer.settings.order, rotation)?;
+    let methods = sequence_methods();
+    let order = transfer.settings.order;
     let mut run = SequenceRun {
         renderer,
-        lightings,
-        base_lighting,
+        methods: (methods.iter())
+            .map(|method| MethodRun::new(*method, &first, order, rotation))
+            .collect::<Result<_>>()?,
+        base_lighting: base_lighting(sequence, order, rotation)?,
         rotation,
         exposure,
-        previous: None,
-        previous_lights: vec![None; SequenceMethod::ALL.len()],
-        light_changes: vec![0; SequenceMethod::ALL.len()],
+        previous_reference: None,
     };
     let request = ReferenceRequest {
         target_noise: None,
@@ -75,10 +76,19 @@ pub fn write_sequence_report(
         let reference = reference_images(
             scene, &camera, &map, rotation, &request, &no_limit, observer,
         )?;
-        let (results, images, sun) = run.frame(k, &map, &reference, sequence.sun(k))?;
+        let FrameMeasures {
+            results,
+            images,
+            sun,
+        } = run.frame(k, &map, &reference, sequence.sun(k))?;
         // hybrid/tracked | prt | reference
+        let image = |technique| {
+            (images.iter())
+                .find(|(m, _)| m.technique == technique)
+                .map_or(&reference.radiance, |(_, image)| image)
+        };
         gif_frames.push(side_by_side(
-            &[&images[1], &images[0], &reference.radiance],
+            &[image(TRACKED), image(Technique::Prt), &reference.radiance],
             exposure,
         ));
         observer.line(&format!(
@@ -93,7 +103,11 @@ pub fn write_sequence_report(
             reference_cached: reference.cached,
         });
     }
-    let report = summarise(scene, sequence_path, settings, frames, &run.light_changes);
+    let light_changes: Vec<(Method, usize)> = (run.methods.iter())
+        .map(|m| (m.method, m.light_changes))
+        .collect();
+    let counts = (methods.as_slice(), light_changes.as_slice());
+    let report = summarise(scene, sequence_path, settings, counts, frames);
     write_outputs(&report, &gif_frames, camera.width * 3, camera.height, out)?;
     Ok(report)
 }
@@ -101,121 +115,153 @@ pub fn write_sequence_report(
 /// The methods' state from frame to frame of a sequence report.
 struct SequenceRun {
     renderer: Renderer,
-    /// Per method, its lighting.
-    lightings: Vec<EnvironmentLighting>,
+    methods: Vec<MethodRun>,
     /// A sun sequence's base map, to measure its own level where the sun's light is.
     base_lighting: Option<EnvironmentLighting>,
     rotation: f32,
     exposure: f32,
-    /// The last frame's tone-mapped luminance: the reference's and each method's.
-    previous: Option<(Vec<f32>, Vec<Vec<f32>>)>,
-    previous_lights: Vec<Option<usize>>,
-    light_changes: Vec<usize>,
+    /// The last frame's tone-mapped luminance of the reference.
+    previous_reference: Option<Vec<f32>>,
+}
+
+/// One method's state from frame to frame.
+struct MethodRun {
+    method: Method,
+    lighting: EnvironmentLighting,
+    /// The last frame's tone-mapped luminance.
+    previous: Option<Vec<f32>>,
+    previous_lights: Option<usize>,
+    light_changes: usize,
+}
+
+impl MethodRun {
+    fn new(method: Method, first: &EnvMap, order: usize, rotation: f32) -> Result<Self> {
+        Ok(Self {
+            method,
+            lighting: method.technique.start(first, order, rotation)?,
+            previous: None,
+            previous_lights: None,
+            light_changes: 0,
+        })
+    }
+}
+
+/// A frame's measures of every method: results and images by method, and how the tracked
+/// hybrid follows a sun.
+struct FrameMeasures {
+    results: Vec<FrameResult>,
+    images: Vec<(Method, RgbImageF32)>,
+    sun: Option<SunAccuracy>,
+}
+
+/// A frame's measures of one method.
+struct Measured {
+    result: FrameResult,
+    image: RgbImageF32,
+    lights: Vec<DirectionalLight>,
 }
 
 impl SequenceRun {
     /// Renders frame `k` (`map`) with every method and measures it against `reference`: each
-    /// method's result, its image, and how the tracked hybrid follows `sun`, if any.
+    /// method's result and image, and how the tracked hybrid follows `sun`, if any.
     fn frame(
         &mut self,
         k: usize,
         map: &EnvMap,
         reference: &ReferenceImages,
         sun: Option<SunDisc>,
-    ) -> Result<(Vec<FrameResult>, Vec<RgbImageF32>, Option<SunAccuracy>)> {
-        let exposure = self.exposure;
-        let masks = reference.masks();
-        let reference_y = tonemapped_luminance(&reference.radiance, exposure);
+    ) -> Result<FrameMeasures> {
+        let reference_y = tonemapped_luminance(&reference.radiance, self.exposure);
         self.renderer.set_environment(map, self.rotation);
-        let mut results = Vec::new();
-        let mut ys = Vec::new();
-        let mut images = Vec::new();
-        let mut accuracy = None;
-        for (m, method) in SequenceMethod::ALL.iter().enumerate() {
-            let lighting = &mut self.lightings[m];
-            if k > 0 {
-                lighting.set_map(map.clone());
-            }
-            let frame = lighting.frame(method.render_mode(), None);
-            self.renderer.set_lighting(&frame.lighting)?;
-            self.renderer.render()?;
-            let image = self.renderer.read_back()?;
-            // Statistics over NaN pixels would read as numbers: refuse the frame instead.
-            check_finite(&image, "frame").map_err(|error| ReportError::Frame {
-                frame: k,
-                method: method.name(),
-                error,
-            })?;
-            let s = error_stats(&image, &reference.radiance, &masks, exposure);
-            let y = tonemapped_luminance(&image, exposure);
-            let temporal_error = self.previous.as_ref().map(|(reference_before, before)| {
-                temporal(
-                    &y,
-                    &before[m],
-                    &reference_y,
-                    reference_before,
-                    &masks.covered,
-                )
-            });
-            let lights = frame.lighting.lights.len();
-            if self.previous_lights[m].is_some_and(|p| p != lights) {
-                self.light_changes[m] += 1;
-            }
-            self.previous_lights[m] = Some(lights);
-            if *method == SequenceMethod::HybridTracked
+        let (mut results, mut images, mut accuracy) = (Vec::new(), Vec::new(), None);
+        for m in 0..self.methods.len() {
+            let measured = self.measure(k, m, map, reference, &reference_y)?;
+            let method = self.methods[m].method;
+            if method.technique == TRACKED
                 && let Some(disc) = &sun
             {
-                accuracy = sun_accuracy(
-                    &frame.lighting.lights,
-                    disc,
-                    self.rotation,
-                    self.base_lighting.as_mut(),
-                );
+                let base = self.base_lighting.as_mut();
+                accuracy = sun_accuracy(&measured.lights, disc, self.rotation, base);
             }
-            results.push(FrameResult {
-                method: method.name().to_owned(),
-                mean: s.mean,
-                shadow_mean: s.shadow_mean,
-                penumbra_mean: s.penumbra_mean,
-                temporal: temporal_error,
-                popping: false,
-                lights,
-            });
-            ys.push(y);
-            images.push(image);
+            results.push(measured.result);
+            images.push((method, measured.image));
         }
-        self.previous = Some((reference_y, ys));
-        Ok((results, images, accuracy))
+        self.previous_reference = Some(reference_y);
+        Ok(FrameMeasures {
+            results,
+            images,
+            sun: accuracy,
+        })
+    }
+
+    /// Renders frame `k` (`map`) with method `m` and measures it against `reference`
+    /// (`reference_y` its tone-mapped luminance).
+    fn measure(
+        &mut self,
+        k: usize,
+        m: usize,
+        map: &EnvMap,
+        reference: &ReferenceImages,
+        reference_y: &[f32],
+    ) -> Result<Measured> {
+        let (exposure, masks) = (self.exposure, reference.masks());
+        let run = &mut self.methods[m];
+        if k > 0 {
+            run.lighting.set_map(map.clone());
+        }
+        let (lighting, lights, _) = run.method.technique.frame(&mut run.lighting);
+        self.renderer.set_lighting(&lighting)?;
+        self.renderer.render()?;
+        let image = self.renderer.read_back()?;
+        // Statistics over NaN pixels would read as numbers: refuse the frame instead.
+        check_finite(&image, "frame").map_err(|error| ReportError::Frame {
+            frame: k,
+            method: run.method.name,
+            error,
+        })?;
+        let s = error_stats(&image, &reference.radiance, &masks, exposure);
+        let y = tonemapped_luminance(&image, exposure);
+        let temporal_error = (run.previous.as_ref().zip(self.previous_reference.as_ref())).map(
+            |(before, reference_before)| {
+                temporal(&y, before, reference_y, reference_before, &masks.covered)
+            },
+        );
+        if run.previous_lights.is_some_and(|p| p != lights) {
+            run.light_changes += 1;
+        }
+        run.previous_lights = Some(lights);
+        run.previous = Some(y);
+        let result = FrameResult {
+            method: run.method.name.to_owned(),
+            mean: s.mean,
+            shadow_mean: s.shadow_mean,
+            penumbra_mean: s.penumbra_mean,
+            temporal: temporal_error,
+            popping: false,
+            lights,
+        };
+        Ok(Measured {
+            result,
+            image,
+            lights: lighting.lights,
+        })
     }
 }
 
-/// The lighting of each method (tracking for the tracked hybrid), and of the base map of a sun
-/// sequence, which measures the map's own level where the sun's light is.
-fn method_lightings(
+/// The lighting of a sun sequence's base map, which measures the map's own level where the
+/// sun's light is.
+fn base_lighting(
     sequence: &Sequence,
-    first: &EnvMap,
     order: usize,
     rotation: f32,
-) -> Result<(Vec<EnvironmentLighting>, Option<EnvironmentLighting>)> {
+) -> Result<Option<EnvironmentLighting>> {
     let decompose = DecomposeSettings::for_mode(runtime::DecomposeMode::Consistent, order);
-    let mut lightings = Vec::new();
-    for method in SequenceMethod::ALL {
-        let mut lighting = EnvironmentLighting::new(first, decompose.clone())?;
-        if method == SequenceMethod::HybridTracked {
-            lighting.enable_tracking(Some(TrackingSettings::default()))?;
-        }
-        lighting.set_rotation(rotation);
-        lightings.push(lighting);
-    }
-    let base = match sequence.sun_base() {
-        Some(base) => {
-            let mut lighting = EnvironmentLighting::new(base, decompose)?;
-            lighting.set_rotation(rotation);
-            Some(lighting)
-        }
-        None => None,
+    let Some(base) = sequence.sun_base() else {
+        return Ok(None);
     };
-    Ok((lightings, base))
+    let mut lighting = EnvironmentLighting::new(base, decompose)?;
+    lighting.set_rotation(rotation);
+    Ok(Some(lighting))
 }
 
 /// How the light nearest the true sun `disc` follows it: its angle, and its power beyond the

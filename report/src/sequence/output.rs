@@ -1,9 +1,10 @@
 //! The sequence report's files: `report.html`, `sequence.json`, `sequence.csv`, the plots and
 //! the animated GIF; and its summary on the terminal.
 
-use super::results::{FrameResult, SequenceMethod, SequenceReport};
+use super::results::{FrameResult, SequenceReport};
 use crate::error::{ReportError, Result};
 use crate::figures;
+use crate::methods::series_by_method;
 use base64::Engine;
 use foundation::image_io::{RgbImageF32, to_display_rgb8};
 use foundation::infra::atomic_file::write_atomic;
@@ -44,18 +45,11 @@ pub(super) fn write_outputs(
     out: &Path,
 ) -> Result<()> {
     let series = |value: &dyn Fn(&FrameResult) -> Option<f64>| -> Vec<(String, Vec<f64>)> {
-        SequenceMethod::ALL
-            .iter()
-            .enumerate()
-            .map(|(m, method)| {
-                let values = report
-                    .per_frame
-                    .iter()
-                    .map(|f| value(&f.methods[m]).unwrap_or(f64::NAN))
-                    .collect();
-                (method.name().to_owned(), values)
-            })
-            .collect()
+        let names = report.methods.iter().map(|m| m.method.as_str());
+        let rows: Vec<&[FrameResult]> = (report.per_frame.iter())
+            .map(|f| f.methods.as_slice())
+            .collect();
+        series_by_method(names, &rows, |r| &r.method, value)
     };
     let error_svg = figures::time_plot(
         "error against the reference",

@@ -1,43 +1,10 @@
 //! What a sequence report found, per frame and per method.
 
 use super::temporal::{POP_FLOOR, POP_SPIKE, mark_popping};
+use crate::methods::{Method, result_of};
 use crate::settings::ReportSettings;
 use foundation::scene::Scene;
-use runtime::render::RenderMode;
 use std::path::Path;
-
-/// The methods of a sequence report.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum SequenceMethod {
-    Prt,
-    /// Lights tracked from frame to frame (hysteresis, fades).
-    HybridTracked,
-    /// Decomposed afresh every frame, as the thesis does.
-    HybridUntracked,
-}
-
-impl SequenceMethod {
-    pub(super) const ALL: [SequenceMethod; 3] = [
-        SequenceMethod::Prt,
-        SequenceMethod::HybridTracked,
-        SequenceMethod::HybridUntracked,
-    ];
-
-    pub(super) fn name(self) -> &'static str {
-        match self {
-            SequenceMethod::Prt => "prt",
-            SequenceMethod::HybridTracked => "hybrid/tracked",
-            SequenceMethod::HybridUntracked => "hybrid/untracked",
-        }
-    }
-
-    pub(super) fn render_mode(self) -> RenderMode {
-        match self {
-            SequenceMethod::Prt => RenderMode::Prt,
-            _ => RenderMode::Hybrid,
-        }
-    }
-}
 
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct FrameResult {
@@ -93,27 +60,38 @@ pub struct SequenceReport {
     pub per_frame: Vec<SequenceFrame>,
 }
 
+/// Marks the popping frames and sums up each method of `methods`; `light_changes` holds how
+/// often each method's light count changed, by method.
 pub(super) fn summarise(
     scene: &Scene,
     sequence: &Path,
     settings: &ReportSettings,
+    (methods, light_changes): (&[Method], &[(Method, usize)]),
     mut per_frame: Vec<SequenceFrame>,
-    light_changes: &[usize],
 ) -> SequenceReport {
-    for m in 0..SequenceMethod::ALL.len() {
-        let temporal: Vec<Option<f64>> = per_frame.iter().map(|f| f.methods[m].temporal).collect();
+    let of = |f: &SequenceFrame, method: &Method| -> Option<usize> {
+        f.methods.iter().position(|r| r.method == method.name)
+    };
+    for method in methods {
+        let temporal: Vec<Option<f64>> = (per_frame.iter())
+            .map(|f| of(f, method).and_then(|k| f.methods[k].temporal))
+            .collect();
         for (frame, popping) in per_frame.iter_mut().zip(mark_popping(&temporal)) {
-            frame.methods[m].popping = popping;
+            if let Some(k) = of(frame, method) {
+                frame.methods[k].popping = popping;
+            }
         }
     }
-    let methods = SequenceMethod::ALL
+    let summaries = methods
         .iter()
-        .enumerate()
-        .map(|(m, method)| {
-            let results: Vec<&FrameResult> = per_frame.iter().map(|f| &f.methods[m]).collect();
+        .map(|method| {
+            let results: Vec<&FrameResult> = (per_frame.iter())
+                .filter_map(|f| result_of(&f.methods, method.name, |r| &r.method))
+                .collect();
             let temporal: Vec<f64> = results.iter().filter_map(|r| r.temporal).collect();
+            let changes = (light_changes.iter()).find(|(m, _)| m == method);
             MethodSummary {
-                method: method.name().to_owned(),
+                method: method.name.to_owned(),
                 mean_error: results.iter().map(|r| r.mean).sum::<f64>() / results.len() as f64,
                 mean_temporal_error: if temporal.is_empty() {
                     0.0
@@ -121,7 +99,7 @@ pub(super) fn summarise(
                     temporal.iter().sum::<f64>() / temporal.len() as f64
                 },
                 popping_frames: results.iter().filter(|r| r.popping).count(),
-                light_count_changes: light_changes[m],
+                light_count_changes: changes.map_or(0, |(_, n)| *n),
             }
         })
         .collect();
@@ -137,7 +115,7 @@ pub(super) fn summarise(
         settings: settings.clone(),
         pop_spike: POP_SPIKE,
         pop_floor: POP_FLOOR,
-        methods,
+        methods: summaries,
         sun_worst,
         per_frame,
     }
