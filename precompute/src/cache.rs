@@ -1,72 +1,49 @@
-//! The bake cache: one bake per scene geometry and settings, kept in a folder shared by every
-//! caller (the program's commands, the viewer, the Python module), written atomically so that
-//! concurrent callers never read half a file.
+//! Bakes in the content-addressed cache (`foundation::infra::cache`): one bake per scene
+//! geometry and settings, shared by every caller (the program's commands, the viewer, the
+//! Python module), written atomically so that concurrent callers never read half a file.
 
 use crate::bake::{BakeError, BakeSettings, BakeStats, Transfer, bake};
 use crate::bakefile::{self, BakeFileError};
 use foundation::bvh::SceneBvh;
+use foundation::infra::cache::{CacheFolderError, CacheKey, EntryKind};
 use foundation::infra::progress::Progress;
 use foundation::scene::Scene;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Why a bake could not be cached.
 #[derive(Debug, thiserror::Error)]
 pub enum CacheError {
-    #[error(
-        "cannot use the cache folder {} (chosen by HPRT_CACHE, else XDG_CACHE_HOME, else HOME): \
-         {cause}",
-        dir.display()
-    )]
-    Folder { dir: PathBuf, cause: std::io::Error },
+    #[error(transparent)]
+    Folder(#[from] CacheFolderError),
     #[error(transparent)]
     Bake(#[from] BakeError),
     #[error(transparent)]
     File(#[from] BakeFileError),
 }
 
-/// The cache folder: `$HPRT_CACHE`, else `$XDG_CACHE_HOME/hprt`, else `~/.cache/hprt`.
-pub fn cache_dir() -> PathBuf {
-    if let Some(dir) = std::env::var_os("HPRT_CACHE") {
-        return PathBuf::from(dir);
-    }
-    if let Some(dir) = std::env::var_os("XDG_CACHE_HOME") {
-        return PathBuf::from(dir).join("hprt");
-    }
-    std::env::var_os("HOME")
-        .map(|home| PathBuf::from(home).join(".cache").join("hprt"))
-        .unwrap_or_else(|| std::env::temp_dir().join("hprt-cache"))
+/// Bakes in the cache. Version 2: keys from the one key function (`foundation::infra::cache`).
+const BAKES: EntryKind = EntryKind {
+    folder: "bakes",
+    tag: "hprt bake v2",
+};
+
+/// The key of the bake of `scene` with `settings`: the scene's geometry (mesh and materials,
+/// by content) and every setting, so any change of either misses the cache.
+pub fn bake_key(scene: &Scene, settings: &BakeSettings) -> CacheKey {
+    CacheKey::new(BAKES, |k| {
+        k.bytes(&scene.geometry.content_hash())
+            .u64(settings.order as u64)
+            .u64(settings.samples as u64)
+            .u64(settings.bounces as u64)
+            .u64(settings.seed);
+    })
 }
 
-/// Creates a folder of the cache.
-pub fn create_cache_folder(dir: &Path) -> Result<(), CacheError> {
-    let folder_error = |cause| CacheError::Folder {
-        dir: dir.to_path_buf(),
-        cause,
-    };
-    if dir.exists() && !dir.is_dir() {
-        return Err(folder_error(std::io::Error::new(
-            std::io::ErrorKind::AlreadyExists,
-            "it exists and is not a folder",
-        )));
-    }
-    std::fs::create_dir_all(dir).map_err(folder_error)
-}
-
-/// Where the bake of `scene` with `settings` is cached: the name carries the scene's mesh hash
-/// and the settings, so any change of either misses the cache.
+/// Where the bake of `scene` with `settings` is cached: named by its key, after the scene.
 pub fn bake_path(scene: &Scene, settings: &BakeSettings) -> PathBuf {
-    let hash: String = scene.geometry.content_hash()[..8]
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    cache_dir().join(format!(
-        "{}-{hash}-o{}-s{}-b{}-seed{}.bake",
-        foundation::infra::names::as_file_name(&scene.name),
-        settings.order,
-        settings.samples,
-        settings.bounces,
-        settings.seed
-    ))
+    bake_key(scene, settings)
+        .entry()
+        .labelled_file(&scene.name, "bake")
 }
 
 /// The cached bake of `scene` with `settings`, if there is a usable one (of this geometry).
@@ -82,12 +59,11 @@ pub fn bake_into_cache(
     settings: &BakeSettings,
     progress: &dyn Progress,
 ) -> Result<(PathBuf, Transfer, BakeStats), CacheError> {
-    let path = bake_path(scene, settings);
+    let entry = bake_key(scene, settings).entry();
+    let path = entry.labelled_file(&scene.name, "bake");
     let bvh = SceneBvh::build(&scene.geometry.mesh);
     let (transfer, stats) = bake(&scene.geometry, &bvh, settings, progress)?;
-    if let Some(dir) = path.parent() {
-        create_cache_folder(dir)?;
-    }
+    entry.create_folder()?;
     bakefile::write(&path, &transfer, &scene.geometry.content_hash())?;
     Ok((path, transfer, stats))
 }

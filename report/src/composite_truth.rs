@@ -7,10 +7,9 @@ use crate::error::Result;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::image_io::{RgbImageF32, read_exr, write_exr};
-use foundation::infra::atomic_file::write_atomic;
+use foundation::infra::cache::{CacheKey, Entry, EntryKind};
 use foundation::infra::progress::NoProgress;
 use foundation::scene::{Backplate, Scene, load_backplate_image};
-use precompute::cache::{cache_dir, create_cache_folder};
 use reference::composite::{PixelKind, composite, render_composite};
 use reference::{EnvironmentLight, ReferenceSettings};
 use std::path::PathBuf;
@@ -84,6 +83,13 @@ fn render(
     }
 }
 
+/// The true composites' renders in the cache. Version 2: keys from the one key function
+/// (`foundation::infra::cache`).
+const COMPOSITES: EntryKind = EntryKind {
+    folder: "composites",
+    tag: "hprt composite truth v2",
+};
+
 /// The cache key: everything the renders depend on (the backplate is applied after).
 fn key(
     scene: &Scene,
@@ -91,32 +97,32 @@ fn key(
     map: &EnvMap,
     rotation_deg: f32,
     settings: &ReportSettings,
-) -> Result<String> {
-    let mut hasher = blake3::Hasher::new();
-    hasher.update(b"hprt composite truth v1");
-    super::truth::hash_view(&mut hasher, scene, camera, map, rotation_deg)?;
-    hasher.update(&settings.bounces.to_le_bytes());
-    hasher.update(&settings.seed.to_le_bytes());
-    hasher.update(&((settings.spp / 2).max(1)).to_le_bytes());
-    hasher.update(settings.sampler.name().as_bytes());
-    Ok(hasher.finalize().to_hex()[..24].to_owned())
+) -> Result<CacheKey> {
+    CacheKey::try_new(COMPOSITES, |k| {
+        super::truth::view_inputs(k, scene, camera, map, rotation_deg)?;
+        k.u64(settings.bounces as u64)
+            .u64(settings.seed)
+            .u64(((settings.spp / 2).max(1)) as u64)
+            .str(settings.sampler.name());
+        Ok(())
+    })
 }
 
-/// A cache entry's files: five images, and a JSON file written last that makes them an
-/// entry (each written to a temporary name and renamed into place; their contents depend
-/// only on the key, so concurrent writers on a shared cache write the same bytes).
-struct Entry {
+/// A cache entry's files: five images, and a marker written last that makes them an entry
+/// (each written to a temporary name and renamed into place; their contents depend only on
+/// the key, so concurrent writers on a shared cache write the same bytes).
+struct EntryFiles {
+    entry: Entry,
     images: [PathBuf; 5],
-    done: PathBuf,
 }
 
-impl Entry {
-    fn new(key: &str) -> Self {
-        let dir = cache_dir().join("composites");
-        let file = |kind: &str| dir.join(format!("{key}.{kind}.exr"));
+impl EntryFiles {
+    fn new(key: &CacheKey) -> Self {
+        let entry = key.entry();
         Self {
-            images: ["with0", "with1", "without0", "without1", "kinds"].map(file),
-            done: dir.join(format!("{key}.json")),
+            images: ["with0", "with1", "without0", "without1", "kinds"]
+                .map(|kind| entry.file(&format!("{kind}.exr"))),
+            entry,
         }
     }
 
@@ -139,7 +145,7 @@ impl Entry {
     }
 
     fn store(&self, renders: &Renders) -> Result<()> {
-        create_cache_folder(self.done.parent().expect("a cache folder"))?;
+        self.entry.create_folder()?;
         let (w, h) = (renders.with[0].width, renders.with[0].height);
         let kinds: Vec<f32> = renders
             .kinds
@@ -161,7 +167,7 @@ impl Entry {
         for (path, image) in self.images.iter().zip(images) {
             write_exr(path, image)?;
         }
-        write_atomic(&self.done, b"{\"complete\": true}")?;
+        self.entry.commit(b"{\"complete\": true}")?;
         Ok(())
     }
 }
@@ -174,8 +180,8 @@ fn renders(
     rotation_deg: f32,
     settings: &ReportSettings,
 ) -> Result<(Renders, bool)> {
-    let entry = Entry::new(&key(scene, camera, map, rotation_deg, settings)?);
-    if entry.done.exists() {
+    let entry = EntryFiles::new(&key(scene, camera, map, rotation_deg, settings)?);
+    if entry.entry.marker().exists() {
         match entry.load() {
             Ok(renders) => return Ok((renders, true)),
             Err(e) => {

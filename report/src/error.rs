@@ -26,6 +26,8 @@ pub enum ReportError {
     MedianCut(#[from] runtime::MedianCutError),
     #[error(transparent)]
     Cache(#[from] precompute::cache::CacheError),
+    #[error(transparent)]
+    CacheFolder(#[from] foundation::infra::cache::CacheFolderError),
     /// The path tracer stopped because its progress asked (Ctrl-C from Python).
     #[error(transparent)]
     PathTraceCancelled(#[from] reference::RenderError),

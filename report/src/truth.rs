@@ -5,7 +5,7 @@
 
 mod request;
 
-pub(crate) use request::hash_view;
+pub(crate) use request::view_inputs;
 pub use request::{NoiseTarget, ReferenceRequest};
 
 use crate::error::{ReportError, Result};
@@ -15,9 +15,9 @@ use foundation::bvh::SceneBvh;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::image_io::{RgbImageF32, read_exr, write_exr};
+use foundation::infra::cache::{CacheKey, Entry};
 use foundation::infra::progress::Progress;
 use foundation::scene::Scene;
-use precompute::cache::{cache_dir, create_cache_folder};
 use reference::{
     self, EnvironmentLight, MAX_SOBOL_SAMPLES, ReferenceImage, ReferenceSettings, SamplerKind,
 };
@@ -72,15 +72,13 @@ struct CacheMeta {
     samples_per_half: u32,
 }
 
-/// A cache entry: a JSON file naming the sample count, and images named by it. Every file
-/// is written to a temporary name and renamed into place, and the images of one sample count
-/// are the same whoever renders them (the samples are deterministic), so processes on many
-/// machines sharing the cache (report shards on NFS) never see a mixed entry: the JSON,
+/// A cache entry: a marker naming the sample count, and images named by it. Every file is
+/// written to a temporary name and renamed into place, and the images of one sample count are
+/// the same whoever renders them (the samples are deterministic), so processes on many
+/// machines sharing the cache (report shards on NFS) never see a mixed entry: the marker,
 /// renamed last, names images that are complete.
 struct CachePaths {
-    dir: PathBuf,
-    key: String,
-    meta: PathBuf,
+    entry: Entry,
 }
 
 /// The images of one cache entry.
@@ -92,20 +90,12 @@ struct EntryFiles {
 }
 
 impl CachePaths {
-    fn new(key: &str) -> Self {
-        let dir = cache_dir().join("references");
-        Self {
-            meta: dir.join(format!("{key}.json")),
-            dir,
-            key: key.to_owned(),
-        }
+    fn new(key: &CacheKey) -> Self {
+        Self { entry: key.entry() }
     }
 
     fn files(&self, samples_per_half: u32) -> EntryFiles {
-        let file = |kind: &str| {
-            self.dir
-                .join(format!("{}.{samples_per_half}spp.{kind}", self.key))
-        };
+        let file = |kind: &str| self.entry.file(&format!("{samples_per_half}spp.{kind}"));
         EntryFiles {
             halves: [file("half0.exr"), file("half1.exr")],
             coverage: file("coverage.exr"),
@@ -116,7 +106,7 @@ impl CachePaths {
 
     /// `glossy`: the entry must have its specular part.
     fn load(&self, glossy: bool) -> Result<ReferenceImages> {
-        let meta: CacheMeta = serde_json::from_slice(&std::fs::read(&self.meta)?)?;
+        let meta: CacheMeta = serde_json::from_slice(&std::fs::read(self.entry.marker())?)?;
         let files = self.files(meta.samples_per_half);
         let halves = [read_exr(&files.halves[0])?, read_exr(&files.halves[1])?];
         let grey = |path: &PathBuf| -> Result<Vec<f32>> {
@@ -141,7 +131,7 @@ impl CachePaths {
     /// Writes the images, then the sample count that makes them the entry, then removes the
     /// images of the count it replaced.
     fn store(&self, images: &ReferenceImages, replaced: Option<u32>) -> Result<()> {
-        create_cache_folder(&self.dir)?;
+        self.entry.create_folder()?;
         let (w, h) = (images.radiance.width, images.radiance.height);
         let files = self.files(images.samples_per_half);
         write_exr(&files.halves[0], &images.halves[0])?;
@@ -160,7 +150,7 @@ impl CachePaths {
         let meta = CacheMeta {
             samples_per_half: images.samples_per_half,
         };
-        foundation::infra::atomic_file::write_atomic(&self.meta, &serde_json::to_vec(&meta)?)?;
+        self.entry.commit(&serde_json::to_vec(&meta)?)?;
         if let Some(old) = replaced.filter(|&n| n != images.samples_per_half) {
             let old = self.files(old);
             for path in old
@@ -266,7 +256,7 @@ fn render_pass(
 
 /// The cached reference at `paths`, if there is a readable one.
 fn cached(paths: &CachePaths, key: &str, glossy: bool) -> Option<ReferenceImages> {
-    if !paths.meta.exists() {
+    if !paths.entry.marker().exists() {
         return None;
     }
     match paths.load(glossy) {
@@ -352,7 +342,7 @@ pub fn reference_images(
 ) -> Result<ReferenceImages> {
     let key = reference_key(scene, camera, map, rotation_deg, request)?;
     let paths = CachePaths::new(&key);
-    let mut current = cached(&paths, &key, scene.geometry.is_glossy());
+    let mut current = cached(&paths, key.hex(), scene.geometry.is_glossy());
     let limit = sample_limit(request.sampler);
     let start = Instant::now();
     let mut seconds_per_sample = None;

@@ -3,6 +3,7 @@
 //! and shards of a job.
 
 pub mod atomic_file;
+pub mod cache;
 pub mod huge_pages;
 pub mod limits;
 pub mod names;

@@ -4,6 +4,7 @@
 use crate::error::Result;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
+use foundation::infra::cache::{CacheKey, EntryKind, KeyInputs};
 use foundation::scene::Scene;
 use reference::SamplerKind;
 
@@ -51,6 +52,13 @@ pub struct ReferenceRequest {
     pub exposure: f32,
 }
 
+/// References in the cache: the two halves of each sample count, coverage, visibility and
+/// the specular part. Version 5: keys from the one key function (`foundation::infra::cache`).
+const REFERENCES: EntryKind = EntryKind {
+    folder: "references",
+    tag: "hprt reference v5 (halves, files by sample count)",
+};
+
 /// Everything that determines the reference's samples, hashed: the cache key (the map by its
 /// content, so generated maps are cached too). The sample count is not in it: more samples
 /// continue the same sequence.
@@ -60,30 +68,30 @@ pub(super) fn reference_key(
     map: &EnvMap,
     rotation_deg: f32,
     request: &ReferenceRequest,
-) -> Result<String> {
-    let mut hasher = blake3::Hasher::new();
-    hasher.update(b"hprt reference v4 (halves, files by sample count)");
-    hash_view(&mut hasher, scene, camera, map, rotation_deg)?;
-    hasher.update(&request.bounces.to_le_bytes());
-    hasher.update(&request.seed.to_le_bytes());
-    hasher.update(request.sampler.name().as_bytes());
-    Ok(hasher.finalize().to_hex()[..24].to_owned())
+) -> Result<CacheKey> {
+    CacheKey::try_new(REFERENCES, |k| {
+        view_inputs(k, scene, camera, map, rotation_deg)?;
+        k.u64(request.bounces as u64)
+            .u64(request.seed)
+            .str(request.sampler.name());
+        Ok(())
+    })
 }
 
-/// Hashes what a path trace sees: the scene's mesh (and materials), the camera, the map's
-/// texels and its rotation.
-pub(crate) fn hash_view(
-    hasher: &mut blake3::Hasher,
+/// Adds what a path trace sees to a key's inputs: the scene's mesh (and materials), the
+/// camera, the map's texels and its rotation.
+pub(crate) fn view_inputs(
+    k: &mut KeyInputs,
     scene: &Scene,
     camera: &Camera,
     map: &EnvMap,
     rotation_deg: f32,
 ) -> Result<()> {
-    hasher.update(&scene.geometry.content_hash());
-    hasher.update(serde_json::to_string(camera)?.as_bytes());
-    hasher.update(&(map.width() as u64).to_le_bytes());
-    hasher.update(&(map.height() as u64).to_le_bytes());
-    hasher.update(bytemuck::cast_slice(map.texels()));
-    hasher.update(&rotation_deg.to_le_bytes());
+    k.bytes(&scene.geometry.content_hash())
+        .str(&serde_json::to_string(camera)?)
+        .u64(map.width() as u64)
+        .u64(map.height() as u64)
+        .bytes(bytemuck::cast_slice(map.texels()))
+        .f32(rotation_deg);
     Ok(())
 }
