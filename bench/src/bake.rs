@@ -160,3 +160,44 @@ pub fn bake_rays(scene_path: &Path, settings: &BakeSettings) -> Result<BakeRays>
         bytes,
     })
 }
+
+impl BakeBench {
+    /// The table's title and column names, as `hprt bench bake` prints them.
+    pub fn header(&self) -> String {
+        let s = &self.settings;
+        format!(
+            "bake benchmark: order {}, {} samples, {} bounces, {} threads, median of {}\n\
+             {:<10} {:>9} {:>11} {:>9} {:>10} {:>9} {:>15} {:>18}",
+            s.order,
+            s.samples,
+            s.bounces,
+            self.threads.unwrap_or_else(rayon::current_num_threads),
+            self.repeat,
+            "scene",
+            "vertices",
+            "rays",
+            "bake s",
+            "direct s",
+            "M rays/s",
+            "occlusion M/s",
+            "max bounce/direct"
+        )
+    }
+}
+
+impl BakeRow {
+    /// The row as the table shows it.
+    pub fn line(&self) -> String {
+        format!(
+            "{:<10} {:>9} {:>11} {:>9.2} {:>10.2} {:>9.2} {:>15.2} {:>17.1}%",
+            self.scene,
+            self.vertices,
+            self.rays,
+            self.bake_seconds,
+            self.direct_seconds,
+            self.rays_per_second / 1e6,
+            self.occlusion_per_second / 1e6,
+            100.0 * self.max_bounce_ratio
+        )
+    }
+}

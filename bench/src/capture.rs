@@ -154,6 +154,25 @@ fn median_log_error(truth: &EnvMap, captured: &EnvMap) -> f32 {
     *errors.select_nth_unstable_by(mid, f32::total_cmp).1
 }
 
+impl CaptureResult {
+    /// The figures as `hprt bench capture` prints them.
+    pub fn lines(&self) -> String {
+        let (w, h) = self.size;
+        format!(
+            "{} photographs of {w}x{h} ({:.1} megapixels) written in {:.1} s\n\
+             hprt capture: {:.1} s, peak memory {:.0} MiB\n\
+             median log-radiance error against the map photographed (after one white-balance \
+             scale per channel): {:.1}%",
+            self.photographs,
+            (w * h) as f64 / 1e6,
+            self.write_seconds,
+            self.capture.seconds,
+            self.capture.peak_mib,
+            100.0 * self.median_log_error
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -132,3 +132,45 @@ fn bench_scene(bench: &CompositeBench, gpu: &GpuContext, scene: &Scene) -> Resul
     }
     Ok(runs)
 }
+
+impl CompositeBench {
+    /// The table's title (naming the adapter) and column names.
+    pub fn header(&self, adapter: &str) -> String {
+        format!(
+            "live composite benchmark on {adapter}: {}x{}, hybrid, median of {} frames x {} \
+             repeats\n{:<20} {:>10} {:>13} {:>8} {:>11} {:>14} {:>8}",
+            self.width,
+            self.height,
+            self.frames,
+            self.repeats,
+            "scene",
+            "whole ms",
+            "composite ms",
+            "ratio",
+            "whole dyn",
+            "composite dyn",
+            "ratio"
+        )
+    }
+}
+
+/// What the table's columns mean.
+pub const COMPOSITE_NOTE: &str = "whole: the same scene drawn with its proxies as ordinary \
+    objects; dyn: the map turning a degree a frame (vertex radiance and shadow maps redone \
+    every frame); ratio: the median of each repeat's composite / whole.";
+
+impl CompositeRow {
+    /// The row as the table shows it.
+    pub fn line(&self) -> String {
+        format!(
+            "{:<20} {:>10.2} {:>13.2} {:>8.3} {:>11.2} {:>14.2} {:>8.3}",
+            self.scene,
+            self.whole,
+            self.composite,
+            self.ratio,
+            self.whole_dynamic,
+            self.composite_dynamic,
+            self.dynamic_ratio
+        )
+    }
+}

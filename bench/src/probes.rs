@@ -211,3 +211,43 @@ fn path_through(probes: &[Probe], steps: usize) -> Result<Vec<Vec3>> {
         .map(|k| path.at((k as f32 + 0.5) / steps as f32).centre)
         .collect())
 }
+
+impl ProbesResult {
+    /// The figures as `hprt bench probes` prints them.
+    pub fn lines(&self, bench: &ProbesBench) -> String {
+        let mut text = format!(
+            "{}: {} probes, {} positions along the path, 6×{}² local maps, {} mode, order {}, \
+             {} threads\n\
+             median ms per update: local map {:.3}, decomposition {:.3}, together {:.3}; \
+             unseen texels {:.2}%\n\
+             lights {}-{}, {} changes of their number; largest step of the lights' power at a \
+             change {:.3} of their most",
+            self.scene,
+            self.probes,
+            self.positions,
+            bench.face,
+            bench.mode.name(),
+            bench.order,
+            self.threads,
+            self.fuse_ms,
+            self.decompose_ms,
+            self.update_ms,
+            100.0 * self.unseen_share,
+            self.min_lights,
+            self.max_lights,
+            self.light_count_changes,
+            self.largest_power_step
+        );
+        if let Some(s) = &self.soft_shadow {
+            text += &format!(
+                "\nthe model's soft shadow on the room: {:.3} ms per update (median of {}), {} \
+                 rays per room vertex",
+                s.ms, s.updates, s.rays
+            );
+        }
+        if !self.truth.is_empty() {
+            text += &truth::lines(&self.truth);
+        }
+        text
+    }
+}

@@ -140,3 +140,46 @@ impl ReferenceRun {
         }))
     }
 }
+
+impl ReferenceRun {
+    /// The benchmark's settings and hprt's figures, as `hprt bench reference` prints them.
+    pub fn lines(&self, bench: &ReferenceBench) -> String {
+        let r = &self.result;
+        format!(
+            "reference benchmark: {} {}x{}, {} spp, {} bounces, {} threads, median of {}\n\
+             hprt: {:.2} s, {:.2} M rays/s, {:.3} s per megapixel per sample",
+            r.scene,
+            bench.width,
+            bench.height,
+            bench.spp,
+            bench.bounces,
+            bench.threads.unwrap_or_else(rayon::current_num_threads),
+            bench.repeat,
+            r.seconds,
+            r.rays_per_second / 1e6,
+            r.seconds_per_megapixel_sample
+        )
+    }
+}
+
+/// Said when no Python with Mitsuba 3 is found.
+pub const NO_MITSUBA: &str =
+    "Mitsuba 3 not found (pip install mitsuba, or set HPRT_MITSUBA_PYTHON): no comparison";
+
+impl MitsubaComparison {
+    /// Mitsuba's figures beside hprt's.
+    pub fn line(&self) -> String {
+        format!(
+            "Mitsuba {} {}: {:.2} s (median of {}; the first, with kernel compilation, {:.2} s); \
+             hprt takes {:.2}x Mitsuba's time; mean radiance of covered pixels: hprt {:+.2}% \
+             from Mitsuba",
+            self.version,
+            self.variant,
+            self.seconds,
+            self.renders,
+            self.first_seconds,
+            self.time_ratio,
+            100.0 * self.mean_difference
+        )
+    }
+}

@@ -131,3 +131,31 @@ fn time_prefilter(
     }
     Ok(times)
 }
+
+/// The table's column names.
+pub fn reflections_header() -> String {
+    format!(
+        "{:>6} {:>10} {:>16} {:>18}",
+        "face", "shininess", "GPU prefilter ms", "CPU remainder ms"
+    )
+}
+
+/// What the table's columns mean.
+pub const REFLECTIONS_NOTE: &str = "GPU prefilter: the remainder's mip chain uploaded and every \
+    face of every shininess convolved (a lighting change); CPU remainder: the map resampled to \
+    the face size and clipped in the lights' caps (the first frame; later changes reuse the \
+    resampled map).";
+
+impl ReflectionsRow {
+    /// The row as the table shows it.
+    pub fn line(&self) -> String {
+        let shininess: Vec<String> = self.shininess.iter().map(f32::to_string).collect();
+        format!(
+            "{:>6} {:>10} {:>16.1} {:>18.1}",
+            format!("6x{}²", self.face_size),
+            shininess.join(","),
+            self.gpu_prefilter_ms,
+            self.cpu_remainder_ms
+        )
+    }
+}

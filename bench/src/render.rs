@@ -168,3 +168,67 @@ fn dynamic_frames(
     })?;
     Ok((frame_ms, median(cpu_ms)))
 }
+
+impl RenderBench {
+    /// The table's title (naming the adapter) and column names.
+    pub fn header(&self, adapter: &str) -> String {
+        let sized = if self.shadow.from_angular_radius {
+            " sized from the light radius"
+        } else {
+            ""
+        };
+        let s = &self.shadow;
+        format!(
+            "render benchmark on {adapter}: {}x{}, {} lights, {}² shadow maps, PCF {}x{}{sized}, \
+             median of {} frames\n\
+             {:<14} {:>10} {:>12} {:>8} {:>11} {:>13} {:>8} {:>13} {:>10} {:>16}",
+            self.width,
+            self.height,
+            self.lights,
+            s.resolution,
+            s.pcf_taps,
+            s.pcf_taps,
+            self.frames,
+            "scene",
+            "prt ms",
+            "hybrid ms",
+            "ratio",
+            "prt dyn ms",
+            "hybrid dyn ms",
+            "ratio",
+            "CPU/frame ms",
+            "rotate ms",
+            "unshadowed ms"
+        )
+    }
+}
+
+/// What the table's last columns mean.
+pub const RENDER_NOTE: &str = "CPU/frame: decomposing the changed map, rotating it and setting \
+    the lighting (face size 64); rotate: the same for a map that only turns (the decomposition \
+    is rotated).";
+
+impl RenderRow {
+    /// The row as the table shows it, after a note when the map gave other than `asked` lights.
+    pub fn line(&self, asked: usize) -> String {
+        let note = if self.lights != asked {
+            format!("note: the map gives {} lights\n", self.lights)
+        } else {
+            String::new()
+        };
+        format!(
+            "{note}{:<14} {:>10.2} {:>12.2} {:>8.2} {:>11.2} {:>13.2} {:>8.2} {:>13.3} {:>10.4} \
+             {:>16.2}",
+            self.scene,
+            self.prt,
+            self.hybrid,
+            self.static_ratio(),
+            self.prt_dynamic,
+            self.hybrid_dynamic,
+            self.dynamic_ratio(),
+            self.cpu_per_frame,
+            self.rotate,
+            self.unshadowed
+        )
+    }
+}

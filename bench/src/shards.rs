@@ -157,3 +157,49 @@ impl Shards {
         })
     }
 }
+
+impl Shards {
+    /// The line before the one-machine bake.
+    pub fn title(&self) -> String {
+        format!(
+            "{}: {} triangles; each process run alone, one after another",
+            self.scene.display(),
+            self.triangles
+        )
+    }
+}
+
+/// The one-machine bake's cost, and the table's column names.
+pub fn shards_header(whole: &Run) -> String {
+    format!(
+        "one machine: {:.2} s, peak {:.0} MiB\n{:>3} {:>22} {:>22} {:>16} {:>14} {:>13}",
+        whole.seconds,
+        whole.peak_mib,
+        "N",
+        "shard s (min-max)",
+        "shard MiB (min-max)",
+        "merge s / MiB",
+        "sum / one",
+        "max MiB / one"
+    )
+}
+
+/// What every row was checked for, and what its times hold.
+pub const SHARDS_NOTE: &str = "every merge equals the one-machine bake byte for byte; shard \
+    times include each process's scene load, BVH build and cost estimate";
+
+impl ShardRow {
+    /// The row as the table shows it.
+    pub fn line(&self) -> String {
+        let (t, m) = (self.seconds, self.peak_mib);
+        format!(
+            "{:>3} {:>22} {:>22} {:>16} {:>14.3} {:>13.3}",
+            self.count,
+            format!("{:.2}-{:.2}", t.min, t.max),
+            format!("{:.0}-{:.0}", m.min, m.max),
+            format!("{:.2} / {:.0}", self.merge.seconds, self.merge.peak_mib),
+            self.time_over_one,
+            self.memory_over_one
+        )
+    }
+}

@@ -174,6 +174,57 @@ fn power_variation(powers: &[f64]) -> f64 {
     if mean > 0.0 { (hi - lo) / mean } else { 0.0 }
 }
 
+impl TurnBench {
+    /// The table's title and column names.
+    pub fn header(&self) -> String {
+        format!(
+            "a full turn in {}° steps, {} mode, order {}: light-count changes, lights (min-max), \
+             total light power (max-min)/mean, strongest light's direction error, CPU per \
+             frame\n{:<10} {:<12} {:>8} {:>7} {:>9} {:>10} {:>12} {:>26}",
+            self.step,
+            self.mode.name(),
+            self.order,
+            "map",
+            "method",
+            "changes",
+            "lights",
+            "power",
+            "dir err °",
+            "ms/frame",
+            "resample/decompose/sources"
+        )
+    }
+}
+
+/// What the table's methods and columns mean.
+pub const TURN_NOTE: &str = "redecompose: the turned map resampled and decomposed every frame \
+    (the thesis' way); rotate: decomposed once in the map's frame, SH part and lights rotated \
+    per frame. ms/frame and its stages are medians of one thread's time; the decomposition \
+    proper (the middle stage) is what `cargo bench -p runtime --bench decompose` times.";
+
+impl TurnRow {
+    /// The row as the table shows it.
+    pub fn line(&self) -> String {
+        let stages = (self.stages)
+            .map(|c| {
+                let (r, d, s) = (c.resample_ms, c.decompose_ms, c.sources_ms);
+                format!("{r:.3}/{d:.3}/{s:.3}")
+            })
+            .unwrap_or_default();
+        format!(
+            "{:<10} {:<12} {:>8} {:>7} {:>8.2}% {:>10.3} {:>12.4} {:>26}",
+            self.map,
+            self.method.name(),
+            self.count_changes,
+            format!("{}-{}", self.min_lights, self.max_lights),
+            100.0 * self.power_variation,
+            self.direction_error_deg,
+            self.frame_ms,
+            stages
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -219,3 +219,33 @@ fn opencv_responses(
         })
         .collect()
 }
+
+impl CamerasBench {
+    /// The table's column names, after a line saying OpenCV is skipped when it is.
+    pub fn header(&self) -> String {
+        let skipped = match self.opencv {
+            true => "",
+            false => "OpenCV's calibrations skipped: python3 with opencv-python is not installed\n",
+        };
+        format!(
+            "{skipped}{:<10} {:<6} {:<17} {:>10} {:>8} {:>10} {:>7}",
+            "camera", "views", "response", "median log", "chroma", "light pow", "angle"
+        )
+    }
+}
+
+impl CameraRow {
+    /// The row as the table shows it.
+    pub fn line(&self) -> String {
+        format!(
+            "{:<10} {:<6} {:<17} {:>9.2}% {:>7.2}% {:>9.3}x {:>6.2}°",
+            self.camera,
+            if self.ball { "ball" } else { "shots" },
+            self.response,
+            100.0 * self.median_log,
+            100.0 * self.chroma,
+            self.light_power,
+            self.light_angle_deg
+        )
+    }
+}

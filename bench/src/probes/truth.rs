@@ -120,6 +120,31 @@ pub fn map_errors(geometry: &CubeGeometry, map: &CubeMap, truth: &CubeMap) -> Ma
     }
 }
 
+/// The table of `points`, after a newline, and how often the fused map is the closest.
+pub(super) fn lines(points: &[TruthPoint]) -> String {
+    let mut text = format!(
+        "\nagainst the true probe (path-traced, 256×128): irradiance error (relative RMS over \
+         26 normals) / map error (relative L1 of luminance)\n{:<24} {:>17} {:>17} {:>17}",
+        "point", "fused", "nearest probe", "one probe"
+    );
+    let cell = |e: MapErrors| format!("{:.3} / {:.3}", e.irradiance, e.map);
+    for t in points {
+        text += &format!(
+            "\n{:<24} {:>17} {:>17} {:>17}",
+            format!("{}", t.point),
+            cell(t.fused),
+            cell(t.nearest_probe),
+            cell(t.one_probe)
+        );
+    }
+    let wins = points.iter().filter(|t| t.fused_is_closest()).count();
+    text += &format!(
+        "\nthe fused map's irradiance is the closest at {wins} of {} points",
+        points.len()
+    );
+    text
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,6 +1,6 @@
 //! `hprt bench bake`: the bake's throughput.
 
-use super::Rows;
+use super::rows::Rows;
 use crate::outputs::{check_outputs, open_outputs, write_outputs};
 use anyhow::Context;
 use bench::bake::{BakeBench, BakeRow, bake_rays, bench_bake as measure};
@@ -46,47 +46,15 @@ pub(super) fn bench_bake(args: BenchBakeArgs) -> anyhow::Result<()> {
             .context("no scene to take the rays of")?;
         dump_rays(scene_path, &settings, path)?;
     }
-    println!(
-        "bake benchmark: order {}, {} samples, {} bounces, {} threads, median of {}",
-        args.order,
-        args.samples,
-        args.bounces,
-        args.threads.unwrap_or_else(rayon::current_num_threads),
-        args.repeat
-    );
-    println!(
-        "{:<10} {:>9} {:>11} {:>9} {:>10} {:>9} {:>15} {:>18}",
-        "scene",
-        "vertices",
-        "rays",
-        "bake s",
-        "direct s",
-        "M rays/s",
-        "occlusion M/s",
-        "max bounce/direct"
-    );
     let bench = BakeBench {
         scenes: args.scenes,
         settings,
         repeat: args.repeat,
         threads: args.threads,
     };
-    measure(&bench, &Rows(print_row))?;
+    println!("{}", bench.header());
+    measure(&bench, &Rows(|row: &BakeRow| println!("{}", row.line())))?;
     Ok(())
-}
-
-fn print_row(row: &BakeRow) {
-    println!(
-        "{:<10} {:>9} {:>11} {:>9.2} {:>10.2} {:>9.2} {:>15.2} {:>17.1}%",
-        row.scene,
-        row.vertices,
-        row.rays,
-        row.bake_seconds,
-        row.direct_seconds,
-        row.rays_per_second / 1e6,
-        row.occlusion_per_second / 1e6,
-        100.0 * row.max_bounce_ratio
-    );
 }
 
 /// Writes the bake's rays of the scene at `scene_path` (layout: [`bake_rays`]) to `path`.

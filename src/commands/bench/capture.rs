@@ -6,7 +6,7 @@
 //! capture was made so, at 160 × 120). `--camera NAME|all` runs the battery of cameras
 //! instead (`bench::capture::cameras`).
 
-use super::Rows;
+use super::rows::Rows;
 use bench::capture::cameras::{CameraRow, CamerasBench, bench_cameras, opencv_available};
 use bench::capture::{CaptureBench, TIMES, bench_capture as measure};
 use clap::Args;
@@ -60,52 +60,17 @@ pub(super) fn bench_capture(args: BenchCaptureArgs) -> anyhow::Result<()> {
         times: args.times,
         width: args.width,
         keep: args.keep,
-        program: super::this_program()?,
+        program: super::rows::this_program()?,
     };
-    let r = measure(&bench)?;
-    let (w, h) = r.size;
-    println!(
-        "{} photographs of {w}x{h} ({:.1} megapixels) written in {:.1} s",
-        r.photographs,
-        (w * h) as f64 / 1e6,
-        r.write_seconds
-    );
-    println!(
-        "hprt capture: {:.1} s, peak memory {:.0} MiB",
-        r.capture.seconds, r.capture.peak_mib
-    );
-    println!(
-        "median log-radiance error against the map photographed (after one white-balance scale \
-         per channel): {:.1}%",
-        100.0 * r.median_log_error
-    );
+    println!("{}", measure(&bench)?.lines());
     Ok(())
 }
 
 /// The battery of cameras, a row per camera, kind of views and response.
 fn cameras(bench: &CamerasBench) -> anyhow::Result<()> {
-    if !bench.opencv {
-        println!("OpenCV's calibrations skipped: python3 with opencv-python is not installed");
-    }
-    println!(
-        "{:<10} {:<6} {:<17} {:>10} {:>8} {:>10} {:>7}",
-        "camera", "views", "response", "median log", "chroma", "light pow", "angle"
-    );
-    bench_cameras(bench, &Rows(print_camera_row))?;
+    println!("{}", bench.header());
+    bench_cameras(bench, &Rows(|row: &CameraRow| println!("{}", row.line())))?;
     Ok(())
-}
-
-fn print_camera_row(row: &CameraRow) {
-    println!(
-        "{:<10} {:<6} {:<17} {:>9.2}% {:>7.2}% {:>9.3}x {:>6.2}°",
-        row.camera,
-        if row.ball { "ball" } else { "shots" },
-        row.response,
-        100.0 * row.median_log,
-        100.0 * row.chroma,
-        row.light_power,
-        row.light_angle_deg
-    );
 }
 
 /// `WIDTHxHEIGHT`, each from 8 to 16384.

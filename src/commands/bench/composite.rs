@@ -1,8 +1,8 @@
 //! `hprt bench composite`: what the live composite adds to a frame (issue 31's target: at
 //! most 20% over the same scene drawn whole).
 
-use super::Rows;
-use bench::composite::{CompositeBench, CompositeRow, bench_composite as measure};
+use super::rows::Rows;
+use bench::composite::{COMPOSITE_NOTE, CompositeBench, CompositeRow, bench_composite as measure};
 use clap::Args;
 use runtime::render::GpuContext;
 use std::path::PathBuf;
@@ -32,18 +32,6 @@ pub struct BenchCompositeArgs {
 
 pub(super) fn bench_composite(args: BenchCompositeArgs) -> anyhow::Result<()> {
     let gpu = GpuContext::headless(args.backend)?;
-    println!(
-        "live composite benchmark on {}: {}x{}, hybrid, median of {} frames x {} repeats",
-        gpu.description(),
-        args.width,
-        args.height,
-        args.frames,
-        args.repeats
-    );
-    println!(
-        "{:<20} {:>10} {:>13} {:>8} {:>11} {:>14} {:>8}",
-        "scene", "whole ms", "composite ms", "ratio", "whole dyn", "composite dyn", "ratio"
-    );
     let bench = CompositeBench {
         scenes: args.scenes,
         width: args.width,
@@ -52,24 +40,12 @@ pub(super) fn bench_composite(args: BenchCompositeArgs) -> anyhow::Result<()> {
         repeats: args.repeats,
         bake_samples: args.bake_samples,
     };
-    measure(&bench, &gpu, &Rows(print_row))?;
-    println!(
-        "whole: the same scene drawn with its proxies as ordinary objects; dyn: the map turning a \
-         degree a frame (vertex radiance and shadow maps redone every frame); ratio: the median of \
-         each repeat's composite / whole."
-    );
+    println!("{}", bench.header(&gpu.description().to_string()));
+    measure(
+        &bench,
+        &gpu,
+        &Rows(|row: &CompositeRow| println!("{}", row.line())),
+    )?;
+    println!("{COMPOSITE_NOTE}");
     Ok(())
-}
-
-fn print_row(t: &CompositeRow) {
-    println!(
-        "{:<20} {:>10.2} {:>13.2} {:>8.3} {:>11.2} {:>14.2} {:>8.3}",
-        t.scene,
-        t.whole,
-        t.composite,
-        t.ratio,
-        t.whole_dynamic,
-        t.composite_dynamic,
-        t.dynamic_ratio
-    );
 }

@@ -7,10 +7,10 @@ mod probes;
 mod reference;
 mod reflections;
 mod render;
+mod rows;
 mod shards;
 mod turn;
 
-use anyhow::Context;
 use bake::{BenchBakeArgs, bench_bake};
 use capture::{BenchCaptureArgs, bench_capture};
 use clap::Subcommand;
@@ -64,18 +64,4 @@ pub fn run(command: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Capture(args) => bench_capture(args),
         BenchCommand::Probes(args) => bench_probes(args),
     }
-}
-
-/// Prints each row as the benchmark measures it.
-struct Rows<F>(F);
-
-impl<R, F: Fn(&R) + Sync> bench::Reporter<R> for Rows<F> {
-    fn row(&self, row: &R) {
-        (self.0)(row)
-    }
-}
-
-/// This hprt, which the benchmarks that time whole commands run.
-fn this_program() -> anyhow::Result<std::path::PathBuf> {
-    std::env::current_exe().context("cannot find this hprt's own path")
 }

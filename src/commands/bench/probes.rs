@@ -4,7 +4,7 @@
 
 use crate::cli::EnvironmentArgs;
 use bench::EnvironmentChoice;
-use bench::probes::{MapErrors, ProbesBench, ProbesResult, bench_probes as measure};
+use bench::probes::{ProbesBench, bench_probes as measure};
 use clap::Args;
 use runtime::DecomposeMode;
 use std::path::PathBuf;
@@ -58,72 +58,6 @@ pub(super) fn bench_probes(args: BenchProbesArgs) -> anyhow::Result<()> {
             rotate,
         },
     };
-    let r = measure(&bench)?;
-    println!(
-        "{}: {} probes, {} positions along the path, 6×{}² local maps, {} mode, order {}, {} \
-         threads",
-        r.scene,
-        r.probes,
-        r.positions,
-        args.face,
-        args.mode.name(),
-        args.order,
-        r.threads
-    );
-    print_measures(&r);
-    if !r.truth.is_empty() {
-        print_truth(&r);
-    }
+    println!("{}", measure(&bench)?.lines(&bench));
     Ok(())
-}
-
-/// The costs, the lights' steadiness and the soft shadow's cost.
-fn print_measures(r: &ProbesResult) {
-    println!(
-        "median ms per update: local map {:.3}, decomposition {:.3}, together {:.3}; \
-         unseen texels {:.2}%",
-        r.fuse_ms,
-        r.decompose_ms,
-        r.update_ms,
-        100.0 * r.unseen_share
-    );
-    println!(
-        "lights {}-{}, {} changes of their number; largest step of the lights' power \
-         at a change {:.3} of their most",
-        r.min_lights, r.max_lights, r.light_count_changes, r.largest_power_step
-    );
-    if let Some(s) = &r.soft_shadow {
-        println!(
-            "the model's soft shadow on the room: {:.3} ms per update (median of {}), {} rays per \
-             room vertex",
-            s.ms, s.updates, s.rays
-        );
-    }
-}
-
-/// Each point's errors against the true probe.
-fn print_truth(r: &ProbesResult) {
-    println!(
-        "against the true probe (path-traced, 256×128): irradiance error (relative RMS over 26 \
-         normals) / map error (relative L1 of luminance)"
-    );
-    println!(
-        "{:<24} {:>17} {:>17} {:>17}",
-        "point", "fused", "nearest probe", "one probe"
-    );
-    let cell = |e: MapErrors| format!("{:.3} / {:.3}", e.irradiance, e.map);
-    for t in &r.truth {
-        println!(
-            "{:<24} {:>17} {:>17} {:>17}",
-            format!("{}", t.point),
-            cell(t.fused),
-            cell(t.nearest_probe),
-            cell(t.one_probe)
-        );
-    }
-    let wins = r.truth.iter().filter(|t| t.fused_is_closest()).count();
-    println!(
-        "the fused map's irradiance is the closest at {wins} of {} points",
-        r.truth.len()
-    );
 }

@@ -1,6 +1,6 @@
 //! `hprt bench reference`: the reference renderer's speed.
 
-use bench::reference::{ReferenceBench, bench_reference as measure};
+use bench::reference::{NO_MITSUBA, ReferenceBench, bench_reference as measure};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -39,43 +39,13 @@ pub(super) fn bench_reference(args: BenchReferenceArgs) -> anyhow::Result<()> {
         threads: args.threads,
     };
     let run = measure(&bench)?;
-    let r = &run.result;
-    println!(
-        "reference benchmark: {} {}x{}, {} spp, {} bounces, {} threads, median of {}",
-        r.scene,
-        args.width,
-        args.height,
-        args.spp,
-        args.bounces,
-        args.threads.unwrap_or_else(rayon::current_num_threads),
-        args.repeat
-    );
-    println!(
-        "hprt: {:.2} s, {:.2} M rays/s, {:.3} s per megapixel per sample",
-        r.seconds,
-        r.rays_per_second / 1e6,
-        r.seconds_per_megapixel_sample
-    );
+    println!("{}", run.lines(&bench));
     if args.no_mitsuba {
         return Ok(());
     }
-    let Some(m) = run.compare_with_mitsuba(args.repeat.max(1))? else {
-        println!(
-            "Mitsuba 3 not found (pip install mitsuba, or set HPRT_MITSUBA_PYTHON): no comparison"
-        );
-        return Ok(());
-    };
-    println!(
-        "Mitsuba {} {}: {:.2} s (median of {}; the first, with kernel compilation, \
-         {:.2} s); hprt takes {:.2}x Mitsuba's time; mean radiance of covered pixels: hprt \
-         {:+.2}% from Mitsuba",
-        m.version,
-        m.variant,
-        m.seconds,
-        m.renders,
-        m.first_seconds,
-        m.time_ratio,
-        100.0 * m.mean_difference
-    );
+    match run.compare_with_mitsuba(args.repeat.max(1))? {
+        Some(comparison) => println!("{}", comparison.line()),
+        None => println!("{NO_MITSUBA}"),
+    }
     Ok(())
 }

@@ -1,8 +1,9 @@
 //! `hprt bench reflections`: the GPU time of prefiltering glossy reflections.
 
-use super::Rows;
+use super::rows::Rows;
 use bench::reflections::{
-    ReflectionsBench, ReflectionsInputs, ReflectionsRow, bench_reflections as measure,
+    REFLECTIONS_NOTE, ReflectionsBench, ReflectionsInputs, ReflectionsRow,
+    bench_reflections as measure, reflections_header,
 };
 use clap::Args;
 use runtime::render::GpuContext;
@@ -36,26 +37,13 @@ pub(super) fn bench_reflections(args: BenchReflectionsArgs) -> anyhow::Result<()
     let inputs = ReflectionsInputs::load(&bench)?;
     let gpu = GpuContext::headless(args.backend)?;
     println!("adapter: {}", gpu.description());
-    println!(
-        "{:>6} {:>10} {:>16} {:>18}",
-        "face", "shininess", "GPU prefilter ms", "CPU remainder ms"
-    );
-    measure(&bench, &inputs, &gpu, &Rows(print_row))?;
-    println!(
-        "GPU prefilter: the remainder's mip chain uploaded and every face of every shininess \
-         convolved (a lighting change); CPU remainder: the map resampled to the face size and \
-         clipped in the lights' caps (the first frame; later changes reuse the resampled map)."
-    );
+    println!("{}", reflections_header());
+    measure(
+        &bench,
+        &inputs,
+        &gpu,
+        &Rows(|row: &ReflectionsRow| println!("{}", row.line())),
+    )?;
+    println!("{REFLECTIONS_NOTE}");
     Ok(())
-}
-
-fn print_row(row: &ReflectionsRow) {
-    let shininess: Vec<String> = row.shininess.iter().map(f32::to_string).collect();
-    println!(
-        "{:>6} {:>10} {:>16.1} {:>18.1}",
-        format!("6x{}²", row.face_size),
-        shininess.join(","),
-        row.gpu_prefilter_ms,
-        row.cpu_remainder_ms
-    );
 }

@@ -1,8 +1,8 @@
 //! `hprt bench render`: GPU frame times of prt and hybrid, and the CPU work per frame.
 
-use super::Rows;
+use super::rows::Rows;
 use crate::cli::Switch;
-use bench::render::{RenderBench, RenderRow, bench_render as measure};
+use bench::render::{RENDER_NOTE, RenderBench, RenderRow, bench_render as measure};
 use clap::Args;
 use runtime::render::{GpuContext, ShadowSettings};
 use std::path::PathBuf;
@@ -43,35 +43,6 @@ pub struct BenchRenderArgs {
 
 pub(super) fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
     let gpu = GpuContext::headless(args.backend)?;
-    println!(
-        "render benchmark on {}: {}x{}, {} lights, {}² shadow maps, PCF {}x{}{}, median of {} frames",
-        gpu.description(),
-        args.width,
-        args.height,
-        args.lights,
-        args.shadow_res,
-        args.pcf,
-        args.pcf,
-        if args.pcf_from_radius.is_on() {
-            " sized from the light radius"
-        } else {
-            ""
-        },
-        args.frames
-    );
-    println!(
-        "{:<14} {:>10} {:>12} {:>8} {:>11} {:>13} {:>8} {:>13} {:>10} {:>16}",
-        "scene",
-        "prt ms",
-        "hybrid ms",
-        "ratio",
-        "prt dyn ms",
-        "hybrid dyn ms",
-        "ratio",
-        "CPU/frame ms",
-        "rotate ms",
-        "unshadowed ms"
-    );
     let bench = RenderBench {
         scenes: args.scenes,
         env: args.env,
@@ -86,30 +57,13 @@ pub(super) fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
         frames: args.frames,
         bake_samples: args.bake_samples,
     };
+    println!("{}", bench.header(&gpu.description().to_string()));
     let lights = args.lights;
-    measure(&bench, &gpu, &Rows(|t: &RenderRow| print_row(t, lights)))?;
-    println!(
-        "CPU/frame: decomposing the changed map, rotating it and setting the lighting (face size \
-         64); rotate: the same for a map that only turns (the decomposition is rotated)."
-    );
+    measure(
+        &bench,
+        &gpu,
+        &Rows(|t: &RenderRow| println!("{}", t.line(lights))),
+    )?;
+    println!("{RENDER_NOTE}");
     Ok(())
-}
-
-fn print_row(t: &RenderRow, lights: usize) {
-    if t.lights != lights {
-        println!("note: the map gives {} lights", t.lights);
-    }
-    println!(
-        "{:<14} {:>10.2} {:>12.2} {:>8.2} {:>11.2} {:>13.2} {:>8.2} {:>13.3} {:>10.4} {:>16.2}",
-        t.scene,
-        t.prt,
-        t.hybrid,
-        t.static_ratio(),
-        t.prt_dynamic,
-        t.hybrid_dynamic,
-        t.dynamic_ratio(),
-        t.cpu_per_frame,
-        t.rotate,
-        t.unshadowed
-    );
 }

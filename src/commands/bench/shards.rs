@@ -5,7 +5,7 @@
 //! the scene's objects side by side instead (generated, not shipped: K = 45 of the res2
 //! dragon is about 9 million triangles).
 
-use bench::shards::{ShardRow, Shards, ShardsBench};
+use bench::shards::{SHARDS_NOTE, Shards, ShardsBench, shards_header};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -39,47 +39,15 @@ pub(super) fn bench_shards(args: BenchShardsArgs) -> anyhow::Result<()> {
         bounces: args.bounces,
         instances: args.instances,
         work_dir: args.work_dir,
-        program: super::this_program()?,
+        program: super::rows::this_program()?,
     };
     let shards = Shards::prepare(&bench)?;
-    println!(
-        "{}: {} triangles; each process run alone, one after another",
-        shards.scene.display(),
-        shards.triangles
-    );
+    println!("{}", shards.title());
     let whole = shards.whole()?;
-    println!(
-        "one machine: {:.2} s, peak {:.0} MiB",
-        whole.seconds, whole.peak_mib
-    );
-    println!(
-        "{:>3} {:>22} {:>22} {:>16} {:>14} {:>13}",
-        "N",
-        "shard s (min-max)",
-        "shard MiB (min-max)",
-        "merge s / MiB",
-        "sum / one",
-        "max MiB / one"
-    );
+    println!("{}", shards_header(&whole));
     for &count in &bench.counts {
-        print_row(&shards.row(count, &whole)?);
+        println!("{}", shards.row(count, &whole)?.line());
     }
-    println!(
-        "every merge equals the one-machine bake byte for byte; shard times include each \
-         process's scene load, BVH build and cost estimate"
-    );
+    println!("{SHARDS_NOTE}");
     Ok(())
-}
-
-fn print_row(row: &ShardRow) {
-    let (t, m) = (row.seconds, row.peak_mib);
-    println!(
-        "{:>3} {:>22} {:>22} {:>16} {:>14.3} {:>13.3}",
-        row.count,
-        format!("{:.2}-{:.2}", t.min, t.max),
-        format!("{:.0}-{:.0}", m.min, m.max),
-        format!("{:.2} / {:.0}", row.merge.seconds, row.merge.peak_mib),
-        row.time_over_one,
-        row.memory_over_one
-    );
 }
