@@ -2,7 +2,7 @@
 
 use crate::Reporter;
 use crate::error::Result;
-use crate::inputs::{load_map, load_scene};
+use crate::inputs::load_scene;
 use crate::stats::{median, ms_since, time_frames};
 use foundation::bvh::SceneBvh;
 use foundation::envmap::EnvMap;
@@ -19,7 +19,6 @@ use std::time::Instant;
 #[derive(Debug, Clone)]
 pub struct RenderBench {
     pub scenes: Vec<PathBuf>,
-    pub env: PathBuf,
     pub width: u32,
     pub height: u32,
     /// Lights of the hybrid (the Weber threshold is 0 so that the brightest are kept).
@@ -59,17 +58,18 @@ impl RenderRow {
     }
 }
 
-/// Times each scene's frames on `gpu`, reporting each scene's row as it is measured.
+/// Times each scene's frames under `map` on `gpu`, reporting each scene's row as it is
+/// measured.
 pub fn bench_render(
     bench: &RenderBench,
+    map: &EnvMap,
     gpu: &GpuContext,
     reporter: &dyn Reporter<RenderRow>,
 ) -> Result<Vec<RenderRow>> {
-    let map = load_map(&bench.env, None)?.map;
     let mut rows = Vec::new();
     for path in &bench.scenes {
         let scene = load_scene(path)?;
-        let row = bench_scene(bench, gpu, &map, &scene)?;
+        let row = bench_scene(bench, gpu, map, &scene)?;
         reporter.row(&row);
         rows.push(row);
     }

@@ -67,29 +67,43 @@ pub fn opencv_available() -> bool {
         .is_ok_and(|s| s.success())
 }
 
+/// The map and the cameras `bench_cameras` runs, loaded and checked before anything is shown.
+pub struct CamerasInputs {
+    map: EnvMap,
+    cameras: Vec<BatteryCamera>,
+}
+
+impl CamerasInputs {
+    pub fn load(bench: &CamerasBench) -> Result<Self> {
+        let map = load_map(&bench.map, None)?.map;
+        let cameras: Vec<BatteryCamera> = battery()
+            .into_iter()
+            .filter(|c| bench.which == "all" || c.name == bench.which)
+            .collect();
+        if cameras.is_empty() {
+            let names: Vec<&str> = battery().iter().map(|c| c.name).collect();
+            let (which, names) = (bench.which.clone(), names.join(", "));
+            return Err(BenchError::NoCamera { which, names });
+        }
+        Ok(Self { map, cameras })
+    }
+}
+
 /// Runs the cameras named by `which`, reporting each row as it is measured.
 pub fn bench_cameras(
     bench: &CamerasBench,
+    inputs: &CamerasInputs,
     reporter: &dyn Reporter<CameraRow>,
 ) -> Result<Vec<CameraRow>> {
-    let map = load_map(&bench.map, None)?.map;
+    let CamerasInputs { map, cameras } = inputs;
     let (dir, _temporary) = work_folder(bench.keep.as_deref())?;
-    let cameras: Vec<BatteryCamera> = battery()
-        .into_iter()
-        .filter(|c| bench.which == "all" || c.name == bench.which)
-        .collect();
-    if cameras.is_empty() {
-        let names: Vec<&str> = battery().iter().map(|c| c.name).collect();
-        let (which, names) = (bench.which.clone(), names.join(", "));
-        return Err(BenchError::NoCamera { which, names });
-    }
     let mut rows = Vec::new();
-    for camera in &cameras {
+    for camera in cameras {
         for ball in [false, true] {
             let kind = if ball { "ball" } else { "shots" };
             let folder = dir.join(format!("{}-{kind}", camera.name));
             create_folder(&folder)?;
-            for row in bench_camera(bench, &map, camera, ball, &folder)? {
+            for row in bench_camera(bench, map, camera, ball, &folder)? {
                 reporter.row(&row);
                 rows.push(row);
             }

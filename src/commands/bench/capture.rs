@@ -7,7 +7,9 @@
 //! instead (`bench::capture::cameras`).
 
 use super::rows::Rows;
-use bench::capture::cameras::{CameraRow, CamerasBench, bench_cameras, opencv_available};
+use bench::capture::cameras::{
+    CameraRow, CamerasBench, CamerasInputs, bench_cameras, opencv_available,
+};
 use bench::capture::{CaptureBench, TIMES, bench_capture as measure};
 use clap::Args;
 use std::path::PathBuf;
@@ -68,8 +70,13 @@ pub(super) fn bench_capture(args: BenchCaptureArgs) -> anyhow::Result<()> {
 
 /// The battery of cameras, a row per camera, kind of views and response.
 fn cameras(bench: &CamerasBench) -> anyhow::Result<()> {
+    let inputs = CamerasInputs::load(bench)?;
     println!("{}", bench.header());
-    bench_cameras(bench, &Rows(|row: &CameraRow| println!("{}", row.line())))?;
+    bench_cameras(
+        bench,
+        &inputs,
+        &Rows(|row: &CameraRow| println!("{}", row.line())),
+    )?;
     Ok(())
 }
 

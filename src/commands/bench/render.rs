@@ -42,10 +42,10 @@ pub struct BenchRenderArgs {
 }
 
 pub(super) fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
+    let map = bench::load_map(&args.env, None)?.map;
     let gpu = GpuContext::headless(args.backend)?;
     let bench = RenderBench {
         scenes: args.scenes,
-        env: args.env,
         width: args.width,
         height: args.height,
         lights: args.lights,
@@ -61,6 +61,7 @@ pub(super) fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
     let lights = args.lights;
     measure(
         &bench,
+        &map,
         &gpu,
         &Rows(|t: &RenderRow| println!("{}", t.line(lights))),
     )?;
