@@ -30,6 +30,7 @@ mod load;
 mod merge;
 mod photo;
 mod response;
+mod response_file;
 mod response_fit;
 
 pub mod synthetic;
@@ -46,3 +47,4 @@ pub use load::{LoadedCapture, load_ball_photographs, load_capture};
 pub use merge::hat_weight;
 pub use photo::{Photo, View};
 pub use response::{equal_step_ratio, equal_steps_warning, recover_response};
+pub use response_file::{MAX_RESPONSE_SPAN, ResponseFileError, read_response, response_csv};

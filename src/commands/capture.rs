@@ -3,10 +3,9 @@
 
 use crate::outputs::{check_outputs, open_outputs, write_outputs};
 use anyhow::Context;
-use capture::{Assembled, AssemblySettings, InverseResponse, RESPONSE_BINS};
+use capture::{Assembled, AssemblySettings, InverseResponse};
 use clap::Args;
 use foundation::image_io::{RgbImageF32, exr_bytes, png_bytes, to_display_rgb8};
-use foundation::infra::limits::read_text_file;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -72,7 +71,7 @@ pub fn run(args: CaptureArgs) -> anyhow::Result<()> {
         ..Default::default()
     };
     let response = match &args.response {
-        Some(path) => read_response(path)?,
+        Some(path) => capture::read_response(path)?,
         None => {
             warn_of_equal_steps(&args.description, &photos);
             capture::calibrate(&photos, &settings).with_context(|| {
@@ -92,7 +91,7 @@ pub fn run(args: CaptureArgs) -> anyhow::Result<()> {
     let image = RgbImageF32::new(width, width / 2, captured.map.texels().to_vec());
     let mut bytes = vec![exr_bytes(&image)?];
     if args.save_response.is_some() {
-        bytes.push(response_csv(&response, spread).into_bytes());
+        bytes.push(capture::response_csv(&response, spread).into_bytes());
     }
     if args.coverage.is_some() {
         bytes.push(png_bytes(&coverage_rgb(&captured), width, width / 2)?);
@@ -253,92 +252,4 @@ fn preview_rgb(captured: &Assembled, image: &RgbImageF32) -> Vec<u8> {
         }
     }
     rgb
-}
-
-fn response_csv(response: &InverseResponse, spread: Option<f32>) -> String {
-    let mut text = match spread {
-        Some(s) => {
-            format!("# spread {s}: the median texel's exposures disagree by this (RMS log)\n")
-        }
-        None => String::new(),
-    };
-    text.push_str("level,r,g,b\n");
-    for z in 0..RESPONSE_BINS {
-        let [r, g, b] = [0, 1, 2].map(|c| response.curves[c][z]);
-        text.push_str(&format!("{z},{r},{g},{b}\n"));
-    }
-    text
-}
-
-/// Largest exposure an inverse response may give a level, relative to its middle level:
-/// a camera's brightest level is at most a few hundred times its middle one, and beyond this
-/// a merged radiance can overflow.
-const MAX_RESPONSE_SPAN: f32 = 1e9;
-
-/// Refuses a response that cannot be a camera's: a channel that does not rise from its
-/// darkest to its brightest level (an all-zero file would make a black map), or one whose
-/// brightest level is more than [`MAX_RESPONSE_SPAN`] times its middle one.
-fn check_response_range(path: &Path, curves: &[Vec<f32>; 3]) -> anyhow::Result<()> {
-    for (curve, channel) in curves.iter().zip(["red", "green", "blue"]) {
-        let (first, middle, last) = (curve[0], curve[RESPONSE_BINS / 2], curve[RESPONSE_BINS - 1]);
-        anyhow::ensure!(
-            last > first && middle > 0.0,
-            "{}: the {channel} response does not rise ({first} at level 0, {middle} at level {}, \
-             {last} at level {}): a camera's brighter levels mean more light; give a response \
-             as --save-response writes it",
-            path.display(),
-            RESPONSE_BINS / 2,
-            RESPONSE_BINS - 1
-        );
-        anyhow::ensure!(
-            last <= MAX_RESPONSE_SPAN * middle,
-            "{}: the {channel} response spans {first} to {last}, more than {MAX_RESPONSE_SPAN:e} \
-             times its middle level {middle}: not a camera's",
-            path.display()
-        );
-    }
-    Ok(())
-}
-
-/// An inverse response as `--save-response` writes it.
-pub(crate) fn read_response(path: &Path) -> anyhow::Result<InverseResponse> {
-    let text = read_text_file(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let mut curves: [Vec<f32>; 3] = Default::default();
-    // Comment lines (`# spread ...`) first, then the header.
-    let lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.starts_with('#'));
-    for (n, line) in lines.skip(1) {
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let values: Option<Vec<f32>> = fields.iter().map(|f| f.parse().ok()).collect();
-        match values.as_deref() {
-            Some([level, r, g, b]) if *level as usize == curves[0].len() => {
-                for (curve, v) in curves.iter_mut().zip([r, g, b]) {
-                    if !(v.is_finite() && *v >= 0.0) {
-                        anyhow::bail!("{} line {}: {v} is not an exposure", path.display(), n + 1);
-                    }
-                    curve.push(*v);
-                }
-            }
-            _ => anyhow::bail!(
-                "{} line {}: expected `{},r,g,b` (a response as --save-response writes it)",
-                path.display(),
-                n + 1,
-                curves[0].len()
-            ),
-        }
-    }
-    if curves[0].len() != RESPONSE_BINS {
-        anyhow::bail!(
-            "{}: {} levels, expected {RESPONSE_BINS}",
-            path.display(),
-            curves[0].len()
-        );
-    }
-    if curves.iter().any(|c| c.windows(2).any(|w| w[1] < w[0])) {
-        anyhow::bail!("{}: a response must not decrease", path.display());
-    }
-    check_response_range(path, &curves)?;
-    Ok(InverseResponse { curves })
 }

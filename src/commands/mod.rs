@@ -9,7 +9,6 @@ pub mod capture;
 pub mod decompose;
 pub mod demo;
 pub mod export;
-mod mitsuba;
 pub mod probes;
 pub mod reference;
 pub mod render;

@@ -8,8 +8,9 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
 /// The crates whose imports are checked, each with its source folder.
-pub const CRATES: [&str; 8] = [
+pub const CRATES: [&str; 9] = [
     "foundation",
+    "bench",
     "precompute",
     "reference",
     "runtime",

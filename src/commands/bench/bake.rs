@@ -1,16 +1,12 @@
 //! `hprt bench bake`: the bake's throughput.
 
+use super::rows::Rows;
 use crate::outputs::{check_outputs, open_outputs, write_outputs};
-use crate::support::{load_scene, median, with_threads};
 use anyhow::Context;
+use bench::bake::{BakeBench, BakeRow, bake_rays, bench_bake as measure};
 use clap::Args;
-use foundation::bvh::{SceneBvh, Skip};
-use foundation::infra::progress::NoProgress;
-use foundation::scene::SceneMesh;
-use precompute::bake::{self, BakeSettings};
-use rayon::prelude::*;
+use precompute::bake::BakeSettings;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 #[derive(Args)]
 pub struct BenchBakeArgs {
@@ -50,130 +46,30 @@ pub(super) fn bench_bake(args: BenchBakeArgs) -> anyhow::Result<()> {
             .context("no scene to take the rays of")?;
         dump_rays(scene_path, &settings, path)?;
     }
-    println!(
-        "bake benchmark: order {}, {} samples, {} bounces, {} threads, median of {}",
-        args.order,
-        args.samples,
-        args.bounces,
-        args.threads.unwrap_or_else(rayon::current_num_threads),
-        args.repeat
-    );
-    println!(
-        "{:<10} {:>9} {:>11} {:>9} {:>10} {:>9} {:>15} {:>18}",
-        "scene",
-        "vertices",
-        "rays",
-        "bake s",
-        "direct s",
-        "M rays/s",
-        "occlusion M/s",
-        "max bounce/direct"
-    );
-    for path in &args.scenes {
-        let scene = load_scene(path)?;
-        let (runs, occlusion) = with_threads(args.threads, || {
-            let bvh = SceneBvh::build(&scene.geometry.mesh);
-            let repeats = 0..args.repeat.max(1);
-            let runs = repeats
-                .clone()
-                .map(|_| bake::bake(&scene.geometry, &bvh, &settings, &NoProgress))
-                .collect::<Result<Vec<_>, _>>();
-            let occlusion = repeats.map(|_| occlusion_rate(&scene.geometry, &bvh, &settings));
-            (runs, median(occlusion.collect()))
-        })?;
-        let runs = runs?;
-        let stats: Vec<_> = runs.into_iter().map(|(_, s)| s).collect();
-        let bounce_ratio = median(
-            stats
-                .iter()
-                .map(|s| s.bounce_seconds.iter().copied().fold(0.0, f64::max) / s.direct_seconds)
-                .collect(),
-        );
-        println!(
-            "{:<10} {:>9} {:>11} {:>9.2} {:>10.2} {:>9.2} {:>15.2} {:>17.1}%",
-            scene.name,
-            stats[0].vertices,
-            stats[0].rays,
-            median(stats.iter().map(|s| s.total_seconds).collect()),
-            median(stats.iter().map(|s| s.direct_seconds).collect()),
-            median(stats.iter().map(|s| s.rays_per_second()).collect()) / 1e6,
-            occlusion / 1e6,
-            100.0 * bounce_ratio
-        );
-    }
+    let bench = BakeBench {
+        scenes: args.scenes,
+        settings,
+        repeat: args.repeat,
+        threads: args.threads,
+    };
+    println!("{}", bench.header());
+    measure(&bench, &Rows(|row: &BakeRow| println!("{}", row.line())))?;
     Ok(())
 }
 
-/// Rays per second of occlusion-only queries (first blocker ends a ray) over the bake's own
-/// fans, generated as the direct pass generates them: the figure to set beside another
-/// tracer's shadow rays on the `--dump-rays` file.
-fn occlusion_rate(geometry: &SceneMesh, bvh: &SceneBvh, settings: &BakeSettings) -> f64 {
-    let fans = bake::RayFans::new(geometry, settings);
-    let vertices = geometry.mesh.vertex_count();
-    let start = Instant::now();
-    let blocked: usize = (0..vertices)
-        .into_par_iter()
-        .map_init(
-            || (Vec::new(), Vec::new()),
-            |(directions, blocked), v| {
-                let (origin, fan) = fans.fan(geometry, v);
-                directions.clear();
-                directions.extend(fan);
-                let skip = Skip::VertexTriangles(v as u32);
-                bvh.occluded_fan(origin, directions, (0.0, f32::INFINITY), skip, blocked);
-                blocked.iter().filter(|b| **b).count()
-            },
-        )
-        .sum();
-    let seconds = start.elapsed().as_secs_f64();
-    // (The count keeps the traversal from being optimised away.)
-    std::hint::black_box(blocked);
-    (vertices * fans.len()) as f64 / seconds
-}
-
-/// The rays file's first eight bytes.
-const RAYS_MAGIC: &[u8; 8] = b"HPRTRAYS";
-
-/// Writes the bake's rays of the scene at `scene_path` and the triangles they are traced
-/// against: `HPRTRAYS`, then little-endian `u32` version (1), `u32` rays per fan, `u64` fan
-/// count, `u64` triangle count; then per ray six `f32` (origin x, y, z, direction x, y, z),
-/// fan after fan in vertex order, each fan's rays in the order traced; then per triangle nine
-/// `f32` (its corners, world space).
+/// Writes the bake's rays of the scene at `scene_path` (layout: [`bake_rays`]) to `path`.
 fn dump_rays(scene_path: &Path, settings: &BakeSettings, path: &Path) -> anyhow::Result<()> {
     let outputs = [("--dump-rays", Some(path))];
     check_outputs(&[scene_path], &outputs)?;
     let files = open_outputs(&outputs)?;
-    let scene = load_scene(scene_path)?;
-    let fans = bake::RayFans::new(&scene.geometry, settings);
-    let count = scene.geometry.mesh.vertex_count();
-    let mesh = &scene.geometry.mesh;
-    let mut bytes = Vec::with_capacity(32 + count * fans.len() * 24 + mesh.triangles.len() * 36);
-    bytes.extend_from_slice(RAYS_MAGIC);
-    bytes.extend_from_slice(&1u32.to_le_bytes());
-    bytes.extend_from_slice(&(fans.len() as u32).to_le_bytes());
-    bytes.extend_from_slice(&(count as u64).to_le_bytes());
-    bytes.extend_from_slice(&(mesh.triangles.len() as u64).to_le_bytes());
-    for v in 0..count {
-        let (origin, directions) = fans.fan(&scene.geometry, v);
-        for d in directions {
-            for x in origin.to_array().into_iter().chain(d.to_array()) {
-                bytes.extend_from_slice(&x.to_le_bytes());
-            }
-        }
-    }
-    for triangle in &mesh.triangles {
-        for &corner in triangle {
-            for x in mesh.positions[corner as usize].to_array() {
-                bytes.extend_from_slice(&x.to_le_bytes());
-            }
-        }
-    }
-    write_outputs(files, vec![bytes])?;
+    let rays = bake_rays(scene_path, settings)?;
+    write_outputs(files, vec![rays.bytes])?;
     println!(
-        "wrote {} rays ({count} fans of {}) of {} to {}",
-        count * fans.len(),
-        fans.len(),
-        scene.name,
+        "wrote {} rays ({} fans of {}) of {} to {}",
+        rays.fans * rays.rays_per_fan,
+        rays.fans,
+        rays.rays_per_fan,
+        rays.scene,
         path.display()
     );
     Ok(())

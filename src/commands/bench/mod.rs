@@ -2,13 +2,12 @@
 
 mod bake;
 mod capture;
-mod capture_cameras;
 mod composite;
 mod probes;
-mod process;
 mod reference;
 mod reflections;
 mod render;
+mod rows;
 mod shards;
 mod turn;
 

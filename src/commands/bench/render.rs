@@ -1,17 +1,10 @@
 //! `hprt bench render`: GPU frame times of prt and hybrid, and the CPU work per frame.
 
+use super::rows::Rows;
 use crate::cli::Switch;
-use crate::maps::load_map;
-use crate::support::{load_scene, median};
+use bench::render::{RENDER_NOTE, RenderBench, RenderRow, bench_render as measure};
 use clap::Args;
-use foundation::bvh::SceneBvh;
-use foundation::envmap::EnvMap;
-use foundation::infra::progress::NoProgress;
-use foundation::scene::Scene;
-use precompute::bake::{self, BakeSettings};
-use runtime::render::ShadowSettings;
-use runtime::render::{GpuContext, RenderMode, Renderer};
-use runtime::{DecomposeSettings, EnvironmentLighting};
+use runtime::render::{GpuContext, ShadowSettings};
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -48,189 +41,30 @@ pub struct BenchRenderArgs {
     pub backend: runtime::render::Backend,
 }
 
-/// Median milliseconds of `frames` calls of `frame` (after one untimed call).
-pub(super) fn time_frames(
-    frames: usize,
-    mut frame: impl FnMut() -> anyhow::Result<()>,
-) -> anyhow::Result<f64> {
-    frame()?;
-    let mut times = Vec::with_capacity(frames);
-    for _ in 0..frames.max(1) {
-        let start = std::time::Instant::now();
-        frame()?;
-        times.push(start.elapsed().as_secs_f64() * 1e3);
-    }
-    Ok(median(times))
-}
-
 pub(super) fn bench_render(args: BenchRenderArgs) -> anyhow::Result<()> {
-    let map = load_map(&args.env, None)?.map;
+    let map = bench::load_map(&args.env, None)?.map;
     let gpu = GpuContext::headless(args.backend)?;
-    println!(
-        "render benchmark on {}: {}x{}, {} lights, {}² shadow maps, PCF {}x{}{}, median of {} frames",
-        gpu.description(),
-        args.width,
-        args.height,
-        args.lights,
-        args.shadow_res,
-        args.pcf,
-        args.pcf,
-        if args.pcf_from_radius.is_on() {
-            " sized from the light radius"
-        } else {
-            ""
+    let bench = RenderBench {
+        scenes: args.scenes,
+        width: args.width,
+        height: args.height,
+        lights: args.lights,
+        shadow: ShadowSettings {
+            resolution: args.shadow_res,
+            pcf_taps: args.pcf,
+            from_angular_radius: args.pcf_from_radius.is_on(),
         },
-        args.frames
-    );
-    println!(
-        "{:<14} {:>10} {:>12} {:>8} {:>11} {:>13} {:>8} {:>13} {:>10} {:>16}",
-        "scene",
-        "prt ms",
-        "hybrid ms",
-        "ratio",
-        "prt dyn ms",
-        "hybrid dyn ms",
-        "ratio",
-        "CPU/frame ms",
-        "rotate ms",
-        "unshadowed ms"
-    );
-    for path in &args.scenes {
-        let scene = load_scene(path)?;
-        let t = bench_scene(&args, &gpu, &map, &scene)?;
-        println!(
-            "{:<14} {:>10.2} {:>12.2} {:>8.2} {:>11.2} {:>13.2} {:>8.2} {:>13.3} {:>10.4} {:>16.2}",
-            scene.name,
-            t.prt,
-            t.hybrid,
-            t.hybrid / t.prt,
-            t.prt_dynamic,
-            t.hybrid_dynamic,
-            t.hybrid_dynamic / t.prt_dynamic,
-            t.cpu_per_frame,
-            t.rotate,
-            t.unshadowed
-        );
-    }
-    println!(
-        "CPU/frame: decomposing the changed map, rotating it and setting the lighting (face size \
-         64); rotate: the same for a map that only turns (the decomposition is rotated)."
-    );
-    Ok(())
-}
-
-/// One scene's medians, in milliseconds.
-struct SceneTimes {
-    prt: f64,
-    hybrid: f64,
-    unshadowed: f64,
-    prt_dynamic: f64,
-    hybrid_dynamic: f64,
-    /// The hybrid's CPU work per frame of a changing map.
-    cpu_per_frame: f64,
-    /// The CPU work per frame of a map that only turns.
-    rotate: f64,
-}
-
-/// Bakes `scene` and times its frames under `map`.
-fn bench_scene(
-    args: &BenchRenderArgs,
-    gpu: &GpuContext,
-    map: &EnvMap,
-    scene: &Scene,
-) -> anyhow::Result<SceneTimes> {
-    let settings = BakeSettings {
-        order: 5,
-        samples: args.bake_samples,
-        bounces: 1,
-        seed: 0,
+        frames: args.frames,
+        bake_samples: args.bake_samples,
     };
-    let bvh = SceneBvh::build(&scene.geometry.mesh);
-    let (transfer, _) = bake::bake(&scene.geometry, &bvh, &settings, &NoProgress)?;
-    let decompose = DecomposeSettings {
-        threshold: 0.0,
-        max_lights: args.lights,
-        ..Default::default()
-    };
-    let mut lighting = EnvironmentLighting::new(map, decompose)?;
-    if scene.geometry.is_glossy() {
-        lighting.enable_reflections(Some(runtime::render::DEFAULT_REFLECTION_SIZE));
-    }
-    let camera = scene.camera.with_size(args.width, args.height);
-    let shadow = ShadowSettings {
-        resolution: args.shadow_res,
-        pcf_taps: args.pcf,
-        from_angular_radius: args.pcf_from_radius.is_on(),
-    };
-    let mut renderer = Renderer::new(gpu, &scene.geometry, &transfer, &camera, shadow)?;
-    renderer.set_environment(map, 0.0);
-    let lights = lighting.decompose().lights.len();
-    if lights != args.lights {
-        println!("note: the map gives {lights} lights");
-    }
-    // Static lighting: shadow maps and vertex radiance are computed once.
-    let mut statics = Vec::new();
-    for mode in [RenderMode::Prt, RenderMode::Hybrid, RenderMode::Unshadowed] {
-        renderer.set_lighting(&lighting.frame(mode, None).lighting)?;
-        statics.push(time_frames(args.frames, || {
-            renderer.render()?;
-            renderer.wait();
-            Ok(())
-        })?);
-    }
-    let (prt_dynamic, _) =
-        dynamic_frames(&mut renderer, &mut lighting, RenderMode::Prt, args.frames)?;
-    let (hybrid_dynamic, cpu_per_frame) = dynamic_frames(
-        &mut renderer,
-        &mut lighting,
-        RenderMode::Hybrid,
-        args.frames,
+    println!("{}", bench.header(&gpu.description().to_string()));
+    let lights = args.lights;
+    measure(
+        &bench,
+        &map,
+        &gpu,
+        &Rows(|t: &RenderRow| println!("{}", t.line(lights))),
     )?;
-    // A map that only turns: the decomposition is rotated, not redone.
-    let rotate = median(
-        (0..100)
-            .map(|k| {
-                let start = std::time::Instant::now();
-                lighting.set_rotation(k as f32 * 3.6);
-                std::hint::black_box(lighting.frame(RenderMode::Hybrid, None));
-                start.elapsed().as_secs_f64() * 1e3
-            })
-            .collect(),
-    );
-    Ok(SceneTimes {
-        prt: statics[0],
-        hybrid: statics[1],
-        unshadowed: statics[2],
-        prt_dynamic,
-        hybrid_dynamic,
-        cpu_per_frame,
-        rotate,
-    })
-}
-
-/// Dynamic lighting: the map changes every frame (decomposed again) and turns a degree, so the
-/// vertex radiance and every shadow map are redone. The median frame and the median CPU work
-/// before the GPU's, in milliseconds.
-fn dynamic_frames(
-    renderer: &mut Renderer,
-    lighting: &mut EnvironmentLighting,
-    mode: RenderMode,
-    frames: usize,
-) -> anyhow::Result<(f64, f64)> {
-    let mut cpu_ms = Vec::new();
-    let mut angle = 0.0f32;
-    let frame_ms = time_frames(frames, || {
-        let start = std::time::Instant::now();
-        angle += 1.0;
-        lighting.redecompose();
-        lighting.set_rotation(angle);
-        let frame = lighting.frame(mode, None);
-        renderer.set_environment_rotation(angle);
-        renderer.set_lighting(&frame.lighting)?;
-        cpu_ms.push(start.elapsed().as_secs_f64() * 1e3);
-        renderer.render()?;
-        renderer.wait();
-        Ok(())
-    })?;
-    Ok((frame_ms, median(cpu_ms)))
+    println!("{RENDER_NOTE}");
+    Ok(())
 }

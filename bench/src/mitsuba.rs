@@ -1,7 +1,8 @@
-//! Mitsuba 3 run from its Python package, for `hprt bench reference`: the same scene exported
-//! with `hprt export`, rendered and timed by Mitsuba, so both renderers are measured in one run.
+//! Mitsuba 3 run from its Python package, for the reference benchmark: the same scene exported
+//! as `hprt export` exports it, rendered and timed by Mitsuba, so both renderers are measured
+//! in one run.
 
-use anyhow::Context;
+use crate::error::{BenchError, Result};
 use foundation::image_io::{RgbImageF32, read_exr};
 use foundation::scene::SceneMesh;
 use reference::export::{ExportSettings, export_mitsuba};
@@ -9,12 +10,12 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// A Python interpreter with Mitsuba 3 and the variant to run.
-pub struct Mitsuba {
+pub(crate) struct Mitsuba {
     python: String,
-    pub variant: &'static str,
+    pub(crate) variant: &'static str,
     /// `DRJIT_LIBLLVM_PATH` for the LLVM variant.
     llvm: Option<PathBuf>,
-    pub version: String,
+    pub(crate) version: String,
 }
 
 /// Where Debian puts the LLVM libraries Dr.Jit can use (LLVM 15 aborts: README).
@@ -29,7 +30,7 @@ impl Mitsuba {
     /// `HPRT_MITSUBA_PYTHON`, else `target/mitsuba-venv` (what `tests/run.sh` installs), else
     /// `python3`, if it imports Mitsuba; the LLVM variant where an LLVM library is found
     /// (`DRJIT_LIBLLVM_PATH`, else the usual Debian paths), else `scalar_rgb`.
-    pub fn find() -> Option<Self> {
+    pub(crate) fn find() -> Option<Self> {
         let mut candidates: Vec<String> = Vec::new();
         if let Ok(p) = std::env::var("HPRT_MITSUBA_PYTHON") {
             candidates.push(p);
@@ -75,14 +76,14 @@ impl Mitsuba {
 
     /// Exports `geometry` into `dir`, renders it `repeat` times and returns each render's
     /// seconds (the first includes the LLVM variant's kernel compilation) and the last image.
-    pub fn render(
+    pub(crate) fn render(
         &self,
         dir: &Path,
         geometry: &SceneMesh,
         map: &foundation::envmap::EnvMap,
         settings: &ExportSettings,
         repeat: usize,
-    ) -> anyhow::Result<(Vec<f64>, RgbImageF32)> {
+    ) -> Result<(Vec<f64>, RgbImageF32)> {
         export_mitsuba(dir, geometry, map, settings)?;
         let script = format!(
             r#"
@@ -114,13 +115,16 @@ mi.util.write_bitmap("mitsuba.exr", image)
         }
         let out = command
             .output()
-            .with_context(|| format!("cannot run {}", self.python))?;
-        anyhow::ensure!(
-            out.status.success(),
-            "Mitsuba ({}) failed: {}",
-            self.variant,
-            String::from_utf8_lossy(&out.stderr)
-        );
+            .map_err(|source| BenchError::MitsubaStart {
+                python: self.python.clone(),
+                source,
+            })?;
+        if !out.status.success() {
+            return Err(BenchError::Mitsuba {
+                variant: self.variant,
+                stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+            });
+        }
         let seconds = String::from_utf8_lossy(&out.stdout)
             .lines()
             .filter_map(|l| l.strip_prefix("seconds ")?.trim().parse().ok())
@@ -130,7 +134,11 @@ mi.util.write_bitmap("mitsuba.exr", image)
 }
 
 /// Relative difference of the mean luminance of `ours` and `theirs` over `covered` pixels.
-pub fn covered_mean_difference(ours: &RgbImageF32, theirs: &RgbImageF32, covered: &[f32]) -> f64 {
+pub(crate) fn covered_mean_difference(
+    ours: &RgbImageF32,
+    theirs: &RgbImageF32,
+    covered: &[f32],
+) -> f64 {
     let mean = |image: &RgbImageF32| {
         let (sum, n) = image
             .pixels
