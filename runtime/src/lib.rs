@@ -14,6 +14,7 @@ mod probes;
 mod reflection;
 pub mod render;
 mod tracking;
+pub mod viewer;
 
 pub use cubemap::{CubeGeometry, CubeMap, CubeResampler, CubeSource};
 pub use decompose::{

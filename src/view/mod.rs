@@ -9,12 +9,9 @@
 mod events;
 mod jobs;
 mod lighting;
-mod orbit;
 mod panel_io;
 mod room;
 mod room_state;
-mod script;
-mod settings;
 mod state;
 mod ui;
 mod window;
@@ -24,12 +21,12 @@ use crate::maps::{maps_beside, scene_rotation};
 use anyhow::Context;
 use clap::Args;
 use foundation::scene::Scene;
-use orbit::Orbit;
 use report::env_sequence::Sequence;
 use runtime::lights_indirect_default;
 use runtime::render::{Backend, RenderMode, ShadowSettings};
+use runtime::viewer::ViewSettings;
+use runtime::viewer::{Orbit, script};
 use runtime::{DecomposeMode, DecomposeSettings};
-use settings::ViewSettings;
 use state::{BakeState, InputState, Jobs, LightingState, ScriptState, Stats, WindowState};
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -345,7 +342,7 @@ impl App {
                 output,
             )
             .iter()
-            .map(|w| settings::shell_quote(w))
+            .map(|w| runtime::viewer::shell_quote(w))
             .collect::<Vec<_>>()
             .join(" ")
     }

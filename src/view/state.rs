@@ -1,16 +1,16 @@
 //! The viewer's state, one struct per concern.
 
 use super::jobs::Job;
-use super::orbit::Orbit;
 use super::room_state::RoomState;
-use super::script;
-use super::settings::ViewSettings;
 use super::window::WindowGpu;
 use crate::support::median;
 use foundation::image_io::RgbImageF32;
 use precompute::bake::Transfer;
 use report::env_sequence::Sequence;
 use runtime::render::{Backend, Renderer};
+use runtime::viewer::Orbit;
+use runtime::viewer::ViewSettings;
+use runtime::viewer::script;
 use runtime::{Decomposition, EnvironmentLighting};
 use std::collections::VecDeque;
 use std::path::PathBuf;

@@ -5,10 +5,10 @@
 mod environment;
 mod placement;
 
-use super::settings::ViewSettings;
 use foundation::envmap::EnvMap;
 use precompute::bake::BakeSettings;
 use runtime::render::RenderMode;
+use runtime::viewer::ViewSettings;
 use runtime::{DecomposeMode, Decomposition, TrackedLight};
 use std::path::{Path, PathBuf};
 

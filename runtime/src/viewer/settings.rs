@@ -1,12 +1,52 @@
-//! What the viewer's panel controls, and the `hprt render` command line that reproduces it.
+//! What a viewer's panel controls, how a script's `set NAME VALUE` changes it, and the
+//! `hprt render` command line that reproduces what it shows.
 
+use crate::render::{MAX_LIGHTS, RenderMode, ShadowSettings};
+use crate::{DecomposeMode, DecomposeSettings, lights_indirect_default};
 use foundation::Rgb;
 use foundation::camera::Camera;
+use foundation::infra::named_enum::UnknownName;
 use foundation::material::{MAX_SHININESS, Material};
-use runtime::lights_indirect_default;
-use runtime::render::{RenderMode, ShadowSettings};
-use runtime::{DecomposeMode, DecomposeSettings};
 use std::path::{Path, PathBuf};
+
+/// Why a `set NAME VALUE` was refused.
+#[derive(Debug, thiserror::Error)]
+pub enum SettingError {
+    #[error("unknown setting {0:?}")]
+    Unknown(String),
+    #[error("{name}: `{value}` is not a finite number")]
+    NotANumber { name: String, value: String },
+    #[error("{name}: expected on or off, got {value:?}")]
+    NotASwitch { name: String, value: String },
+    #[error("{name}: {source}")]
+    UnknownName { name: String, source: UnknownName },
+    #[error("{name}: median cut makes a power of two of lights, 1 to {MAX_LIGHTS}; got {value:?}")]
+    MedianCutLights { name: String, value: String },
+    #[error("{name}: expected an object index after ':'")]
+    NoIndex { name: String },
+    #[error("{name}: no object {index} (the scene has {count})")]
+    NoObject {
+        name: String,
+        index: usize,
+        count: usize,
+    },
+    #[error("{name}: expected r,g,b or one value, got {value:?}")]
+    NotAColour { name: String, value: String },
+    #[error("{name}: specular {value} outside [0, 1]")]
+    SpecularOutOfRange { name: String, value: String },
+    #[error("{name}: shininess {value} outside (0, {MAX_SHININESS}]")]
+    ShininessOutOfRange { name: String, value: f32 },
+}
+
+/// `value` as a finite number.
+fn finite(name: &str, value: &str) -> Result<f32, SettingError> {
+    (value.trim().parse::<f32>().ok())
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| SettingError::NotANumber {
+            name: name.to_owned(),
+            value: value.to_owned(),
+        })
+}
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct ViewSettings {
@@ -44,21 +84,60 @@ pub struct ViewSettings {
 }
 
 /// `r,g,b` or one value, each in [0, 1].
-fn parse_specular(name: &str, value: &str) -> anyhow::Result<Rgb> {
-    let values: Vec<f32> = value
-        .split(',')
-        .map(|v| crate::cli::parse_finite(v.trim()).map_err(|m| anyhow::anyhow!("{name}: {m}")))
-        .collect::<anyhow::Result<_>>()?;
+fn parse_specular(name: &str, value: &str) -> Result<Rgb, SettingError> {
+    let values: Vec<f32> = (value.split(','))
+        .map(|v| finite(name, v))
+        .collect::<Result<_, _>>()?;
     let rgb = match values[..] {
         [v] => Rgb::splat(v),
         [r, g, b] => Rgb::new(r, g, b),
-        _ => anyhow::bail!("{name}: expected r,g,b or one value, got {value:?}"),
+        _ => {
+            return Err(SettingError::NotAColour {
+                name: name.to_owned(),
+                value: value.to_owned(),
+            });
+        }
     };
-    anyhow::ensure!(
-        rgb.min_element() >= 0.0 && rgb.max_element() <= 1.0,
-        "{name}: specular {value} outside [0, 1]"
-    );
+    if rgb.min_element() < 0.0 || rgb.max_element() > 1.0 {
+        return Err(SettingError::SpecularOutOfRange {
+            name: name.to_owned(),
+            value: value.to_owned(),
+        });
+    }
     Ok(rgb)
+}
+
+/// `on`/`true` or `off`/`false`.
+fn switch(name: &str, value: &str) -> Result<bool, SettingError> {
+    match value {
+        "on" | "true" => Ok(true),
+        "off" | "false" => Ok(false),
+        _ => Err(SettingError::NotASwitch {
+            name: name.to_owned(),
+            value: value.to_owned(),
+        }),
+    }
+}
+
+/// A named value (`mode`, `decompose`).
+fn named<T: std::str::FromStr<Err = UnknownName>>(
+    name: &str,
+    value: &str,
+) -> Result<T, SettingError> {
+    value.parse().map_err(|source| SettingError::UnknownName {
+        name: name.to_owned(),
+        source,
+    })
+}
+
+/// A median-cut light count: a power of two, at most [`MAX_LIGHTS`].
+fn median_cut_lights(name: &str, value: &str) -> Result<usize, SettingError> {
+    (value.parse::<usize>().ok())
+        .filter(|n| n.is_power_of_two() && *n <= MAX_LIGHTS)
+        .ok_or_else(|| SettingError::MedianCutLights {
+            name: name.to_owned(),
+            value: value.to_owned(),
+        })
 }
 
 impl ViewSettings {
@@ -79,61 +158,60 @@ impl ViewSettings {
     }
 
     /// Applies a `set NAME VALUE` of a script.
-    pub fn set(&mut self, name: &str, value: &str) -> anyhow::Result<()> {
-        let number = || crate::cli::parse_finite(value).map_err(|m| anyhow::anyhow!("{name}: {m}"));
-        let switch = || match value {
-            "on" | "true" => Ok(true),
-            "off" | "false" => Ok(false),
-            _ => Err(anyhow::anyhow!("{name}: expected on or off, got {value:?}")),
-        };
+    pub fn set(&mut self, name: &str, value: &str) -> Result<(), SettingError> {
+        let number = || finite(name, value);
+        let switch = || switch(name, value);
         match name {
             "rotation" => self.rotation_deg = number()?,
             "animate" => self.animate = switch()?,
             "speed" => self.animate_speed = number()?,
-            "mode" => self.mode = value.parse()?,
-            "decompose" => self.set_decompose_mode(value.parse()?),
+            "mode" => self.mode = named(name, value)?,
+            "decompose" => self.set_decompose_mode(named(name, value)?),
             "threshold" => self.threshold = number()?,
             "order" => self.order = number()? as usize,
             "shadow_res" => self.shadow.resolution = number()? as u32,
             "pcf" => self.shadow.pcf_taps = number()? as u32,
             "pcf_from_radius" => self.shadow.from_angular_radius = switch()?,
             "lights_indirect" => self.lights_indirect = switch()?,
-            "median_cut_lights" => {
-                self.median_cut_lights = crate::cli::parse_median_cut_lights(value)
-                    .map_err(|m| anyhow::anyhow!("{name}: {m}"))?
-            }
+            "median_cut_lights" => self.median_cut_lights = median_cut_lights(name, value)?,
             "exposure" => self.exposure = number()?,
             "env" => self.env = PathBuf::from(value),
             "composite" => self.composite = switch()?,
             "wireframe" => self.wireframe = switch()?,
             "play_path" => self.play_path = switch()?,
             "soft_shadow" => self.soft_shadow = switch()?,
-            _ => {
-                // `specular:N r,g,b` (or one value for all three) and `shininess:N s`, for
-                // object N (from 0).
-                let Some((what, index)) = name.split_once(':') else {
-                    anyhow::bail!("unknown setting {name:?}")
-                };
-                let index: usize = index
-                    .parse()
-                    .map_err(|_| anyhow::anyhow!("{name}: expected an object index after ':'"))?;
-                let count = self.materials.len();
-                let material = self.materials.get_mut(index).ok_or_else(|| {
-                    anyhow::anyhow!("{name}: no object {index} (the scene has {count})")
-                })?;
-                match what {
-                    "specular" => material.specular = parse_specular(name, value)?,
-                    "shininess" => {
-                        let s = number()?;
-                        anyhow::ensure!(
-                            s > 0.0 && s <= MAX_SHININESS,
-                            "{name}: shininess {s} outside (0, {MAX_SHININESS}]"
-                        );
-                        material.shininess = s;
-                    }
-                    _ => anyhow::bail!("unknown setting {name:?}"),
+            _ => self.set_material(name, value)?,
+        }
+        Ok(())
+    }
+
+    /// `specular:N r,g,b` (or one value for all three) and `shininess:N s`, for object N
+    /// (from 0).
+    fn set_material(&mut self, name: &str, value: &str) -> Result<(), SettingError> {
+        let unknown = || SettingError::Unknown(name.to_owned());
+        let (what, index) = name.split_once(':').ok_or_else(unknown)?;
+        let index: usize = index.parse().map_err(|_| SettingError::NoIndex {
+            name: name.to_owned(),
+        })?;
+        let count = self.materials.len();
+        let material = (self.materials.get_mut(index)).ok_or_else(|| SettingError::NoObject {
+            name: name.to_owned(),
+            index,
+            count,
+        })?;
+        match what {
+            "specular" => material.specular = parse_specular(name, value)?,
+            "shininess" => {
+                let s = finite(name, value)?;
+                if !(s > 0.0 && s <= MAX_SHININESS) {
+                    return Err(SettingError::ShininessOutOfRange {
+                        name: name.to_owned(),
+                        value: s,
+                    });
                 }
+                material.shininess = s;
             }
+            _ => return Err(unknown()),
         }
         Ok(())
     }

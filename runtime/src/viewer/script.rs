@@ -1,4 +1,4 @@
-//! Scripted input for the viewer (`hprt view --script FILE`): drives it without a person, for
+//! Scripted input for a viewer (`hprt view --script FILE`): drives it without a person, for
 //! the smoke test and for reproducible timings. One command per line, `#` starts a comment:
 //!
 //! ```text
@@ -44,8 +44,38 @@ pub enum Command {
     Quit,
 }
 
+/// What is wrong with a script's line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ScriptProblem {
+    ExpectedNumber,
+    ExpectedPath,
+    ExpectedSet,
+    UnknownCommand,
+}
+
+impl ScriptProblem {
+    fn describe(self) -> &'static str {
+        match self {
+            ScriptProblem::ExpectedNumber => "expected a number",
+            ScriptProblem::ExpectedPath => "expected a path",
+            ScriptProblem::ExpectedSet => "expected `set NAME VALUE`",
+            ScriptProblem::UnknownCommand => "unknown command",
+        }
+    }
+}
+
+/// A script's line that cannot be run, with its file and number (from 1).
+#[derive(Debug, thiserror::Error)]
+#[error("{}: line {number}: {}: {line:?}", path.display(), problem.describe())]
+pub struct ScriptError {
+    pub path: PathBuf,
+    pub number: usize,
+    pub line: String,
+    pub problem: ScriptProblem,
+}
+
 /// Parses a script; errors name the file and line.
-pub fn parse(path: &Path, text: &str) -> anyhow::Result<Vec<Command>> {
+pub fn parse(path: &Path, text: &str) -> Result<Vec<Command>, ScriptError> {
     let mut commands = Vec::new();
     for (number, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();
@@ -53,24 +83,23 @@ pub fn parse(path: &Path, text: &str) -> anyhow::Result<Vec<Command>> {
             continue;
         }
         let words: Vec<&str> = line.split_whitespace().collect();
-        let error = |message: &str| {
-            anyhow::anyhow!(
-                "{}: line {}: {message}: {line:?}",
-                path.display(),
-                number + 1
-            )
+        let error = |problem| ScriptError {
+            path: path.to_path_buf(),
+            number: number + 1,
+            line: line.to_owned(),
+            problem,
         };
-        let number_at = |i: usize| -> anyhow::Result<f32> {
+        let number_at = |i: usize| -> Result<f32, ScriptError> {
             words
                 .get(i)
                 .and_then(|w| w.parse::<f32>().ok())
-                .ok_or_else(|| error("expected a number"))
+                .ok_or_else(|| error(ScriptProblem::ExpectedNumber))
         };
-        let path_at = |i: usize| -> anyhow::Result<PathBuf> {
+        let path_at = |i: usize| -> Result<PathBuf, ScriptError> {
             words
                 .get(i)
                 .map(PathBuf::from)
-                .ok_or_else(|| error("expected a path"))
+                .ok_or_else(|| error(ScriptProblem::ExpectedPath))
         };
         let command = match words[0] {
             "wait" => Command::Wait(number_at(1)? as u32),
@@ -80,7 +109,7 @@ pub fn parse(path: &Path, text: &str) -> anyhow::Result<Vec<Command>> {
             "zoom" => Command::Zoom(number_at(1)?),
             "reset" => Command::Reset,
             "set" if words.len() == 3 => Command::Set(words[1].to_owned(), words[2].to_owned()),
-            "set" => return Err(error("expected `set NAME VALUE`")),
+            "set" => return Err(error(ScriptProblem::ExpectedSet)),
             "screenshot" => Command::Screenshot(path_at(1)?),
             "window-screenshot" => Command::WindowScreenshot(path_at(1)?),
             "command" => Command::SaveRenderLine(path_at(1)?),
@@ -89,7 +118,7 @@ pub fn parse(path: &Path, text: &str) -> anyhow::Result<Vec<Command>> {
             "place" => Command::Place(glam::Vec3::new(number_at(1)?, number_at(2)?, number_at(3)?)),
             "state" => Command::State(path_at(1)?),
             "quit" => Command::Quit,
-            _ => return Err(error("unknown command")),
+            _ => return Err(error(ScriptProblem::UnknownCommand)),
         };
         commands.push(command);
     }
@@ -116,6 +145,10 @@ mod tests {
         assert_eq!(commands[5], Command::Set("rotation".into(), "30".into()));
         let err = parse(Path::new("s.txt"), "wait\n").unwrap_err().to_string();
         assert!(err.contains("s.txt: line 1"), "{err}");
-        assert!(parse(Path::new("s.txt"), "fly 1\n").is_err());
+        let unknown = parse(Path::new("s.txt"), "wait 1\nfly 1\n").unwrap_err();
+        assert_eq!(
+            (unknown.number, unknown.problem),
+            (2, ScriptProblem::UnknownCommand)
+        );
     }
 }
