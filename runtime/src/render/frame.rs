@@ -23,7 +23,7 @@ impl Renderer {
             .lighting
             .clone()
             .ok_or_else(|| InvalidSettings::new("lighting", SettingsProblem::NoLighting))?;
-        let shadows = lighting.shadows && !lighting.lights.is_empty();
+        let shadows = lighting.shadows && !lighting.lights.is_empty() && self.casts_shadows();
         let mut encoder = self.device.create_command_encoder(&Default::default());
         self.record_reflections(&mut encoder, &lighting);
         self.record_radiance(&mut encoder, &lighting);
@@ -124,6 +124,15 @@ impl Renderer {
             .record(&self.device, encoder, &inputs, shadows);
         if let Some(composite) = &self.composite {
             composite.record(&self.device, encoder, &self.scene, &self.buffers);
+        }
+    }
+
+    /// Whether anything casts shadows: with no casters every map would be empty (every light
+    /// wholly visible), so none is drawn or kept, which is what the shadowless pass computes.
+    fn casts_shadows(&self) -> bool {
+        match self.casters {
+            ShadowCasters::All => true,
+            ShadowCasters::Objects => !self.scene.objects.is_empty() || self.proxy_layers(),
         }
     }
 
