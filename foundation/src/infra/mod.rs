@@ -1,8 +1,9 @@
-//! Infrastructure under the domain code: files written atomically, huge-page tables, cache
+//! Infrastructure under the domain code: files written atomically, the shard files' container, huge-page tables, cache
 //! prefetching, progress bars, enums named in settings files, names that become file names,
 //! and shards of a job.
 
 pub mod atomic_file;
+pub mod container;
 pub mod huge_pages;
 pub mod limits;
 pub mod names;
