@@ -258,6 +258,11 @@ impl<R: Read + Seek> Reader<R> {
         })
     }
 
+    /// The file's path, as given.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
     /// The header's bytes.
     pub fn header_bytes(&self) -> &[u8] {
         &self.header
