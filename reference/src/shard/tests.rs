@@ -143,6 +143,12 @@ fn damaged_or_impossible_bands_are_refused_with_the_reason() {
         text.contains("where its reference band header describes"),
         "{text}"
     );
+    // Or fewer: the file's bytes must be the header's, exactly.
+    let text = message(&edited(&bytes, |h| h["width"] = 4.into()));
+    assert!(
+        text.contains("where its reference band header describes"),
+        "{text}"
+    );
     let text = message(&edited(&bytes, |h| h["images"] = 2.into()));
     assert!(text.contains("2 images of 5x7"), "{text}");
     let text = message(&edited(&bytes, |h| h["index"] = 3.into()));
