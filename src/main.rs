@@ -6,7 +6,6 @@ mod cli;
 mod commands;
 mod maps;
 mod outputs;
-mod recorded;
 mod support;
 mod view;
 

@@ -67,31 +67,6 @@ pub fn create_folder(dir: &Path) -> anyhow::Result<()> {
         .with_context(|| format!("cannot create the folder {}", dir.display()))
 }
 
-/// The files in `dir` whose extension is `extension`, sorted by name; an error naming the
-/// folder and `how` to make them when there are none.
-pub fn files_with_extension(
-    dir: &Path,
-    extension: &str,
-    what: &str,
-    how: &str,
-) -> anyhow::Result<Vec<std::path::PathBuf>> {
-    let unreadable = || format!("cannot read the folder {}", dir.display());
-    let mut files = Vec::new();
-    for entry in std::fs::read_dir(dir).with_context(unreadable)? {
-        let path = entry.with_context(unreadable)?.path();
-        if path.extension().is_some_and(|e| e == extension) {
-            files.push(path);
-        }
-    }
-    files.sort();
-    anyhow::ensure!(
-        !files.is_empty(),
-        "{} holds no {what} (*.{extension}); make them with `{how}`",
-        dir.display()
-    );
-    Ok(files)
-}
-
 pub use report::maps::median;
 
 /// A progress bar with ETA on a terminal; draws nothing when stderr is not a terminal.

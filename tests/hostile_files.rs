@@ -51,15 +51,32 @@ fn resealed(mut bytes: Vec<u8>) -> Vec<u8> {
 /// A bake shard whose recorded scene path is replaced by `path` (and, when given, its
 /// recorded scene hash by `hash`), checksum made right.
 fn shard_naming(bytes: &[u8], path: &str, hash: Option<[u8; 32]>) -> Vec<u8> {
-    let old_len = u32::from_le_bytes(bytes[160..164].try_into().unwrap()) as usize;
-    let mut out = bytes[..256].to_vec();
-    out[160..164].copy_from_slice(&(path.len() as u32).to_le_bytes());
-    if let Some(hash) = hash {
-        out[172..204].copy_from_slice(&hash);
-    }
-    out.extend_from_slice(path.as_bytes());
+    container_edited(bytes, |h| {
+        h["scene_path"] = path.into();
+        if let Some(hash) = hash {
+            h["scene_hash"] = serde_json::json!(hash);
+        }
+    })
+}
+
+/// Where the sections of a shard or band start: after the container's magic, version and
+/// header length, and the JSON header zero-padded to 4 bytes.
+fn data_start(bytes: &[u8]) -> usize {
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    (16 + json_len).div_ceil(4) * 4
+}
+
+/// A shard or band with its JSON header edited by `edit`, padding and checksum made right.
+fn container_edited(bytes: &[u8], edit: impl Fn(&mut serde_json::Value)) -> Vec<u8> {
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let mut header: serde_json::Value = serde_json::from_slice(&bytes[16..16 + json_len]).unwrap();
+    edit(&mut header);
+    let json = serde_json::to_vec(&header).unwrap();
+    let mut out = bytes[..12].to_vec();
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(&json);
     out.resize(out.len().div_ceil(4) * 4, 0);
-    out.extend_from_slice(&bytes[256 + old_len.div_ceil(4) * 4..]);
+    out.extend_from_slice(&bytes[data_start(bytes)..]);
     resealed(out)
 }
 
@@ -99,8 +116,7 @@ fn shards_that_name_another_file_are_refused_before_it_is_read() {
     let out = hprt_limited(d, &["bake", "merge", "shards", "-o", "m.bake"]);
     assert_clean_failure(&out, &["other.toml", "now holds other bytes"]);
     // Absurd but finite values: refused by name, not merged into a bake render then fails on.
-    let path_len = u32::from_le_bytes(original[160..164].try_into().unwrap()) as usize;
-    let visibility = 256 + path_len.div_ceil(4) * 4;
+    let visibility = data_start(&original);
     let mut absurd = original.clone();
     absurd[visibility..visibility + 4].copy_from_slice(&3e38f32.to_le_bytes());
     std::fs::write(&shard, resealed(absurd)).unwrap();
@@ -111,21 +127,6 @@ fn shards_that_name_another_file_are_refused_before_it_is_read() {
     );
     std::fs::write(&shard, &original).unwrap();
     ok(&hprt(d, &["bake", "merge", "shards", "-o", "m.bake"]));
-}
-
-/// A band with its JSON header edited by `edit`, padding and checksum made right.
-fn band_edited(bytes: &[u8], edit: impl Fn(&mut serde_json::Value)) -> Vec<u8> {
-    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let data = (16 + json_len).div_ceil(4) * 4;
-    let mut header: serde_json::Value = serde_json::from_slice(&bytes[16..16 + json_len]).unwrap();
-    edit(&mut header);
-    let json = serde_json::to_vec(&header).unwrap();
-    let mut out = bytes[..12].to_vec();
-    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
-    out.extend_from_slice(&json);
-    out.resize(out.len().div_ceil(4) * 4, 0);
-    out.extend_from_slice(&bytes[data..]);
-    resealed(out)
 }
 
 #[test]
@@ -154,8 +155,8 @@ fn bands_that_name_another_file_or_size_are_refused() {
     let hash = blake3::hash(&passwd).to_hex().to_string();
     let merge = ["reference", "merge", "bands", "-o", "r.exr"];
     // The scene's path rewritten; then also recorded with the right hash.
-    let rewritten = band_edited(&original, |h| h["job"]["scene"] = "/etc/passwd".into());
-    let forged = band_edited(&original, |h| {
+    let rewritten = container_edited(&original, |h| h["job"]["scene"] = "/etc/passwd".into());
+    let forged = container_edited(&original, |h| {
         h["job"]["scene"] = "/etc/passwd".into();
         h["files"][0] = serde_json::json!({"path": "/etc/passwd", "blake3": hash});
     });
@@ -168,7 +169,7 @@ fn bands_that_name_another_file_or_size_are_refused() {
     // Another image size with as many pixels per band: once merged into an image of that size.
     std::fs::write(
         &band,
-        band_edited(&original, |h| {
+        container_edited(&original, |h| {
             h["width"] = 8.into();
             h["height"] = 16.into();
         }),
@@ -179,7 +180,7 @@ fn bands_that_name_another_file_or_size_are_refused() {
     for (w, h) in [(1u64 << 62, 4u64), (1 << 32, 1 << 32), (1 << 62, 1)] {
         std::fs::write(
             &band,
-            band_edited(&original, |head| {
+            container_edited(&original, |head| {
                 head["width"] = w.into();
                 head["height"] = h.into();
             }),

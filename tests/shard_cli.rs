@@ -172,6 +172,28 @@ fn reference_bands_merge_to_the_whole_composite_and_its_aux_images() {
 }
 
 #[test]
+fn bands_of_different_jobs_or_an_incomplete_set_do_not_merge() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let teapot = scene("teapot.toml");
+    let band = |i: &str, spp: &str| {
+        let args = ["reference", teapot.to_str().unwrap(), "--width", "16"];
+        let more = ["--height", "8", "--spp", spp, "--shard", i, "-o", "bands"];
+        run_ok(d, &[&args[..], &more].concat(), &[]);
+    };
+    band("0/2", "1");
+    band("1/2", "2");
+    let merge = ["reference", "merge", "bands", "-o", "m.exr"];
+    assert_clean_failure(&hprt(d, &merge), &["different jobs", "shard 0/2"]);
+    band("1/2", "1");
+    std::fs::remove_file(d.join("bands/reference-0000-of-0002.hprtband")).unwrap();
+    assert_clean_failure(&hprt(d, &merge), &["shard 0 of 2 is missing"]);
+    assert!(!d.join("m.exr").exists());
+    band("0/2", "1");
+    run_ok(d, &merge, &[]);
+}
+
+#[test]
 fn report_shards_fill_the_cache_the_report_then_reads() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

@@ -1,47 +1,29 @@
-//! The bake shard file (`.hprtshard`): one shard's tracing results, little-endian, checked by
-//! the merge (see `precompute/BAKE_FORMAT.md`).
+//! The bake shard file (`.hprtshard`): one shard's tracing results, in the shard container
+//! of `foundation::infra::container` (magic `HPRTSHRD`), checked by the merge (see
+//! `precompute/BAKE_FORMAT.md`).
+//!
+//! The header ([`ShardHeader`], JSON) holds the settings, the shard, the vertex range, the
+//! hashes and the scene's path; the sections follow, with `R` the shard's vertices, `n²` the
+//! coefficients and `E` the operator's entries:
 //!
 //! ```text
-//! offset size  field
-//!      0    8  magic "HPRTSHRD"
-//!      8    4  u32 format version (2)
-//!     12    4  u32 header size in bytes (256)
-//!     16    4  u32 SH order n
-//!     20    4  u32 bounces
-//!     24    4  u32 samples per vertex
-//!     28    4  u32 shard index I (from 0)
-//!     32    4  u32 shard count N
-//!     36    4  f32 ray offset (fraction of the scene's bounding-box diagonal)
-//!     40    8  u64 seed
-//!     48    8  u64 vertex count V of the scene
-//!     56    8  u64 first vertex of the shard
-//!     64    8  u64 end vertex of the shard (exclusive); R = end − first
-//!     72    8  f64 seconds the shard's tracing took
-//!     80   32  BLAKE3 hash of the scene mesh
-//!    112   32  BLAKE3 hash of every shard's vertex range
-//!    144   16  hprt version (UTF-8, zero-padded)
-//!    160    4  u32 scene path length P in bytes
-//!    164    8  u64 operator entries E
-//!    172   32  BLAKE3 hash of the scene file's bytes
-//!    204   52  reserved (zero)
-//!    256    P  scene path (UTF-8), zero-padded to a multiple of 4
-//!      …  4·R·n²  visibility, f32 [R][n²]: (1/samples) Σ over escaping rays of Y_k(ω)
-//!      …  4·(R+1)  u32 operator row starts (relative to the shard's first entry)
-//!      …  4·E  u32 operator columns (scene vertex indices)
-//!      …  4·E  f32 operator weights
-//!      …  R    u8 inside flags (0 or 1), zero-padded to a multiple of 4
-//!    end    4  u32 CRC-32 (IEEE) of every preceding byte
+//! f32 [R][n²]  visibility: (1/samples) Σ over escaping rays of Y_k(ω)
+//! u32 [R+1]    operator row starts (relative to the shard's first entry)
+//! u32 [E]      operator columns (scene vertex indices)
+//! f32 [E]      operator weights
+//! u8  [R]      inside flags (0 or 1)
 //! ```
 
 use crate::bake::bounce::{InterreflectionOperator, OperatorBlock};
 use crate::bake::shard::BakeShard;
 use crate::bake::visibility::{CHUNK, TracedVertices};
 use crate::bake::{BakeSettings, RAY_OFFSET_FRACTION};
-use crate::bakefile::{Envelope, check_envelope, u32_at, u64_at};
-use foundation::infra::limits::{MAX_BAKE_BYTES, ReadError};
+use foundation::infra::container::{ContainerError, Format, Reader, Section};
+use foundation::infra::limits::MAX_BAKE_BYTES;
 use foundation::infra::shard::ShardSpec;
 use foundation::sh::{self, num_coeffs};
-use std::io::{Read, Seek, SeekFrom};
+use serde::{Deserialize, Serialize};
+use std::io::{Read, Seek};
 use std::path::{Path, PathBuf};
 use values::{check_row_sums, check_rows, check_visibility, check_weights};
 
@@ -50,25 +32,50 @@ mod write;
 
 pub use write::{encode, write};
 
-const MAGIC: &[u8; 8] = b"HPRTSHRD";
-/// Version 2 added the scene file's hash (version 1 named the scene by its path alone).
-const VERSION: u32 = 2;
-const HEADER_SIZE: usize = 256;
+/// Version 3 moved the shard into the shared container (a JSON header); version 2 added the
+/// scene file's hash (version 1 named the scene by its path alone).
+const FORMAT: Format = Format {
+    magic: b"HPRTSHRD",
+    version: 3,
+    what: "bake shard",
+};
 /// The file name extension of bake shards.
 pub const EXTENSION: &str = "hprtshard";
+
+/// A shard's header.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ShardHeader {
+    /// The hprt version that traced it: shards merge only into the version that made them.
+    pub hprt: String,
+    pub order: usize,
+    pub bounces: u32,
+    pub samples: u32,
+    pub seed: u64,
+    pub index: u32,
+    pub count: u32,
+    /// The ray offset (a fraction of the scene's bounding-box diagonal).
+    pub ray_offset: f32,
+    /// The scene's vertex count, and the shard's range of them (end exclusive).
+    pub vertex_count: u64,
+    pub first: u64,
+    pub end: u64,
+    /// Seconds the shard's tracing took.
+    pub seconds: f64,
+    /// BLAKE3 of the scene mesh, of every shard's vertex range, and of the scene file.
+    pub mesh_hash: [u8; 32],
+    pub partition_hash: [u8; 32],
+    pub scene_hash: [u8; 32],
+    /// The scene's absolute path (the merge checks the file there against `scene_hash`).
+    pub scene_path: String,
+    /// Interreflection operator entries.
+    pub entries: u64,
+}
 
 /// Why a shard file cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum ShardFileError {
-    #[error("{}: {cause}", path.display())]
-    Io {
-        path: PathBuf,
-        cause: std::io::Error,
-    },
-    #[error("{}: not an hprt bake shard (bad magic)", path.display())]
-    NotAShard { path: PathBuf },
-    #[error("{}: bake shard format version {found}, this hprt reads version {VERSION}", path.display())]
-    Version { path: PathBuf, found: u32 },
+    #[error(transparent)]
+    Container(#[from] ContainerError),
     #[error(
         "{}: made by hprt {found}, this is hprt {}; bake the shards again with this version",
         path.display(), env!("CARGO_PKG_VERSION")
@@ -83,193 +90,113 @@ pub fn file_name(spec: ShardSpec) -> String {
     format!("bake-{}.{EXTENSION}", spec.tag())
 }
 
-/// Bytes moved per read or write of the data arrays.
-const IO_CHUNK: usize = 1 << 16;
-
-/// Where a shard file's sections start, from its header and checked against its length.
-struct Layout {
-    rows: usize,
-    entries: usize,
-    path: u64,
-    path_len: usize,
-    visibility: u64,
-    row_starts: u64,
-    columns: u64,
-    weights: u64,
-    inside: u64,
-}
-
-impl Layout {
-    /// The sections of a file of `len` bytes whose header is `header` (its first
-    /// [`HEADER_SIZE`] bytes); an error when the header's sizes do not add up to `len`.
-    fn of(header: &[u8], len: u64) -> Result<Self, String> {
-        let order = u32_at(header, 16) as usize;
-        sh::check_order(order).map_err(|e| e.to_string())?;
-        let (vertex_count, first, end) =
-            (u64_at(header, 48), u64_at(header, 56), u64_at(header, 64));
-        if first > end || end > vertex_count || vertex_count > u64::from(u32::MAX) {
-            return Err(format!("vertex range {first}..{end} of {vertex_count}"));
-        }
-        let rows = end - first;
-        let entries = u64_at(header, 164);
-        let path_len = u64::from(u32_at(header, 160));
-        let coeffs = num_coeffs(order) as u64;
-        let sizes = [
-            path_len.div_ceil(4) * 4,
-            rows.checked_mul(4 * coeffs).ok_or("size")?,
-            4 * (rows + 1),
-            entries.checked_mul(4).ok_or("size")?,
-            entries.checked_mul(4).ok_or("size")?,
-            rows.div_ceil(4) * 4,
-        ];
-        let mut starts = [0u64; 6];
-        let mut at = HEADER_SIZE as u64;
-        for (start, size) in starts.iter_mut().zip(sizes) {
-            *start = at;
-            at = at.checked_add(size).ok_or("size")?;
-        }
-        if at.checked_add(4) != Some(len) {
-            return Err(format!(
-                "{len} bytes where its header describes {} (truncated or damaged)",
-                at.saturating_add(4)
-            ));
-        }
-        Ok(Self {
-            rows: rows as usize,
-            entries: entries as usize,
-            path: starts[0],
-            path_len: path_len as usize,
-            visibility: starts[1],
-            row_starts: starts[2],
-            columns: starts[3],
-            weights: starts[4],
-            inside: starts[5],
-        })
-    }
-}
-
-/// Reads `count` little-endian 32-bit words at `offset`.
-fn read_words<R: Read + Seek>(
-    source: &mut R,
-    offset: u64,
-    count: usize,
-) -> std::io::Result<Vec<u32>> {
-    source.seek(SeekFrom::Start(offset))?;
-    let mut out = Vec::with_capacity(count);
-    let mut buffer = vec![0u8; IO_CHUNK];
-    let mut left = count * 4;
-    while left > 0 {
-        let chunk = &mut buffer[..left.min(IO_CHUNK)];
-        source.read_exact(chunk)?;
-        out.extend(
-            chunk
-                .chunks_exact(4)
-                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
-        );
-        left -= chunk.len();
-    }
-    Ok(out)
-}
-
-/// The CRC-32 of the first `len` bytes of `source`, read a buffer at a time.
-fn checksum<R: Read + Seek>(source: &mut R, len: u64) -> std::io::Result<u32> {
-    source.seek(SeekFrom::Start(0))?;
-    let mut crc = crc32fast::Hasher::new();
-    let mut buffer = vec![0u8; IO_CHUNK];
-    let mut left = len;
-    while left > 0 {
-        let chunk = &mut buffer[..left.min(IO_CHUNK as u64) as usize];
-        source.read_exact(chunk)?;
-        crc.update(chunk);
-        left -= chunk.len() as u64;
-    }
-    Ok(crc.finalize())
-}
-
 /// Parses bytes written by [`encode`]; `path` only names the file in errors.
 pub fn decode(path: &Path, bytes: &[u8]) -> Result<BakeShard, ShardFileError> {
-    decode_from(path, &mut std::io::Cursor::new(bytes), bytes.len() as u64)
+    let source = std::io::Cursor::new(bytes);
+    decode_from(Reader::new(path, source, bytes.len() as u64, FORMAT)?)
 }
 
 /// Reads and verifies a shard file: checksum first (one pass over the file), then the data
 /// straight into the shard's arrays, so reading holds no copy of the file.
 pub fn read(path: &Path) -> Result<BakeShard, ShardFileError> {
-    let io = |cause: std::io::Error| ShardFileError::Io {
-        path: path.to_owned(),
-        cause,
-    };
-    let metadata = std::fs::metadata(path).map_err(io)?;
-    if !metadata.is_file() {
-        return Err(io(ReadError::NotAFile.into()));
-    }
-    if metadata.len() > MAX_BAKE_BYTES {
-        return Err(io(ReadError::TooLarge {
-            size: metadata.len(),
-            max: MAX_BAKE_BYTES,
-        }
-        .into()));
-    }
-    let file = std::fs::File::open(path).map_err(io)?;
-    decode_from(path, &mut std::io::BufReader::new(file), metadata.len())
+    decode_from(Reader::open(path, FORMAT, MAX_BAKE_BYTES)?)
 }
 
-/// [`decode`] from a source of `len` bytes.
-fn decode_from<R: Read + Seek>(
-    path: &Path,
-    source: &mut R,
-    len: u64,
-) -> Result<BakeShard, ShardFileError> {
+/// The sections of a shard, claimed in order.
+struct Sections {
+    visibility: Section<f32>,
+    row_starts: Section<u32>,
+    columns: Section<u32>,
+    weights: Section<f32>,
+    inside: Section<u8>,
+}
+
+impl Sections {
+    fn claim<R: Read + Seek>(
+        reader: &mut Reader<R>,
+        header: &ShardHeader,
+    ) -> Result<Self, ContainerError> {
+        let rows = header.end - header.first;
+        let coeffs = num_coeffs(header.order) as u64;
+        let sections = Self {
+            visibility: reader.section(rows.saturating_mul(coeffs))?,
+            row_starts: reader.section(rows + 1)?,
+            columns: reader.section(header.entries)?,
+            weights: reader.section(header.entries)?,
+            inside: reader.section(rows)?,
+        };
+        reader.check_filled()?;
+        Ok(sections)
+    }
+}
+
+/// The checked header, settings and shard of a file whose framing and checksum passed.
+fn checked_header(header: &ShardHeader) -> Result<(BakeSettings, ShardSpec), String> {
+    sh::check_order(header.order).map_err(|e| e.to_string())?;
+    let (vertex_count, first, end) = (header.vertex_count, header.first, header.end);
+    if first > end || end > vertex_count || vertex_count > u64::from(u32::MAX) {
+        return Err(format!("vertex range {first}..{end} of {vertex_count}"));
+    }
+    let settings = BakeSettings {
+        order: header.order,
+        bounces: header.bounces,
+        samples: header.samples,
+        seed: header.seed,
+    };
+    settings.validate().map_err(|e| e.to_string())?;
+    let spec = ShardSpec::new(header.index, header.count)?;
+    if header.ray_offset != RAY_OFFSET_FRACTION {
+        return Err(format!(
+            "ray offset {}, this hprt uses {RAY_OFFSET_FRACTION}",
+            header.ray_offset
+        ));
+    }
+    Ok((settings, spec))
+}
+
+/// The shard of a container whose framing and checksum passed.
+fn decode_from<R: Read + Seek>(mut reader: Reader<R>) -> Result<BakeShard, ShardFileError> {
+    let path = reader.path().to_owned();
     let corrupt = |message: String| ShardFileError::Corrupt {
-        path: path.to_owned(),
+        path: path.clone(),
         message,
     };
-    let io = |cause: std::io::Error| ShardFileError::Io {
-        path: path.to_owned(),
-        cause,
-    };
-    let mut header = vec![0u8; len.min(HEADER_SIZE as u64 + 4) as usize];
-    source.read_exact(&mut header).map_err(io)?;
-    check_envelope(&header, MAGIC, HEADER_SIZE, VERSION).map_err(|e| match e {
-        Envelope::Magic => ShardFileError::NotAShard {
-            path: path.to_owned(),
-        },
-        Envelope::Short(_) => corrupt(format!("only {len} bytes")),
-        Envelope::Version(found) => ShardFileError::Version {
-            path: path.to_owned(),
-            found,
-        },
-    })?;
-    let mut stored = [0u8; 4];
-    source.seek(SeekFrom::Start(len - 4)).map_err(io)?;
-    source.read_exact(&mut stored).map_err(io)?;
-    if checksum(source, len - 4).map_err(io)? != u32::from_le_bytes(stored) {
-        return Err(corrupt("checksum mismatch (truncated or damaged)".into()));
-    }
-    let hprt = String::from_utf8_lossy(&header[144..160])
-        .trim_end_matches('\0')
-        .to_owned();
-    if hprt != env!("CARGO_PKG_VERSION") {
+    let header: ShardHeader = reader.header()?;
+    if header.hprt != env!("CARGO_PKG_VERSION") {
         return Err(ShardFileError::HprtVersion {
-            path: path.to_owned(),
-            found: hprt,
+            path,
+            found: header.hprt,
         });
     }
-    let layout = Layout::of(&header, len).map_err(corrupt)?;
-    decode_checked(&header, &layout, source).map_err(|e| match e {
-        Decode::Io(cause) => io(cause),
+    let (settings, spec) = checked_header(&header).map_err(corrupt)?;
+    let sections = Sections::claim(&mut reader, &header)?;
+    let traced = decode_traced(&mut reader, &header, &sections).map_err(|e| match e {
+        Decode::Container(e) => e.into(),
         Decode::Corrupt(message) => corrupt(message),
+    })?;
+    Ok(BakeShard {
+        spec,
+        settings,
+        vertex_count: header.vertex_count,
+        vertices: header.first as usize..header.end as usize,
+        mesh_hash: header.mesh_hash,
+        partition_hash: header.partition_hash,
+        scene_path: header.scene_path,
+        scene_hash: header.scene_hash,
+        seconds: header.seconds,
+        traced,
     })
 }
 
 /// Why the data of a shard whose header passed cannot be read.
 enum Decode {
-    Io(std::io::Error),
+    Container(ContainerError),
     Corrupt(String),
 }
 
-impl From<std::io::Error> for Decode {
-    fn from(e: std::io::Error) -> Self {
-        Self::Io(e)
+impl From<ContainerError> for Decode {
+    fn from(e: ContainerError) -> Self {
+        Self::Container(e)
     }
 }
 
@@ -279,86 +206,45 @@ impl From<String> for Decode {
     }
 }
 
-/// The fields of a shard whose header, version, length and checksum passed; the operator is
-/// read block by block into its final arrays.
-fn decode_checked<R: Read + Seek>(
-    header: &[u8],
-    layout: &Layout,
-    source: &mut R,
-) -> Result<BakeShard, Decode> {
-    let order = u32_at(header, 16) as usize;
-    let settings = BakeSettings {
-        order,
-        bounces: u32_at(header, 20),
-        samples: u32_at(header, 24),
-        seed: u64_at(header, 40),
-    };
-    settings.validate().map_err(|e| e.to_string())?;
-    let spec = ShardSpec::new(u32_at(header, 28), u32_at(header, 32))?;
-    let ray_offset = f32::from_le_bytes(header[36..40].try_into().expect("4 bytes"));
-    if ray_offset != RAY_OFFSET_FRACTION {
-        return Err(
-            format!("ray offset {ray_offset}, this hprt uses {RAY_OFFSET_FRACTION}").into(),
-        );
-    }
-    let vertex_count = u64_at(header, 48);
-    let first = u64_at(header, 56) as usize;
-    let mut path_bytes = vec![0u8; layout.path_len];
-    source.seek(SeekFrom::Start(layout.path))?;
-    source.read_exact(&mut path_bytes)?;
-    let visibility: Vec<f32> =
-        read_words(source, layout.visibility, layout.rows * num_coeffs(order))?
-            .into_iter()
-            .map(f32::from_bits)
-            .collect();
-    let row_starts = read_words(source, layout.row_starts, layout.rows + 1)?;
-    check_rows(&row_starts, layout.entries)?;
-    let mut blocks = Vec::with_capacity(layout.rows.div_ceil(CHUNK));
-    for first_row in (0..layout.rows).step_by(CHUNK) {
-        let end = (first_row + CHUNK).min(layout.rows);
-        let (base, stop) = (row_starts[first_row], row_starts[end]);
-        let count = (stop - base) as usize;
-        let columns = read_words(source, layout.columns + 4 * u64::from(base), count)?;
-        if columns.iter().any(|&c| u64::from(c) >= vertex_count) {
+/// The traced data, checked; the operator is read block by block into its final arrays.
+fn decode_traced<R: Read + Seek>(
+    reader: &mut Reader<R>,
+    header: &ShardHeader,
+    sections: &Sections,
+) -> Result<TracedVertices, Decode> {
+    let rows = sections.inside.len();
+    let visibility = reader.read_all(&sections.visibility)?;
+    let row_starts = reader.read_all(&sections.row_starts)?;
+    check_rows(&row_starts, sections.columns.len())?;
+    let mut blocks = Vec::with_capacity(rows.div_ceil(CHUNK));
+    for first_row in (0..rows).step_by(CHUNK) {
+        let end = (first_row + CHUNK).min(rows);
+        let entries = row_starts[first_row] as usize..row_starts[end] as usize;
+        let columns = reader.read(&sections.columns, entries.clone())?;
+        if columns.iter().any(|&c| u64::from(c) >= header.vertex_count) {
             return Err("operator column beyond the scene's vertices"
                 .to_string()
                 .into());
         }
-        let weights: Vec<f32> = read_words(source, layout.weights + 4 * u64::from(base), count)?
-            .into_iter()
-            .map(f32::from_bits)
-            .collect();
+        let weights = reader.read(&sections.weights, entries.clone())?;
         check_weights(&weights)?;
         blocks.push(OperatorBlock {
             row_starts: row_starts[first_row..=end]
                 .iter()
-                .map(|s| s - base)
+                .map(|s| s - entries.start as u32)
                 .collect(),
             columns,
             weights,
         });
     }
-    check_visibility(&visibility, order)?;
+    check_visibility(&visibility, header.order)?;
     check_row_sums(&blocks)?;
-    let mut inside = vec![0u8; layout.rows];
-    source.seek(SeekFrom::Start(layout.inside))?;
-    source.read_exact(&mut inside)?;
-    Ok(BakeShard {
-        spec,
-        settings,
-        vertex_count,
-        vertices: first..first + layout.rows,
-        mesh_hash: header[80..112].try_into().expect("32 bytes"),
-        partition_hash: header[112..144].try_into().expect("32 bytes"),
-        scene_path: String::from_utf8_lossy(&path_bytes).into_owned(),
-        scene_hash: header[172..204].try_into().expect("32 bytes"),
-        seconds: f64::from_le_bytes(header[72..80].try_into().expect("8 bytes")),
-        traced: TracedVertices {
-            order,
-            visibility,
-            operator: InterreflectionOperator::from_blocks(blocks),
-            inside: inside.into_iter().map(|b| b != 0).collect(),
-        },
+    let inside = reader.read_all(&sections.inside)?;
+    Ok(TracedVertices {
+        order: header.order,
+        visibility,
+        operator: InterreflectionOperator::from_blocks(blocks),
+        inside: inside.into_iter().map(|b| b != 0).collect(),
     })
 }
 
@@ -432,36 +318,74 @@ mod tests {
         assert_eq!(read(&path).unwrap(), shard);
     }
 
+    /// Where the sections start: after the container's 16 bytes and the padded JSON header.
+    fn data_start(bytes: &[u8]) -> usize {
+        let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        (16 + json_len).div_ceil(4) * 4
+    }
+
+    /// `bytes` with its JSON header edited by `edit`, padding and checksum made right.
+    fn edited(bytes: &[u8], edit: impl Fn(&mut serde_json::Value)) -> Vec<u8> {
+        let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        let mut header: serde_json::Value =
+            serde_json::from_slice(&bytes[16..16 + json_len]).unwrap();
+        edit(&mut header);
+        let json = serde_json::to_vec(&header).unwrap();
+        let mut out = bytes[..12].to_vec();
+        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        out.extend_from_slice(&json);
+        out.resize(out.len().div_ceil(4) * 4, 0);
+        out.extend_from_slice(&bytes[data_start(bytes)..]);
+        resealed(out)
+    }
+
     #[test]
     fn damaged_truncated_or_foreign_shards_are_refused_with_the_reason() {
-        let bytes = encode(&shard());
+        let shard = shard();
+        let bytes = encode(&shard);
         assert!(message(&bytes[..bytes.len() - 40]).contains("checksum"));
-        assert!(message(&bytes[..100]).contains("only 100 bytes"));
+        assert!(message(&bytes[..10]).contains("truncated bake shard"));
         let mut flipped = bytes.clone();
-        flipped[HEADER_SIZE + 20] ^= 1;
+        flipped[data_start(&bytes) + 20] ^= 1;
         assert!(message(&flipped).contains("checksum"));
+        // A band is not a shard, nor is an older shard.
+        let mut band = bytes.clone();
+        band[..8].copy_from_slice(b"HPRTBAND");
+        assert!(message(&resealed(band)).contains("not an hprt bake shard"));
+        let mut older = bytes.clone();
+        older[8..12].copy_from_slice(&2u32.to_le_bytes());
+        let text = message(&resealed(older));
+        assert!(text.contains("bake shard format version 2"), "{text}");
         // Another hprt version, checksum intact.
-        let mut other = bytes.clone();
-        other[144..160].copy_from_slice(b"0.0.1\0\0\0\0\0\0\0\0\0\0\0");
-        let text = message(&resealed(other));
+        let text = message(&edited(&bytes, |h| h["hprt"] = "0.0.1".into()));
         assert!(text.contains("made by hprt 0.0.1"), "{text}");
         // A header that promises more operator entries than the file holds.
-        let mut more = bytes.clone();
-        let entries = u64_at(&more, 164) + 1;
-        more[164..172].copy_from_slice(&entries.to_le_bytes());
-        let text = message(&resealed(more));
-        assert!(text.contains("where its header describes"), "{text}");
+        let entries = shard
+            .traced
+            .operator
+            .blocks()
+            .iter()
+            .map(|b| b.columns.len())
+            .sum::<usize>();
+        let text = message(&edited(&bytes, |h| h["entries"] = (entries + 1).into()));
+        assert!(
+            text.contains("where its bake shard header describes"),
+            "{text}"
+        );
+        // Sizes no file holds: refused before anything is allocated.
+        let text = message(&edited(&bytes, |h| h["entries"] = u64::MAX.into()));
+        assert!(text.contains("more than any file holds"), "{text}");
         // An operator column that names a vertex the scene does not have.
-        let layout = Layout::of(&bytes[..HEADER_SIZE], bytes.len() as u64).unwrap();
+        let rows = shard.vertices.len();
+        let visibility = data_start(&bytes);
+        let columns = visibility + 4 * rows * num_coeffs(shard.settings.order) + 4 * (rows + 1);
         let mut column = bytes.clone();
-        let at = layout.columns as usize;
-        column[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+        column[columns..columns + 4].copy_from_slice(&u32::MAX.to_le_bytes());
         let text = message(&resealed(column));
         assert!(text.contains("beyond the scene's vertices"), "{text}");
         // Finite values no tracing makes (the bounds are tested in `values`).
         let mut absurd = bytes.clone();
-        let at = layout.visibility as usize;
-        absurd[at..at + 4].copy_from_slice(&3e38f32.to_le_bytes());
+        absurd[visibility..visibility + 4].copy_from_slice(&3e38f32.to_le_bytes());
         let text = message(&resealed(absurd));
         assert!(text.contains("visibility coefficient is 3"), "{text}");
         // The shard it was made from reads back whole: real values pass every bound.

@@ -13,8 +13,10 @@
 pub mod composite;
 pub mod export;
 mod integrator;
+pub mod job;
 mod light;
 mod sampler;
+pub mod shard;
 
 pub use integrator::{DirectVisibility, Integrator, PathEstimate, SurfacePoint};
 pub use light::EnvironmentLight;

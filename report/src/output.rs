@@ -3,7 +3,7 @@
 
 use crate::error::{ReportError, Result};
 use foundation::scene::Scene;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Refuses `folder` (given as `option`) when it holds any of `inputs`.
 pub fn check_folder_spares_inputs(
@@ -31,15 +31,5 @@ pub fn check_folder_spares_inputs(
 
 /// Every file `scene` reads (its sources, map and probes), with `other` inputs.
 pub fn scene_inputs<'a>(scene: &'a Scene, other: &[Option<&'a Path>]) -> Vec<&'a Path> {
-    let environment = scene.environment.as_ref().map(|e| e.map.as_path());
-    let probes = (scene.probes.iter())
-        .flat_map(|p| std::iter::once(p.image.as_path()).chain(p.distances.as_deref()));
-    scene
-        .sources
-        .iter()
-        .map(PathBuf::as_path)
-        .chain(other.iter().flatten().copied())
-        .chain(environment)
-        .chain(probes)
-        .collect()
+    scene.inputs(other)
 }

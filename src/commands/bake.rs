@@ -3,14 +3,13 @@
 
 use crate::bake_cache::print_bake_stats;
 use crate::outputs::{check_outputs, scene_inputs};
-use crate::support::{
-    TerminalProgress, create_folder, files_with_extension, load_scene, with_threads,
-};
+use crate::support::{TerminalProgress, create_folder, load_scene, with_threads};
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use foundation::bvh::SceneBvh;
 use foundation::infra::atomic_file::AtomicOutput;
-use foundation::infra::shard::{ProcessEnvironment, ShardSpec};
+use foundation::infra::recorded::{RecordedFile, check_scene_path, file_hash};
+use foundation::infra::shard::{ProcessEnvironment, ShardSpec, files_with_extension};
 use foundation::scene::Scene;
 use precompute::bake::{self, BakeSettings, BakeStats, Transfer};
 use precompute::{bakefile, shardfile};
@@ -179,8 +178,8 @@ fn run_shard(
     // The merge reloads the scene by this path, perhaps from another folder.
     let scene_path = std::path::absolute(&scene.path)
         .with_context(|| format!("cannot resolve {}", scene.path.display()))?;
-    let scene_hash = crate::recorded::file_hash(&scene_path)
-        .with_context(|| format!("cannot read {}", scene_path.display()))?;
+    let scene_hash =
+        file_hash(&scene_path).with_context(|| format!("cannot read {}", scene_path.display()))?;
     let shard = with_threads(threads, || {
         let bvh = SceneBvh::build(&scene.geometry.mesh);
         let progress = TerminalProgress::new("tracing");
@@ -206,8 +205,7 @@ fn run_shard(
 /// `hprt bake merge DIR -o FILE`.
 fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
     let dir = &args.shards;
-    let how = format!("hprt bake SCENE --shard I/N -o {}", dir.display());
-    let files = files_with_extension(dir, shardfile::EXTENSION, "bake shards", &how)?;
+    let files = files_with_extension(dir, shardfile::EXTENSION, "bake shards", "hprt bake SCENE")?;
     let shards = files
         .iter()
         .map(|f| shardfile::read(f))
@@ -218,13 +216,13 @@ fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
         None => {
             // A path read from a shard: the file must still be the one it was baked from
             // before any of it is read.
-            let recorded = crate::recorded::RecordedFile {
+            let recorded = RecordedFile {
                 path: PathBuf::from(&shards[0].scene_path),
                 blake3: blake3::Hash::from_bytes(shards[0].scene_hash)
                     .to_hex()
                     .to_string(),
             };
-            crate::recorded::check_scene_path(&files[0], &recorded.path)?;
+            check_scene_path(&files[0], &recorded.path)?;
             recorded.check(&files[0]).context(
                 "cannot merge the shards (give the scene with --scene if it moved or changed)",
             )?;

@@ -1,9 +1,10 @@
-//! Infrastructure under the domain code: files written atomically, huge-page tables, cache
-//! prefetching, progress bars, enums named in settings files, names that become file names,
+//! Infrastructure under the domain code: files written atomically, the content-addressed cache, the shard files' container, huge-page tables, cache
+//! prefetching, progress bars, files recorded with their hashes, enums named in settings files, names that become file names,
 //! and shards of a job.
 
 pub mod atomic_file;
 pub mod cache;
+pub mod container;
 pub mod huge_pages;
 pub mod limits;
 pub mod names;
@@ -11,6 +12,7 @@ pub mod names;
 pub mod named_enum;
 pub mod prefetch;
 pub mod progress;
+pub mod recorded;
 pub mod shard;
 
 /// Logs `message` as a warning unless this process already has: a file read twice (a model

@@ -179,6 +179,60 @@ pub fn check_indices(specs: &[ShardSpec]) -> Result<(), IncompleteShards> {
     Ok(())
 }
 
+/// The shard files of a folder cannot be listed.
+#[derive(Debug, thiserror::Error)]
+pub enum ListError {
+    #[error("cannot read the folder {}", dir.display())]
+    Unreadable {
+        dir: std::path::PathBuf,
+        #[source]
+        cause: std::io::Error,
+    },
+    #[error(
+        "{} holds no {what} (*.{extension}); make them with `{command} --shard I/N -o {}`",
+        dir.display(),
+        dir.display()
+    )]
+    Empty {
+        dir: std::path::PathBuf,
+        what: &'static str,
+        extension: &'static str,
+        /// The command that makes them ("hprt bake SCENE").
+        command: &'static str,
+    },
+}
+
+/// The files in `dir` whose extension is `extension`, sorted by name; an error naming the
+/// folder and the `command` that makes them when there are none.
+pub fn files_with_extension(
+    dir: &std::path::Path,
+    extension: &'static str,
+    what: &'static str,
+    command: &'static str,
+) -> Result<Vec<std::path::PathBuf>, ListError> {
+    let unreadable = |cause| ListError::Unreadable {
+        dir: dir.to_owned(),
+        cause,
+    };
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(unreadable)? {
+        let path = entry.map_err(unreadable)?.path();
+        if path.extension().is_some_and(|e| e == extension) {
+            files.push(path);
+        }
+    }
+    files.sort();
+    if files.is_empty() {
+        return Err(ListError::Empty {
+            dir: dir.to_owned(),
+            what,
+            extension,
+            command,
+        });
+    }
+    Ok(files)
+}
+
 /// Splits items of the given costs into `count` consecutive ranges of about equal total
 /// cost (each range's end is the first item whose cost prefix reaches its share). The split
 /// depends only on `costs`, so every shard computes the same one on its own.

@@ -22,7 +22,7 @@ pub use rotation::rotation_from_deg;
 use crate::bake_settings::BakeSettings;
 use crate::camera::Camera;
 use crate::mesh::MeshError;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Why a scene could not be loaded. Every variant names the scene file.
 #[derive(Debug, thiserror::Error)]
@@ -68,6 +68,21 @@ pub struct Scene {
 /// Variants of a scene: a part of its geometry (the room, the model) or geometry changed
 /// (the model collapsed), the rest of the scene kept.
 impl Scene {
+    /// The files the scene reads (its sources, then `other`, its map and its probes' images):
+    /// what a command's outputs must not overwrite, and what a reference band records.
+    pub fn inputs<'a>(&'a self, other: &[Option<&'a Path>]) -> Vec<&'a Path> {
+        let environment = self.environment.as_ref().map(|e| e.map.as_path());
+        let probes = (self.probes.iter())
+            .flat_map(|p| std::iter::once(p.image.as_path()).chain(p.distances.as_deref()));
+        self.sources
+            .iter()
+            .map(PathBuf::as_path)
+            .chain(other.iter().flatten().copied())
+            .chain(environment)
+            .chain(probes)
+            .collect()
+    }
+
     /// This scene with `geometry` in place of its own (its own is not copied).
     pub fn with_geometry(&self, geometry: SceneMesh) -> Scene {
         Scene {

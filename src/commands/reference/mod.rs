@@ -5,11 +5,13 @@ mod job;
 mod shard;
 
 use crate::cli::{EnvironmentArgs, ImageSizeArgs};
+use crate::support::{TerminalProgress, with_threads};
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use foundation::infra::shard::{ProcessEnvironment, ShardSpec};
-use job::{JobSpec, OutputFiles, ReferenceJob};
+use job::OutputFiles;
 use reference::SamplerKind;
+use reference::job::{JobSpec, ReferenceJob};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -63,6 +65,7 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
     }
     let spec = job_spec(&args)?;
     let job = ReferenceJob::prepare(&spec)?;
+    job::warn(&job.warnings);
     let Some(output) = &args.files.output else {
         anyhow::bail!("hprt reference needs -o");
     };
@@ -75,10 +78,12 @@ pub fn run(args: ReferenceArgs) -> anyhow::Result<()> {
         );
         return shard::run_band(&spec, &job, band, output, args.threads);
     }
-    let files = job.open_outputs(&args.files, output, &[])?;
-    job.announce();
-    let (image, composite) = job.render_whole(args.threads)?;
-    job.write(&args.files, output, files, &image, composite.as_ref())
+    let files = job::open(&job, &args.files, output, &[])?;
+    job::announce(&job);
+    let finished = with_threads(args.threads, || {
+        job.render_whole(&TerminalProgress::new("rendering rows"))
+    })?;
+    job::write(&job, &args.files, output, files, finished)
 }
 
 fn absolute(path: &Path) -> anyhow::Result<PathBuf> {

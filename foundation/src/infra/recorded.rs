@@ -3,8 +3,7 @@
 //! a path rewritten in a shard or band cannot make hprt read another file, nor quote any of
 //! it in an error.
 
-use anyhow::Context;
-use foundation::infra::limits::{MAX_MESH_BYTES, ReadError, regular_file_size};
+use super::limits::{MAX_MESH_BYTES, ReadError, regular_file_size};
 use serde::{Deserialize, Serialize};
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -16,10 +15,43 @@ pub struct RecordedFile {
     pub blake3: String,
 }
 
+/// Why a recorded file is refused.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordedError {
+    #[error("cannot read {}", path.display())]
+    Unreadable {
+        path: PathBuf,
+        #[source]
+        cause: ReadError,
+    },
+    #[error(
+        "{} names {} as an input, but that file {}: the inputs changed since it was written, or \
+         it was altered; make it again",
+        holder.display(),
+        path.display(),
+        if *.readable { "now holds other bytes" } else { "cannot be read as a regular file" }
+    )]
+    Changed {
+        holder: PathBuf,
+        path: PathBuf,
+        readable: bool,
+    },
+    #[error(
+        "{} names {} as its scene, which is not a scene file (.toml) or a model: it was \
+         altered; make it again",
+        holder.display(),
+        path.display()
+    )]
+    NotAScene { holder: PathBuf, path: PathBuf },
+}
+
 impl RecordedFile {
     /// Records `path` as it is now.
-    pub fn of(path: &Path) -> anyhow::Result<Self> {
-        let hash = file_hash(path).with_context(|| format!("cannot read {}", path.display()))?;
+    pub fn of(path: &Path) -> Result<Self, RecordedError> {
+        let hash = file_hash(path).map_err(|cause| RecordedError::Unreadable {
+            path: path.to_owned(),
+            cause,
+        })?;
         Ok(Self {
             path: path.to_owned(),
             blake3: blake3::Hash::from_bytes(hash).to_hex().to_string(),
@@ -28,39 +60,33 @@ impl RecordedFile {
 
     /// Refuses the file unless it still holds the recorded bytes; `holder` is the file that
     /// recorded it, named in the message.
-    pub fn check(&self, holder: &Path) -> anyhow::Result<()> {
+    pub fn check(&self, holder: &Path) -> Result<(), RecordedError> {
         let now = file_hash(&self.path)
             .ok()
             .map(|h| blake3::Hash::from_bytes(h).to_hex().to_string());
-        anyhow::ensure!(
-            now.as_deref() == Some(self.blake3.as_str()),
-            "{} names {} as an input, but that file {}: the inputs changed since it was \
-             written, or it was altered; make it again",
-            holder.display(),
-            self.path.display(),
-            if now.is_some() {
-                "now holds other bytes"
-            } else {
-                "cannot be read as a regular file"
-            }
-        );
+        if now.as_deref() != Some(self.blake3.as_str()) {
+            return Err(RecordedError::Changed {
+                holder: holder.to_owned(),
+                path: self.path.clone(),
+                readable: now.is_some(),
+            });
+        }
         Ok(())
     }
 }
 
 /// Refuses a recorded scene path that names no scene file hprt reads (a `.toml` scene or a
 /// model): such a file is never parsed, so no part of it can appear in an error.
-pub fn check_scene_path(holder: &Path, path: &Path) -> anyhow::Result<()> {
+pub fn check_scene_path(holder: &Path, path: &Path) -> Result<(), RecordedError> {
     let toml = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
-    anyhow::ensure!(
-        toml || foundation::mesh::is_mesh_file(path),
-        "{} names {} as its scene, which is not a scene file (.toml) or a model: it was \
-         altered; make it again",
-        holder.display(),
-        path.display()
-    );
+    if !(toml || crate::mesh::is_mesh_file(path)) {
+        return Err(RecordedError::NotAScene {
+            holder: holder.to_owned(),
+            path: path.to_owned(),
+        });
+    }
     Ok(())
 }
 
@@ -112,5 +138,7 @@ mod tests {
                 .to_string()
                 .contains("regular")
         );
+        assert!(check_scene_path(&holder, Path::new("/etc/passwd")).is_err());
+        assert!(check_scene_path(&holder, &scene).is_ok());
     }
 }
