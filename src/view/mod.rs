@@ -58,7 +58,7 @@ pub struct ViewArgs {
     pub width: u32,
     #[arg(long, default_value_t = 720)]
     pub height: u32,
-    /// Drive the viewer from a script of commands (see src/view/script.rs).
+    /// Drive the viewer from a script of commands (see runtime/src/viewer/script.rs).
     #[arg(long)]
     pub script: Option<PathBuf>,
     /// For a model: composite it into a backplate, "environment" (the map as the camera sees
