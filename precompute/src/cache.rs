@@ -61,7 +61,7 @@ pub fn bake_into_cache(
 ) -> Result<(PathBuf, Transfer, BakeStats), CacheError> {
     let entry = bake_key(scene, settings).entry();
     let path = entry.labelled_file(&scene.name, "bake");
-    let bvh = SceneBvh::build(&scene.geometry.mesh);
+    let bvh = SceneBvh::cached(&scene.geometry.mesh);
     let (transfer, stats) = bake(&scene.geometry, &bvh, settings, progress)?;
     entry.create_folder()?;
     bakefile::write(&path, &transfer, &scene.geometry.content_hash())?;

@@ -38,7 +38,7 @@ pub(crate) fn reference<'py>(
     let camera = resolve(&data.camera, camera.as_ref(), width, height)?;
     let map = map_argument(map)?;
     let image = with_progress(py, progress.as_ref(), "reference", |progress| {
-        let bvh = SceneBvh::build(&data.geometry.mesh);
+        let bvh = SceneBvh::cached(&data.geometry.mesh);
         let light = EnvironmentLight::new(&map, rotation_deg);
         ::reference::try_render(&data.geometry, &bvh, &light, &camera, &settings, progress)
     })?

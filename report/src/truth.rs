@@ -356,7 +356,7 @@ pub fn reference_images(
         let view = view.get_or_init(|| View {
             scene,
             camera,
-            bvh: SceneBvh::build(&scene.geometry.mesh),
+            bvh: SceneBvh::cached(&scene.geometry.mesh),
             light: EnvironmentLight::new(map, rotation_deg),
         });
         let images = render_pass(view, request, current, count, progress.as_ref())?;

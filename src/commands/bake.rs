@@ -107,7 +107,7 @@ pub fn run(args: BakeArgs) -> anyhow::Result<()> {
     announce(&scene, &settings, "");
     let baked = with_threads(args.threads, || {
         let start = Instant::now();
-        let bvh = SceneBvh::build(&scene.geometry.mesh);
+        let bvh = SceneBvh::cached(&scene.geometry.mesh);
         let bvh_seconds = start.elapsed().as_secs_f64();
         let progress = TerminalProgress::new("baking");
         bake::bake(&scene.geometry, &bvh, &settings, &progress).map(|r| (r, bvh_seconds))
@@ -181,7 +181,7 @@ fn run_shard(
     let scene_hash =
         file_hash(&scene_path).with_context(|| format!("cannot read {}", scene_path.display()))?;
     let shard = with_threads(threads, || {
-        let bvh = SceneBvh::build(&scene.geometry.mesh);
+        let bvh = SceneBvh::cached(&scene.geometry.mesh);
         let progress = TerminalProgress::new("tracing");
         let name = scene_path.to_string_lossy();
         let scene_file = (name.as_ref(), scene_hash);

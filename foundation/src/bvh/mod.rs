@@ -4,12 +4,14 @@
 
 use crate::infra::huge_pages::HugePageTable;
 use crate::mesh::TriangleMesh;
+pub use cache::{BvhFileError, bvh_key};
 use glam::{Vec3, Vec3A};
 use obvhs::bvh2::builder::build_bvh2_from_tris;
 use obvhs::triangle::Triangle;
 use stack::{Stack, insert_farthest_first};
 use wide::{Bvh4, ChildRef, NO_TRIANGLE, TrianglePacket, WideRay, moller_trumbore};
 
+mod cache;
 mod fan;
 mod packet;
 mod stack;

@@ -160,7 +160,57 @@ impl Builder<'_> {
     }
 }
 
+/// Words of a [`Node4`] in a file: 24 plane values (as bits), 4 children, 4 counts.
+pub(super) const NODE_WORDS: usize = 32;
+
+impl Node4 {
+    pub(super) fn to_words(self) -> [u32; NODE_WORDS] {
+        let mut words = [0u32; NODE_WORDS];
+        let planes = self
+            .planes
+            .iter()
+            .flat_map(|p| p.to_array().map(f32::to_bits));
+        let rest = self.child.into_iter().chain(self.count);
+        for (word, value) in words.iter_mut().zip(planes.chain(rest)) {
+            *word = value;
+        }
+        words
+    }
+
+    /// The node of `words` ([`NODE_WORDS`] of them).
+    pub(super) fn from_words(words: &[u32]) -> Self {
+        let plane =
+            |k: usize| Vec4::from_array(std::array::from_fn(|i| f32::from_bits(words[4 * k + i])));
+        Self {
+            planes: std::array::from_fn(plane),
+            child: std::array::from_fn(|i| words[24 + i]),
+            count: std::array::from_fn(|i| words[28 + i]),
+        }
+    }
+
+    /// Its children as references (empty slots left out).
+    pub(super) fn children(&self) -> impl Iterator<Item = ChildRef> + '_ {
+        (0..4).filter(|k| self.count[*k] != 0).map(|k| ChildRef {
+            index: self.child[k],
+            count: self.count[k],
+        })
+    }
+}
+
 impl Bvh4 {
+    /// The nodes, root first, and what a ray starts from.
+    pub(super) fn parts(&self) -> (&[Node4], Option<ChildRef>) {
+        (&self.nodes, self.root)
+    }
+
+    /// The tree of `nodes` and `root` (checked by the caller).
+    pub(super) fn from_parts(nodes: Vec<Node4>, root: Option<ChildRef>) -> Self {
+        Self {
+            nodes: HugePageTable::new(nodes.into_iter()),
+            root,
+        }
+    }
+
     #[inline(always)]
     pub(super) fn prefetch(&self, node: u32) {
         crate::infra::prefetch::prefetch(self.nodes.as_ptr().wrapping_add(node as usize));

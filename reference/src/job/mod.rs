@@ -198,7 +198,7 @@ impl ReferenceJob {
             );
             (with, Some(without))
         } else {
-            let bvh = SceneBvh::build(&geometry.mesh);
+            let bvh = SceneBvh::cached(&geometry.mesh);
             let image =
                 crate::render_rows(geometry, &bvh, &light, camera, settings, rows, progress);
             (image, None)

@@ -175,7 +175,7 @@ fn oversized_lengths_are_refused_without_allocating() {
         reader.section::<f32>(1 << 40),
         Err(ContainerError::Length { .. })
     ));
-    let error = reader.section::<u32>(u64::MAX).err().expect("refused");
+    let error = reader.section::<u32>(u64::MAX).expect_err("refused");
     assert!(matches!(
         error,
         ContainerError::Length {
@@ -186,7 +186,7 @@ fn oversized_lengths_are_refused_without_allocating() {
     // Sections that leave bytes over.
     let mut reader = open(&bytes).unwrap();
     reader.section::<f32>(3).unwrap();
-    let error = reader.check_filled().err().expect("refused");
+    let error = reader.check_filled().expect_err("refused");
     assert!(
         error
             .to_string()
@@ -199,7 +199,7 @@ fn oversized_lengths_are_refused_without_allocating() {
 fn an_unreadable_header_is_named() {
     let bytes = encode(FORMAT, &"not a head", |_| Ok(())).unwrap();
     let reader = open(&bytes).unwrap();
-    let error = reader.header::<Head>().err().expect("refused");
+    let error = reader.header::<Head>().expect_err("refused");
     assert!(
         error.to_string().contains("unreadable test file header"),
         "{error}"
