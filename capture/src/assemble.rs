@@ -34,6 +34,9 @@ impl Default for AssemblySettings {
     }
 }
 
+mod views;
+pub use views::SPREAD_WARNING;
+
 /// An assembled capture.
 #[derive(Debug, Clone)]
 pub struct Assembled {

@@ -35,7 +35,7 @@ mod response_fit;
 
 pub mod synthetic;
 
-pub use assemble::{Assembled, AssemblySettings, assemble, calibrate};
+pub use assemble::{Assembled, AssemblySettings, SPREAD_WARNING, assemble, calibrate};
 pub use ball::MirrorBall;
 pub use ball_finder::{Circle, FoundBall, find_ball};
 pub use camera::ShotCamera;

@@ -5,7 +5,7 @@ use crate::outputs::{check_outputs, open_outputs, write_outputs};
 use anyhow::Context;
 use capture::{Assembled, AssemblySettings, InverseResponse};
 use clap::Args;
-use foundation::image_io::{RgbImageF32, exr_bytes, png_bytes, to_display_rgb8};
+use foundation::image_io::{RgbImageF32, exr_bytes, png_bytes};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -83,7 +83,7 @@ pub fn run(args: CaptureArgs) -> anyhow::Result<()> {
         }
     };
     let mut captured = capture::assemble(&photos, &response, &settings);
-    scale_map(&mut captured, args.scale);
+    captured.scale(args.scale);
     check_radiance(&args, &captured, &photos, &response)?;
     report(&args.description, &captured, photos.len());
     let spread = captured.response_spread();
@@ -94,14 +94,10 @@ pub fn run(args: CaptureArgs) -> anyhow::Result<()> {
         bytes.push(capture::response_csv(&response, spread).into_bytes());
     }
     if args.coverage.is_some() {
-        bytes.push(png_bytes(&coverage_rgb(&captured), width, width / 2)?);
+        bytes.push(png_bytes(&captured.coverage_rgb(), width, width / 2)?);
     }
     if args.preview.is_some() {
-        bytes.push(png_bytes(
-            &preview_rgb(&captured, &image),
-            width,
-            width / 2,
-        )?);
+        bytes.push(png_bytes(&captured.preview_rgb(&image), width, width / 2)?);
     }
     write_outputs(files, bytes)
 }
@@ -115,12 +111,7 @@ fn check_radiance(
     photos: &[capture::Photo],
     response: &InverseResponse,
 ) -> anyhow::Result<()> {
-    let bad = captured
-        .map
-        .texels()
-        .iter()
-        .filter(|c| !c.is_finite())
-        .count();
+    let bad = captured.overflowed_texels();
     if bad == 0 {
         return Ok(());
     }
@@ -144,12 +135,6 @@ fn check_radiance(
     )
 }
 
-fn scale_map(captured: &mut Assembled, scale: f32) {
-    let (w, h) = (captured.map.width(), captured.map.height());
-    let texels = captured.map.texels().iter().map(|c| *c * scale).collect();
-    captured.map = foundation::envmap::EnvMap::new(w, h, texels);
-}
-
 /// What the capture resolved, and a warning for what no exposure did.
 fn report(description: &Path, captured: &Assembled, photos: usize) {
     let (clipped_sr, clipped_share) = captured.saturation();
@@ -158,7 +143,7 @@ fn report(description: &Path, captured: &Assembled, photos: usize) {
          surroundings",
         description.display(),
         100.0 * captured.covered_fraction(),
-        100.0 * filled_fraction(captured),
+        100.0 * captured.filled_fraction(),
     );
     if clipped_sr > 0.0 {
         log::warn!(
@@ -181,11 +166,6 @@ fn warn_of_equal_steps(description: &Path, photos: &[capture::Photo]) {
     }
 }
 
-/// A response spread above this (the median texel's readings scattering by more than 10% in
-/// log across exposures) says the response is poor: the right one leaves the noise, a few
-/// percent.
-const SPREAD_WARNING: f32 = 0.10;
-
 /// The response's spread beside the map, and a warning where it shows the response is poor.
 fn report_spread(description: &Path, spread: Option<f32>, given: Option<&Path>) {
     let Some(spread) = spread else {
@@ -203,7 +183,7 @@ fn report_spread(description: &Path, spread: Option<f32>, given: Option<&Path>) 
         description.display(),
         100.0 * spread
     );
-    if spread > SPREAD_WARNING {
+    if spread > capture::SPREAD_WARNING {
         log::warn!(
             "{}: the response's ({source}) spread is {:.1}%, above {:.0}%: the response does not \
              fit these photographs (a camera that changed its tone curve, white balance or ISO \
@@ -211,45 +191,7 @@ fn report_spread(description: &Path, spread: Option<f32>, given: Option<&Path>) 
              disagree most are yellow in --coverage",
             description.display(),
             100.0 * spread,
-            100.0 * SPREAD_WARNING
+            100.0 * capture::SPREAD_WARNING
         );
     }
-}
-
-fn filled_fraction(captured: &Assembled) -> f32 {
-    let w = captured.map.width();
-    // Summed from +0 (an empty float sum is −0, printed "-0.0%").
-    let filled = (0..captured.filled.len())
-        .filter(|t| captured.filled[*t])
-        .map(|t| captured.map.texel_solid_angle(t / w))
-        .fold(0.0f32, |sum, a| sum + a);
-    filled / (4.0 * std::f32::consts::PI)
-}
-
-fn coverage_rgb(captured: &Assembled) -> Vec<u8> {
-    let mut rgb = Vec::with_capacity(3 * captured.confidence.len());
-    for (t, c) in captured.confidence.iter().enumerate() {
-        let grey = (255.0 * c.sqrt()).round() as u8;
-        rgb.extend(if captured.saturated[t] {
-            [255, 0, 0]
-        } else if captured.spread[t] > SPREAD_WARNING {
-            [grey.max(128), grey.max(128), 0]
-        } else {
-            [grey; 3]
-        });
-    }
-    rgb
-}
-
-fn preview_rgb(captured: &Assembled, image: &RgbImageF32) -> Vec<u8> {
-    let exposure = 0.5 / captured.map.mean_luminance().max(f32::MIN_POSITIVE);
-    let mut rgb = to_display_rgb8(image, exposure);
-    for (t, pixel) in rgb.chunks_exact_mut(3).enumerate() {
-        if captured.saturated[t] {
-            pixel.copy_from_slice(&[255, 0, 0]);
-        } else if captured.filled[t] {
-            pixel[2] = pixel[2].saturating_add(96);
-        }
-    }
-    rgb
 }
