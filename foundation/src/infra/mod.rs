@@ -1,6 +1,6 @@
 //! Infrastructure under the domain code: files written atomically, huge-page tables, cache
 //! prefetching, progress bars, enums named in settings files, names that become file names,
-//! and shards of a job.
+//! shards of a job, and Slurm jobs of shards.
 
 pub mod atomic_file;
 pub mod cache;
@@ -12,6 +12,7 @@ pub mod named_enum;
 pub mod prefetch;
 pub mod progress;
 pub mod shard;
+pub mod slurm;
 
 /// Logs `message` as a warning unless this process already has: a file read twice (a model
 /// measured, then loaded) must not repeat its warnings.
