@@ -1,7 +1,8 @@
 //! One module per subcommand; each parses its arguments and calls library code. Commands do
 //! not import each other: what several share lives in `cli`, `environment`, `bake_cache`,
-//! `support`, `report` and `view`. The exception is `slurm`, which writes other commands'
-//! command lines and checks them with their own argument parsers.
+//! `support`, `report` and `view`. The exception is `slurm`, which checks other commands'
+//! command lines with their own argument parsers before `foundation::infra::slurm` writes them
+//! into batch jobs.
 
 pub mod bake;
 pub mod bench;

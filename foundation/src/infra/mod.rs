@@ -1,6 +1,7 @@
-//! Infrastructure under the domain code: files written atomically, the content-addressed cache, the shard files' container, huge-page tables, cache
-//! prefetching, progress bars, files recorded with their hashes, enums named in settings files, names that become file names,
-//! and shards of a job.
+//! Infrastructure under the domain code: files written atomically, the content-addressed
+//! cache, the shard files' container, huge-page tables, cache prefetching, progress bars, files
+//! recorded with their hashes, enums named in settings files, names that become file names,
+//! shards of a job, and Slurm jobs of shards.
 
 pub mod atomic_file;
 pub mod cache;
@@ -14,6 +15,7 @@ pub mod prefetch;
 pub mod progress;
 pub mod recorded;
 pub mod shard;
+pub mod slurm;
 
 /// Logs `message` as a warning unless this process already has: a file read twice (a model
 /// measured, then loaded) must not repeat its warnings.
