@@ -149,5 +149,5 @@ fn check_probe_outputs(scene: &Scene, map: &Path, targets: &[Target]) -> anyhow:
     let outputs: Vec<Output> = (names.iter())
         .map(|(name, path)| (name.as_str(), Some(*path)))
         .collect();
-    check_outputs(&inputs, &outputs)
+    Ok(check_outputs(&inputs, &outputs)?)
 }

@@ -11,6 +11,7 @@ pub mod limits;
 pub mod names;
 #[macro_use]
 pub mod named_enum;
+pub mod outputs;
 pub mod prefetch;
 pub mod progress;
 pub mod recorded;
