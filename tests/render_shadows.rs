@@ -12,7 +12,7 @@ use foundation::scene::SceneMesh;
 use foundation::{Rgb, luminance};
 use glam::Vec3;
 use runtime::DirectionalLight;
-use runtime::render::{FrameLighting, Renderer, ShadowSettings};
+use runtime::render::{FrameLighting, Renderer, ShadowCasters, ShadowSettings};
 
 #[test]
 fn shadow_of_a_sphere_lands_where_geometry_predicts() {
@@ -365,5 +365,81 @@ fn a_source_with_a_halo_casts_its_wide_penumbra() {
             with_halo < 0.025 && with_halo < 0.25 * disc_only,
             "mean |visibility error| over the penumbra: {with_halo} with the halo, {disc_only} without"
         );
+    }
+}
+
+/// Five lights from around the sky, each with a soft source.
+fn lights_around() -> Vec<DirectionalLight> {
+    (0..5)
+        .map(|k| {
+            let azimuth = k as f32 * 1.3;
+            DirectionalLight {
+                direction: Vec3::new(azimuth.cos(), 1.2, azimuth.sin()).normalize(),
+                power: Rgb::splat(1.0 + k as f32),
+                cap_radius: 0.05,
+                angular_radius: 0.01,
+                halo_radius: 0.02,
+                core_fraction: 0.8,
+                share: 1.0,
+            }
+        })
+        .collect()
+}
+
+/// Shadow maps freed between frames are drawn again the same: the frame does not change.
+#[test]
+fn released_shadow_maps_are_drawn_again_the_same() {
+    let geometry = sphere_on_plane();
+    let transfer = bake_of(&geometry, 2, 16, 0);
+    let lighting = FrameLighting::lights_only(2, lights_around());
+    let cam = camera(Vec3::new(0.0, 5.0, 7.0), Vec3::ZERO, 96, 72);
+    for gpu in gpus() {
+        let mut renderer =
+            Renderer::new(&gpu, &geometry, &transfer, &cam, ShadowSettings::default()).unwrap();
+        renderer.background = false;
+        renderer.set_lighting(&lighting).unwrap();
+        renderer.render().unwrap();
+        let first = renderer.read_back().unwrap();
+        renderer.release_shadow_maps();
+        renderer.render().unwrap();
+        let again = renderer.read_back().unwrap();
+        assert!(first.pixels == again.pixels, "the frame changed");
+        // Shadows are in it: the unshadowed frame is brighter somewhere.
+        let mut unshadowed = lighting.clone();
+        unshadowed.shadows = false;
+        renderer.set_lighting(&unshadowed).unwrap();
+        renderer.render().unwrap();
+        let open = renderer.read_back().unwrap();
+        let darker = (first.pixels.iter().zip(&open.pixels))
+            .filter(|(s, o)| s.max_element() < 0.9 * o.max_element())
+            .count();
+        assert!(darker > 50, "{darker} shadowed pixels");
+    }
+}
+
+/// A renderer told to let only the virtual objects cast shadows, in a scene without any,
+/// draws no shadow maps; its frame is the one a scene's own maps give where nothing can
+/// shadow anything (a flat floor under lights from above).
+#[test]
+fn no_casters_draw_the_frame_empty_maps_give() {
+    let mut floor = floor_with(3.0, &[]);
+    floor.objects[0].role = foundation::scene::ObjectRole::Proxy;
+    let transfer = bake_of(&floor, 2, 16, 0);
+    let lighting = FrameLighting::lights_only(2, lights_around());
+    let cam = camera(Vec3::new(0.0, 5.0, 7.0), Vec3::ZERO, 96, 72);
+    for gpu in gpus() {
+        let draw = |casters| {
+            let mut renderer =
+                Renderer::new(&gpu, &floor, &transfer, &cam, ShadowSettings::default()).unwrap();
+            renderer.background = false;
+            renderer.set_shadow_casters(casters);
+            renderer.set_lighting(&lighting).unwrap();
+            renderer.render().unwrap();
+            renderer.read_back().unwrap()
+        };
+        let drawn = draw(ShadowCasters::All);
+        let skipped = draw(ShadowCasters::Objects);
+        assert!(drawn.pixels.iter().any(|p| p.max_element() > 0.1));
+        assert!(drawn.pixels == skipped.pixels, "the frames differ");
     }
 }

@@ -144,6 +144,8 @@ fn report_map(
         "{name}: the true composite ({}x{}, {} spp)",
         camera.width, camera.height, settings.spp
     ));
+    // The last map's shadow maps are not needed while the truth renders on the CPU.
+    job.renderer.release_shadow_maps();
     let truth = true_composite(scene, &camera, &map, rotation, settings)?;
     if truth.cached {
         job.observer

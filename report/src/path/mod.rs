@@ -212,6 +212,8 @@ impl PathRun {
         let centre = pose.centre;
         let posed = self.model.posed(pose)?;
         let geometry = &posed.geometry;
+        // The last position's shadow maps are not needed while the truth renders on the CPU.
+        self.whole.release_shadow_maps();
         let truth = self.truth_at(geometry, observer)?;
         let kinds = pixel_kinds(
             geometry,

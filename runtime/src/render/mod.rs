@@ -271,6 +271,15 @@ impl Renderer {
         Ok(())
     }
 
+    /// Frees the shadow maps beyond the fewest kept (32 lights' maps of 2048² take 1 GiB),
+    /// before other work that needs the memory; the next frame with lights draws them again,
+    /// the same.
+    pub fn release_shadow_maps(&mut self) {
+        if self.shadow_maps.release(&self.device) {
+            self.light_pass.inputs_changed();
+        }
+    }
+
     /// Which geometry casts the lights' shadows (all of it unless set).
     pub fn set_shadow_casters(&mut self, casters: ShadowCasters) {
         if casters != self.casters {

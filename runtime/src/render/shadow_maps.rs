@@ -205,6 +205,20 @@ impl ShadowMaps {
         true
     }
 
+    /// Keeps only the fewest layers; returns whether the maps were re-created.
+    pub(crate) fn release(&mut self, device: &wgpu::Device) -> bool {
+        if self.layers.count <= MIN_LAYERS {
+            return false;
+        }
+        self.layers = Layers::new(
+            device,
+            &self.view_layout,
+            self.settings.resolution,
+            MIN_LAYERS,
+        );
+        true
+    }
+
     pub(crate) fn array_view(&self) -> &wgpu::TextureView {
         &self.layers.array_view
     }
