@@ -137,9 +137,7 @@ fn report_map(job: &mut MapJob, env: &Path, name: &str) -> Result<MapReport> {
         lighting.enable_reflections(Some(runtime::render::DEFAULT_REFLECTION_SIZE));
     }
     let (rendered, images) = render_methods(job, &mut lighting, &dir, exposure)?;
-    // The peers' shadow maps (1 GiB for median cut's 32) are not needed while the reference
-    // renders on the CPU.
-    job.renderer.release_shadow_maps();
+    job.renderer.release_shadow_maps(); // not needed while the reference renders on the CPU
 
     let request = job.settings.reference_request(exposure);
     let best_error = |reference: &ReferenceImages| {

@@ -212,8 +212,7 @@ impl PathRun {
         let centre = pose.centre;
         let posed = self.model.posed(pose)?;
         let geometry = &posed.geometry;
-        // The last position's shadow maps are not needed while the truth renders on the CPU.
-        self.whole.release_shadow_maps();
+        self.whole.release_shadow_maps(); // not needed while the truth renders on the CPU
         let truth = self.truth_at(geometry, observer)?;
         let kinds = pixel_kinds(
             geometry,
@@ -266,13 +265,11 @@ impl PathRun {
             changed_pixels: changed.iter().filter(|c| **c).count(),
             methods: results,
         };
-        let here: Vec<bool> = (on_model.iter().zip(&changed))
-            .map(|(a, b)| *a || *b)
-            .collect();
+        let covered = (on_model.iter().zip(&changed)).map(|(a, b)| *a || *b);
         self.previous = Some(Previous {
             truth: truth_y,
             methods: ys,
-            covered: here,
+            covered: covered.collect(),
         });
         // The GIF: the tracked hybrid on one probe, on the nearest probe, on the fused map.
         let hybrid_on = |map: PathMap| {
