@@ -186,6 +186,8 @@ pub fn composite_frame(
             &backplate,
         ));
     }
+    // The proxies' renderer makes shadow maps of its own: the whole scene's are not needed.
+    whole.release_shadow_maps();
     let proxies = proxies_scene(inputs.scene, transfer);
     let proxies_transfer = proxies_bake(inputs.scene, transfer, observer)?;
     let mut without = Renderer::new(
