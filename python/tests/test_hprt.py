@@ -135,7 +135,7 @@ class BakeAndRender(unittest.TestCase):
             try:
                 first = hprt.bake(self.scene, samples=8, bounces=0, order=2, cache=True, progress=record)
                 self.assertGreater(len(calls), 0)
-                self.assertEqual(len(list(Path(folder).glob("teapot-*-o2-s8-b0-seed*.bake"))), 1)
+                self.assertEqual(len(list(Path(folder).glob("bakes/teapot-*.bake"))), 1)
                 calls.clear()
                 second = hprt.bake(self.scene, samples=8, bounces=0, order=2, cache=True, progress=record)
                 self.assertEqual(calls, [])
