@@ -8,6 +8,7 @@ pub mod cache;
 pub mod container;
 pub mod huge_pages;
 pub mod limits;
+pub mod memory;
 pub mod names;
 #[macro_use]
 pub mod named_enum;

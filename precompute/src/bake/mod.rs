@@ -249,6 +249,7 @@ pub fn bake(
     let start = Instant::now();
     let traced = trace(geometry, bvh, settings, progress)?;
     let (transfer, mut stats) = sum_bounces(geometry, settings, traced, progress)?;
+    foundation::infra::memory::release_freed_memory();
     stats.total_seconds = start.elapsed().as_secs_f64();
     Ok((transfer, stats))
 }
