@@ -211,9 +211,15 @@ fn opens_a_gltf_model_in_one_command_under_xvfb() {
     };
     let out = open();
     assert!(out.status.success(), "viewer failed: {}", stderr(&out));
-    let baked: Vec<_> = std::fs::read_dir(cache.join("bakes")).unwrap().flatten().collect();
+    let baked: Vec<_> = std::fs::read_dir(cache.join("bakes"))
+        .unwrap()
+        .flatten()
+        .collect();
     assert_eq!(baked.len(), 1, "one bake in the cache");
-    let trees: Vec<_> = std::fs::read_dir(cache.join("bvhs")).unwrap().flatten().collect();
+    let trees: Vec<_> = std::fs::read_dir(cache.join("bvhs"))
+        .unwrap()
+        .flatten()
+        .collect();
     assert_eq!(trees.len(), 1, "its BVH in the cache");
     assert!(baked[0].file_name().to_string_lossy().starts_with("crate-"));
 
