@@ -81,8 +81,7 @@ impl Technique {
         if let Technique::Hybrid { tracked: true, .. } = self {
             lighting.enable_tracking(Some(TrackingSettings::default()))?;
         }
-        let threshold = self.decompose_settings(order, settings.threshold).threshold;
-        self.configure(&mut lighting, order, threshold)?;
+        self.configure(&mut lighting, order, settings.threshold)?;
         lighting.set_rotation(rotation_deg);
         Ok(lighting)
     }
