@@ -22,7 +22,7 @@ use foundation::envmap::EnvMap;
 use foundation::sh::ShCoeffs;
 use glam::{Quat, Vec3};
 use std::sync::Arc;
-use std::time::Instant;
+use web_time::Instant;
 
 /// Lasting state of the median-cut peer: how many times it halves the map (2^levels lights).
 struct MedianCutPeer {

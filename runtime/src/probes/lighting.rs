@@ -9,7 +9,7 @@ use foundation::bvh::SceneBvh;
 use foundation::envmap::EnvMap;
 use foundation::probe::Probe;
 use glam::Vec3;
-use std::time::Instant;
+use web_time::Instant;
 
 /// A room's probes, proxies and sky, and the decomposition that follows a moving point.
 pub struct ProbeLighting {

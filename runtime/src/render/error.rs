@@ -44,6 +44,11 @@ pub enum BakeMismatch {
     #[error("the transfer ({mb} MB) exceeds the adapter's storage buffer limit ({limit_mb} MB)")]
     TooLarge { mb: usize, limit_mb: usize },
     #[error(
+        "the transfer of {vertices} vertices does not fit the adapter's textures ({max} texels \
+         a side), which hold it where there are no storage buffers (WebGL2)"
+    )]
+    TooLargeForTextures { vertices: usize, max: u32 },
+    #[error(
         "the {part}' bake has {bake} vertices and SH order {bake_order}; the scene's {part} \
          have {scene} vertices and its bake order {scene_order}"
     )]
@@ -71,6 +76,7 @@ pub enum ReadbackError {
 
 /// Runs `work` with wgpu validation and out-of-memory errors turned into a `RenderError`
 /// (instead of wgpu's default of panicking).
+#[cfg(not(target_arch = "wasm32"))]
 pub(super) fn checked<T>(
     device: &wgpu::Device,
     work: impl FnOnce() -> Result<T, RenderError>,
@@ -86,10 +92,21 @@ pub(super) fn checked<T>(
     }
 }
 
+/// In a page, which cannot block on the scopes' answers, errors reach the device's
+/// uncaptured-error handler instead ([`super::GpuContext`]), which the page shows.
+#[cfg(target_arch = "wasm32")]
+pub(super) fn checked<T>(
+    _device: &wgpu::Device,
+    work: impl FnOnce() -> Result<T, RenderError>,
+) -> Result<T, RenderError> {
+    work()
+}
+
 /// The error to report of those two scopes caught: running out of memory first, since the
 /// resource it left invalid makes every later use of it a validation error that hides the
 /// cause.
 /// `ran_out`: memory ran out earlier where no scope caught it.
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 fn first_cause(
     validation: Option<wgpu::Error>,
     memory: Option<wgpu::Error>,

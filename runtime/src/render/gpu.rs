@@ -23,6 +23,7 @@ impl Backend {
         }
     }
 
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
     fn description(self) -> &'static str {
         match self {
             Backend::Auto => "Vulkan or OpenGL",
@@ -73,6 +74,7 @@ impl fmt::Display for AdapterDescription {
     }
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 fn preference(info: &wgpu::AdapterInfo) -> u8 {
     let device = match info.device_type {
         wgpu::DeviceType::DiscreteGpu => 0,
@@ -87,38 +89,72 @@ fn preference(info: &wgpu::AdapterInfo) -> u8 {
 
 impl GpuContext {
     /// Opens the best adapter of `backend` without a window.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn headless(backend: Backend) -> Result<Self, GpuError> {
         let instance = Self::instance(
             backend,
             wgpu::InstanceDescriptor::new_without_display_handle(),
         );
         let adapter =
-            Self::best_adapter(&instance, backend, |_| true).ok_or(GpuError::NoAdapter {
-                backend: backend.description(),
-                for_window: false,
-            })?;
-        Self::open(instance, adapter)
+            pollster::block_on(Self::best_adapter(&instance, backend.backends(), |_| true)).ok_or(
+                GpuError::NoAdapter {
+                    backend: backend.description(),
+                    for_window: false,
+                },
+            )?;
+        pollster::block_on(Self::open(instance, adapter))
     }
 
     /// Opens the best adapter of `backend` that can present to `target` (a window), with the
     /// surface for it.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn for_surface(
         backend: Backend,
         descriptor: wgpu::InstanceDescriptor,
         target: impl Into<wgpu::SurfaceTarget<'static>>,
     ) -> Result<(Self, wgpu::Surface<'static>), GpuError> {
         let instance = Self::instance(backend, descriptor);
+        pollster::block_on(Self::for_surface_of(
+            instance,
+            backend.backends(),
+            backend.description(),
+            target,
+        ))
+    }
+
+    /// Opens the best adapter among `backends` of `instance` that can present to `target` (a
+    /// window or a page's canvas), with the surface for it. `description` names the backends
+    /// in the error.
+    pub async fn for_surface_of(
+        instance: wgpu::Instance,
+        backends: wgpu::Backends,
+        description: &'static str,
+        target: impl Into<wgpu::SurfaceTarget<'static>>,
+    ) -> Result<(Self, wgpu::Surface<'static>), GpuError> {
         let surface = instance
             .create_surface(target)
             .map_err(|e| GpuError::Surface(e.to_string()))?;
-        let adapter = Self::best_adapter(&instance, backend, |a| a.is_surface_supported(&surface))
-            .ok_or(GpuError::NoAdapter {
-                backend: backend.description(),
-                for_window: true,
-            })?;
-        Ok((Self::open(instance, adapter)?, surface))
+        #[cfg(not(target_arch = "wasm32"))]
+        let adapter =
+            Self::best_adapter(&instance, backends, |a| a.is_surface_supported(&surface)).await;
+        // A browser lists no adapters (WebGL2 has one only for the canvas): it picks one.
+        #[cfg(target_arch = "wasm32")]
+        let adapter = {
+            let _ = backends;
+            let options = wgpu::RequestAdapterOptions {
+                compatible_surface: Some(&surface),
+                ..Default::default()
+            };
+            instance.request_adapter(&options).await.ok()
+        };
+        let adapter = adapter.ok_or(GpuError::NoAdapter {
+            backend: description,
+            for_window: true,
+        })?;
+        Ok((Self::open(instance, adapter).await?, surface))
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     fn instance(backend: Backend, mut descriptor: wgpu::InstanceDescriptor) -> wgpu::Instance {
         descriptor.backends = backend.backends();
         wgpu::Instance::new(descriptor)
@@ -126,12 +162,15 @@ impl GpuContext {
 
     /// The adapter policy, one for windows and headless work: a real GPU before a software
     /// one, Vulkan before OpenGL on the same kind of device.
-    fn best_adapter(
+    #[cfg(not(target_arch = "wasm32"))]
+    async fn best_adapter(
         instance: &wgpu::Instance,
-        backend: Backend,
+        backends: wgpu::Backends,
         usable: impl Fn(&wgpu::Adapter) -> bool,
     ) -> Option<wgpu::Adapter> {
-        pollster::block_on(instance.enumerate_adapters(backend.backends()))
+        instance
+            .enumerate_adapters(backends)
+            .await
             .into_iter()
             .filter(|a| usable(a))
             .min_by_key(|a| preference(&a.get_info()))
@@ -139,17 +178,19 @@ impl GpuContext {
 
     /// Opens a device on `adapter`, asking for the adapter's own limits (large scenes need
     /// big storage buffers).
-    fn open(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self, GpuError> {
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("hprt"),
-            required_features: wgpu::Features::empty(),
-            required_limits: adapter.limits(),
-            ..Default::default()
-        }))
-        .map_err(|e| GpuError::Device {
-            adapter: adapter.get_info().name,
-            message: e.to_string(),
-        })?;
+    async fn open(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self, GpuError> {
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("hprt"),
+                required_features: wgpu::Features::empty(),
+                required_limits: required_limits(&adapter),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| GpuError::Device {
+                adapter: adapter.get_info().name,
+                message: e.to_string(),
+            })?;
         // Errors outside the renderer's error scopes are reported, not turned into a panic.
         device.on_uncaptured_error(std::sync::Arc::new(|error: wgpu::Error| {
             note_uncaptured(&error);
@@ -174,6 +215,19 @@ impl GpuContext {
     }
 }
 
+/// The adapter's own limits (large scenes need big storage buffers). With
+/// `HPRT_GPU_LIMITS=webgl2`, a browser's WebGL2 limits instead (no compute, no storage
+/// buffers; the adapter's texture sizes), so that the paths a WebGL2 page takes run natively
+/// and are tested there (DEVELOPERS.md, "The web viewer").
+fn required_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
+    #[cfg(not(target_arch = "wasm32"))]
+    if std::env::var("HPRT_GPU_LIMITS").as_deref() == Ok("webgl2") {
+        log::warn!("HPRT_GPU_LIMITS=webgl2: the device takes a browser's WebGL2 limits");
+        return wgpu::Limits::downlevel_webgl2_defaults().using_resolution(adapter.limits());
+    }
+    adapter.limits()
+}
+
 /// Whether the driver ran out of memory outside an error scope in this process.
 static RAN_OUT_OF_MEMORY: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
@@ -186,6 +240,7 @@ fn note_uncaptured(error: &wgpu::Error) {
 
 /// Whether memory ran out earlier where no error scope caught it: what fails later is then
 /// reported as running out of memory, its cause.
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 pub(super) fn ran_out_of_memory() -> bool {
     RAN_OUT_OF_MEMORY.load(std::sync::atomic::Ordering::Relaxed)
 }

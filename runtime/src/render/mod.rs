@@ -37,6 +37,7 @@ mod shadow_fit;
 mod shadow_maps;
 mod targets;
 mod transfer_pass;
+mod transfer_texels;
 mod uniforms;
 
 use composite::{Compositor, CompositorSource};
@@ -57,6 +58,8 @@ use gpu_scene::GpuScene;
 use light_pass::LightPass;
 use precompute::bake::Transfer;
 use prt_pass::PrtPass;
+pub use readback::TextureCopy;
+#[cfg(not(target_arch = "wasm32"))]
 pub use readback::read_texture;
 use reflection_maps::ReflectionMaps;
 pub use shaders::{MAX_GPU_ORDER, MAX_LIGHTS};
@@ -420,20 +423,37 @@ impl Renderer {
     }
 
     /// Waits for the last frame and copies it to the CPU as linear radiance.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn read_back(&self) -> Result<RgbImageF32, RenderError> {
         checked(&self.device, || {
             let bytes = readback::read_texture(&self.device, &self.queue, self.color_texture(), 8)?;
-            let halves: &[half::f16] = bytemuck::cast_slice(&bytes);
-            let pixels = halves
-                .chunks_exact(4)
-                .map(|p| Rgb::new(p[0].to_f32(), p[1].to_f32(), p[2].to_f32()))
-                .collect();
-            Ok(RgbImageF32::new(
-                self.targets.width as usize,
-                self.targets.height as usize,
-                pixels,
-            ))
+            Ok(self.radiance(&bytes))
         })
+    }
+
+    /// Starts copying the last frame back, for a caller that waits for the mapping itself
+    /// (a page): [`Self::finish_read_back`] once [`TextureCopy::buffer`] is mapped.
+    pub fn start_read_back(&self) -> TextureCopy {
+        TextureCopy::submit(&self.device, &self.queue, self.color_texture(), 8)
+    }
+
+    /// The linear radiance of a copy [`Self::start_read_back`] began, once mapped.
+    pub fn finish_read_back(&self, copy: TextureCopy) -> Result<RgbImageF32, RenderError> {
+        Ok(self.radiance(&copy.texels()?))
+    }
+
+    /// The color target's Rgba16Float texels as linear RGB.
+    fn radiance(&self, bytes: &[u8]) -> RgbImageF32 {
+        let halves: &[half::f16] = bytemuck::cast_slice(bytes);
+        let pixels = halves
+            .chunks_exact(4)
+            .map(|p| Rgb::new(p[0].to_f32(), p[1].to_f32(), p[2].to_f32()))
+            .collect();
+        RgbImageF32::new(
+            self.targets.width as usize,
+            self.targets.height as usize,
+            pixels,
+        )
     }
 
     /// Blocks until submitted work is done.
