@@ -99,6 +99,18 @@ pub(crate) const TRANSFER: BindGroupDecl = BindGroupDecl {
     ],
 };
 
+/// `shaders/transfer_texels.wgsl`: the transfer pass drawn into textures (WebGL2).
+pub(crate) const TRANSFER_TEXELS: BindGroupDecl = BindGroupDecl {
+    label: "transfer texels",
+    shader: Shader::TransferTexels,
+    group: 0,
+    bindings: &[
+        binding("lighting", FRAGMENT, Resource::Uniform),
+        binding("full_transfer", FRAGMENT, FLOAT_2D),
+        binding("indirect_transfer", FRAGMENT, FLOAT_2D),
+    ],
+};
+
 /// `shaders/geometry.wgsl`, group 0: the frame, the materials and the reflection maps.
 pub(crate) const PRT_FRAME: BindGroupDecl = BindGroupDecl {
     label: "prt pass frame",
@@ -257,8 +269,9 @@ pub(crate) const WIREFRAME: BindGroupDecl = BindGroupDecl {
 
 /// Every declaration, for the test against the WGSL.
 #[cfg(test)]
-pub(crate) const ALL: [&BindGroupDecl; 10] = [
+pub(crate) const ALL: [&BindGroupDecl; 11] = [
     &TRANSFER,
+    &TRANSFER_TEXELS,
     &PRT_FRAME,
     &ALBEDO_TEXTURE,
     &SHADOW_VIEW,
@@ -432,13 +445,18 @@ mod tests {
     /// stride), and the dynamic offsets step by it.
     #[test]
     fn rust_structs_have_the_wgsl_layout() {
-        use super::super::{materials, reflection_maps, transfer_pass, uniforms};
+        use super::super::{materials, reflection_maps, uniforms};
         use std::mem::size_of;
         let structs = [
             (
                 Shader::Transfer,
                 "Lighting",
-                size_of::<transfer_pass::LightingUniform>(),
+                size_of::<uniforms::LightingUniform>(),
+            ),
+            (
+                Shader::TransferTexels,
+                "Lighting",
+                size_of::<uniforms::LightingUniform>(),
             ),
             (Shader::Lights, "Frame", size_of::<uniforms::FrameUniform>()),
             (Shader::Lights, "Light", size_of::<uniforms::LightUniform>()),

@@ -6,7 +6,8 @@ use super::environment_texture::{mip_chain_of, upload_mip_chain};
 use super::error::{BakeMismatch, RenderError};
 use super::materials::GpuMaterials;
 use super::shaders::MAX_GPU_ORDER;
-use super::transfer_pass::TransferPass;
+use super::transfer_pass::{TransferPass, TransferPath};
+use super::transfer_texels::TexelTransfer;
 use crate::lighting::{FrameLighting, ShTransfer};
 use bytemuck::{Pod, Zeroable};
 use foundation::color::Rgb;
@@ -129,22 +130,20 @@ impl GpuScene {
             bytemuck::cast_slice(&indices),
             wgpu::BufferUsages::INDEX,
         );
-        let radiance_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("vertex radiance"),
-            size: (mesh.vertex_count() * 16) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
-            mapped_at_creation: false,
-        });
-        let indirect_radiance_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("vertex indirect radiance"),
-            size: (mesh.vertex_count() * 16) as u64,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::VERTEX
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let path = TransferPath::of(device);
+        let radiance = |label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: path.radiance_bytes(mesh.vertex_count()),
+                usage: path.radiance_usage(),
+                mapped_at_creation: false,
+            })
+        };
+        let radiance_buffer = radiance("vertex radiance");
+        let indirect_radiance_buffer = radiance("vertex indirect radiance");
         let transfer_pass = TransferPass::new(
             device,
+            queue,
             transfer,
             &radiance_buffer,
             &indirect_radiance_buffer,
@@ -302,15 +301,25 @@ fn check_bake(
             max: MAX_GPU_ORDER,
         });
     }
-    let limit = device.limits().max_storage_buffer_binding_size as usize;
     let transfer_bytes = transfer.direct.as_slice().len() * 4;
-    if transfer_bytes > limit {
-        return Err(BakeMismatch::TooLarge {
-            mb: transfer_bytes >> 20,
-            limit_mb: limit >> 20,
-        });
+    let limits = device.limits();
+    match TransferPath::of(device) {
+        TransferPath::Compute
+            if transfer_bytes > limits.max_storage_buffer_binding_size as usize =>
+        {
+            Err(BakeMismatch::TooLarge {
+                mb: transfer_bytes >> 20,
+                limit_mb: limits.max_storage_buffer_binding_size as usize >> 20,
+            })
+        }
+        TransferPath::Texels if !TexelTransfer::fits(device, vertices, order) => {
+            Err(BakeMismatch::TooLargeForTextures {
+                vertices,
+                max: limits.max_texture_dimension_2d,
+            })
+        }
+        _ => Ok(()),
     }
-    Ok(())
 }
 
 /// The glossy materials, with each vertex's bent normal and unoccluded fraction (its

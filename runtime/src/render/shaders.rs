@@ -26,6 +26,8 @@ pub(crate) const FLOOR_SUMS: usize = FLOOR_GROUPS as usize + 1;
 pub(crate) enum Shader {
     /// Per-vertex PRT radiance (compute).
     Transfer,
+    /// The same, drawn into textures where there is no compute (WebGL2).
+    TransferTexels,
     /// The PRT pass writing the G-buffer.
     Geometry,
     /// Depth from a light.
@@ -46,6 +48,7 @@ impl Shader {
     fn file_name(self) -> &'static str {
         match self {
             Shader::Transfer => "transfer.wgsl",
+            Shader::TransferTexels => "transfer_texels.wgsl",
             Shader::Geometry => "geometry.wgsl",
             Shader::Shadow => "shadow.wgsl",
             Shader::Lights => "lights.wgsl",
@@ -59,6 +62,7 @@ impl Shader {
     fn body(self) -> &'static str {
         match self {
             Shader::Transfer => include_str!("../../../shaders/transfer.wgsl"),
+            Shader::TransferTexels => include_str!("../../../shaders/transfer_texels.wgsl"),
             Shader::Geometry => include_str!("../../../shaders/geometry.wgsl"),
             Shader::Shadow => include_str!("../../../shaders/shadow.wgsl"),
             Shader::Lights => include_str!("../../../shaders/lights.wgsl"),
@@ -81,6 +85,7 @@ impl Shader {
 
         match self {
             Shader::Transfer => &[],
+            Shader::TransferTexels => &[FULLSCREEN],
             Shader::Geometry => &[COMMON, GLOSSY],
             Shader::Shadow => &[COMMON],
             Shader::Lights => &[COMMON, FULLSCREEN, GLOSSY, ENVIRONMENT, COMPOSITE],
@@ -154,6 +159,7 @@ mod tests {
     fn shaders_validate_and_take_their_limits_from_rust() {
         for shader in [
             Shader::Transfer,
+            Shader::TransferTexels,
             Shader::Geometry,
             Shader::Shadow,
             Shader::Lights,

@@ -2,14 +2,46 @@
 //! lights (`Light`), as laid out in `shaders/common.wgsl`.
 
 use super::pass_helpers::writable_buffer;
-use super::shaders::MAX_LIGHTS;
+use super::shaders::{MAX_GPU_COEFFS, MAX_LIGHTS};
 use super::shadow_fit::{BoundingSphere, ShadowFit};
 use crate::light::DirectionalLight;
+use crate::lighting::FrameLighting;
 use bytemuck::{Pod, Zeroable};
 use foundation::Rgb;
 use foundation::camera::Camera;
-use foundation::sh::{ShCoeffs, clamped_cosine_bands};
+use foundation::sh::{ShCoeffs, clamped_cosine_bands, num_coeffs};
 use glam::Mat4;
+
+/// Matches `Lighting` in `shaders/transfer.wgsl` and `shaders/transfer_texels.wgsl`: the SH
+/// lighting the transfer pass dots with every vertex's transfer.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(super) struct LightingUniform {
+    pub vertex_count: u32,
+    pub coeff_count: u32,
+    /// The texel pass's row lengths (unused by the compute pass).
+    pub transfer_width: u32,
+    pub target_width: u32,
+    sh: [[f32; 4]; MAX_GPU_COEFFS],
+    lights_sh: [[f32; 4]; MAX_GPU_COEFFS],
+}
+
+impl LightingUniform {
+    /// `lighting` at the bake's `order`, for `vertex_count` vertices.
+    pub(super) fn new(lighting: &FrameLighting, order: usize, vertex_count: u32) -> Self {
+        let n = num_coeffs(order);
+        let mut uniform = Self::zeroed();
+        uniform.vertex_count = vertex_count;
+        uniform.coeff_count = n as u32;
+        let sh = lighting.sh.with_order(order);
+        let lights_sh = lighting.lights_sh(order);
+        for k in 0..n {
+            uniform.sh[k] = sh.as_slice()[k].extend(0.0).to_array();
+            uniform.lights_sh[k] = lights_sh.as_slice()[k].extend(0.0).to_array();
+        }
+        uniform
+    }
+}
 
 /// Matches `Frame` in `shaders/common.wgsl`.
 #[repr(C)]

@@ -27,7 +27,7 @@ use super::pass_helpers::texture;
 use super::pass_helpers::writable_buffer;
 use super::prt_pass::PrtComposite;
 use super::targets::COLOR_FORMAT;
-use super::transfer_pass::TransferPass;
+use super::transfer_pass::{TransferPass, TransferPath};
 use super::uniforms::FrameBuffers;
 use crate::lighting::{FrameLighting, ShTransfer};
 use bytemuck::{Pod, Zeroable};
@@ -92,22 +92,24 @@ fn photograph_texture(
 /// that writes it from `transfer`, their bake spread over the scene.
 fn without_objects_pass(
     device: &wgpu::Device,
+    queue: &wgpu::Queue,
     transfer: &Transfer,
     vertex_count: u32,
 ) -> (wgpu::Buffer, TransferPass) {
-    let vertex_bytes = u64::from(vertex_count) * 16;
+    let path = TransferPath::of(device);
     let buffer = |label| {
         device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
-            size: vertex_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
+            size: path.radiance_bytes(vertex_count as usize),
+            usage: path.radiance_usage(),
             mapped_at_creation: false,
         })
     };
     let without_radiance = buffer("vertex radiance without the objects");
     // The pass writes an interreflected part too, which the proxies do not need.
     let unused_indirect = buffer("indirect radiance without the objects (unused)");
-    let transfer_pass = TransferPass::new(device, transfer, &without_radiance, &unused_indirect);
+    let transfer_pass =
+        TransferPass::new(device, queue, transfer, &without_radiance, &unused_indirect);
     (without_radiance, transfer_pass)
 }
 
@@ -234,7 +236,7 @@ impl Compositor {
         check_proxies(geometry)?;
         let transfer = without_transfer(geometry, source.proxies_transfer, source.scene.order)?;
         let (without_radiance, transfer_pass) =
-            without_objects_pass(device, &transfer, source.scene.vertex_count);
+            without_objects_pass(device, queue, &transfer, source.scene.vertex_count);
         let (photograph, backplate_uniform) = backplate_resources(device, queue, source.backplate);
         let floor_sums = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("composite floor sums"),
