@@ -5,6 +5,7 @@
 // Every public item is reachable from the crate root: the API is what lib.rs exports.
 #![deny(unreachable_pub)]
 
+pub mod bundle;
 mod cubemap;
 mod decompose;
 mod light;
