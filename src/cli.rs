@@ -220,6 +220,10 @@ pub struct ReportOptions {
     /// Graphics backend: auto, vulkan or gl.
     #[arg(long, default_value = "auto")]
     pub backend: Backend,
+    /// Also write the scene's web viewer (every map of the report) into web/ beside
+    /// report.html, which links to it (per-map reports; needs web/build.sh's module).
+    #[arg(long)]
+    pub web: bool,
 }
 
 impl ReportOptions {
@@ -242,6 +246,7 @@ impl ReportOptions {
             thresholds: self.thresholds.clone(),
             frames: self.frames as usize,
             backend: self.backend,
+            web: self.web,
         }
     }
 }

@@ -101,6 +101,7 @@ pub(crate) fn report_json(
         thresholds,
         frames,
         backend,
+        web: false,
     };
     let options = report::path::PathOptions {
         positions,

@@ -33,6 +33,9 @@ pub enum ReportError {
     PathTraceCancelled(#[from] reference::RenderError),
     #[error(transparent)]
     BakeFile(#[from] precompute::bakefile::BakeFileError),
+    /// The web viewer beside the report.
+    #[error(transparent)]
+    Web(#[from] crate::web::WebError),
     /// A map that cannot be loaded.
     #[error("cannot load the environment map")]
     Map(#[from] foundation::envmap::EnvMapError),

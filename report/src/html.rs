@@ -316,6 +316,15 @@ pub(crate) fn page(report: &Report, out: &Path) -> Result<String> {
         adapter = escape(&report.adapter),
         frames = s.frames,
     );
+    if let Some(web) = &report.web {
+        let _ = write!(
+            html,
+            "<p><a href=\"{web}\">The scene in your browser</a>: the hybrid, PRT and the peers \
+             drawn live (WebGPU, or WebGL2), the map turned and decomposed in the page. Serve \
+             this folder (<code>python3 -m http.server</code>) and open it there.</p>",
+            web = escape(web)
+        );
+    }
     let ok: Vec<&MapReport> = report
         .maps
         .iter()

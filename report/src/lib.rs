@@ -29,6 +29,8 @@ mod settings;
 pub mod shard;
 pub mod stats;
 mod truth;
+pub mod web;
+mod web_viewer;
 
 pub use bake::{bake_stats_lines, cached_bake};
 pub use error::{ReportError, error_chain};

@@ -394,7 +394,14 @@ pub fn run_report(
         });
         maps.push(report);
     }
+    let web = match settings.web {
+        true => Some(crate::web_viewer::write(
+            scene, transfer, camera, envs, &maps, out, observer,
+        )?),
+        false => None,
+    };
     let report = Report {
+        web,
         scene: scene.path.display().to_string(),
         adapter: gpu.description().to_string(),
         bake: bake.display().to_string(),

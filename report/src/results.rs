@@ -74,4 +74,7 @@ pub struct Report {
     /// Reference direct visibility bounds (exclusive) of the penumbra region.
     pub penumbra_visibility: (f32, f32),
     pub maps: Vec<MapReport>,
+    /// The scene's web viewer, relative to the report (`--web`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub web: Option<String>,
 }

@@ -24,6 +24,10 @@ pub struct ReportSettings {
     pub frames: usize,
     #[serde(skip)]
     pub backend: Backend,
+    /// Write the scene's web viewer beside the report (`web/`, linked from `report.html`);
+    /// needs the page's module built (`report::web::WebPackage`).
+    #[serde(skip)]
+    pub web: bool,
 }
 
 impl ReportSettings {

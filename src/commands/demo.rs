@@ -67,6 +67,7 @@ const COMPOSITE_MAPS: [&str; 3] = [
 const COMPOSITE_SPP: u32 = 512;
 /// The teapot composited into a photograph of the city square taken through its camera.
 const PHOTO_COMPOSITE: &str = "scenes/teapot_photo.toml";
+
 /// Glossy materials: the teapot (shininess 60) under every bundled map, and the dragon under
 /// one, with a quick reference.
 const GLOSSY_TEAPOT: &str = "scenes/teapot_glossy.toml";
@@ -107,14 +108,21 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         thresholds: vec![0.0, 0.02, 0.05, 0.1, 0.2, 0.4],
         frames: 5,
         backend: args.backend,
+        web: web_viewer_built(),
     };
     write_report(&scene, &envs, &options, &args.output)?;
+    // The composites, the capture and the room need what the page does not draw (a
+    // photograph behind the model, probes): their reports carry no web viewer.
+    let without_web = ReportOptions {
+        web: false,
+        ..options.clone()
+    };
 
     if bundled_scenes {
         demo_glossy(&args.output, &envs, &options)?;
-        demo_composite(&args.output, &options)?;
-        demo_capture(&args.output.join("capture"), &scene, &options)?;
-        demo_room(&args.output.join("room"), &options)?;
+        demo_composite(&args.output, &without_web)?;
+        demo_capture(&args.output.join("capture"), &scene, &without_web)?;
+        demo_room(&args.output.join("room"), &without_web)?;
     }
 
     // A model as users bring theirs: the textured glTF sample, placed on its own, through
@@ -134,6 +142,18 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         &sample_options,
         &args.output.join("crate"),
     )
+}
+
+/// Whether the page's module is built (`web/build.sh`), for the web viewers of the teapot's,
+/// the glossy scenes' and the glTF sample's reports; says why not when it is not.
+fn web_viewer_built() -> bool {
+    match report::web::WebPackage::locate(None) {
+        Ok(_) => true,
+        Err(e) => {
+            println!("the web viewer is left out: {e}");
+            false
+        }
+    }
 }
 
 /// Glossy materials: shadowed highlights from the lights, prefiltered reflections of the

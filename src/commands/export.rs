@@ -9,10 +9,14 @@ use reference::export::{ExportSettings, export_files, export_mitsuba, mitsuba_ma
 use std::path::PathBuf;
 
 #[derive(Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct ExportArgs {
+    #[command(subcommand)]
+    pub target: Option<ExportTarget>,
     /// Scene file (TOML), or a model (glTF, OBJ, PLY, BPT) placed in a default scene (`hprt
     /// scene init` writes that scene out for editing).
-    pub scene: PathBuf,
+    #[arg(required = true)]
+    pub scene: Option<PathBuf>,
     #[command(flatten)]
     pub environment: EnvironmentArgs,
     /// Indirect bounces (Mitsuba's max_depth is bounces + 2).
@@ -24,19 +28,33 @@ pub struct ExportArgs {
     #[command(flatten)]
     pub size: ImageSizeArgs,
     /// Output folder (scene.xml, envmap.exr, meshes/).
-    #[arg(short, long)]
-    pub output: PathBuf,
+    #[arg(short, long, required = true)]
+    pub output: Option<PathBuf>,
+}
+
+/// What else `hprt export` writes.
+#[derive(clap::Subcommand)]
+pub enum ExportTarget {
+    /// The scene as a web page: the hybrid in the browser (WebGPU, or WebGL2), any static
+    /// file server serving the folder.
+    Web(super::export_web::WebArgs),
 }
 
 pub fn run(args: ExportArgs) -> anyhow::Result<()> {
-    let scene = load_scene(&args.scene)?;
+    let (scene, output) = match (args.target, &args.scene, &args.output) {
+        (Some(ExportTarget::Web(web)), _, _) => return super::export_web::run(web),
+        (None, Some(scene), Some(output)) => (scene.clone(), output.clone()),
+        // clap requires both without a subcommand.
+        _ => anyhow::bail!("hprt export needs a scene and -o"),
+    };
+    let scene = load_scene(&scene)?;
     let env = args.environment.choose(&scene)?;
     let camera = args.size.camera(&scene)?;
     check_folder_output(
         &scene_inputs(&scene, &[Some(&env.path)]),
         "-o",
-        &args.output,
-        &export_files(&args.output, &scene.geometry),
+        &output,
+        &export_files(&output, &scene.geometry),
     )?;
     let settings = ExportSettings {
         camera,
@@ -44,14 +62,14 @@ pub fn run(args: ExportArgs) -> anyhow::Result<()> {
         spp: args.spp,
         bounces: args.bounces,
     };
-    export_mitsuba(&args.output, &scene.geometry, &env.loaded.map, &settings)
+    export_mitsuba(&output, &scene.geometry, &env.loaded.map, &settings)
         .context("cannot export the scene")?;
     println!(
         "wrote {}/scene.xml ({} objects, path integrator with max_depth {}); render it with\n  mitsuba -m scalar_rgb {}/scene.xml",
-        args.output.display(),
+        output.display(),
         scene.geometry.objects.len(),
         mitsuba_max_depth(args.bounces),
-        args.output.display()
+        output.display()
     );
     Ok(())
 }

@@ -10,6 +10,7 @@ pub mod capture;
 pub mod decompose;
 pub mod demo;
 pub mod export;
+pub mod export_web;
 pub mod probes;
 pub mod reference;
 pub mod render;
