@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # The whole test suite on a fresh Debian machine with Rust: installs the system packages the
 # tests need (software Vulkan, a virtual X server, numpy for the bake-format test, Slurm and
-# munge), starts a one-node Slurm cluster on localhost, installs Mitsuba 3 (pip, into
-# target/mitsuba-venv), then runs every test of the workspace.
+# munge, Chromium and its WebDriver for the web viewer), starts a one-node Slurm cluster on
+# localhost, installs Mitsuba 3 (pip, into target/mitsuba-venv), builds the Python module and
+# the web viewer's module, then runs every test of the workspace.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth python3 python3-numpy python3-venv slurm-wlm munge)
+packages=(mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth python3 python3-numpy python3-venv slurm-wlm munge chromium chromium-driver)
 sudo=""
 [ "$(id -u)" -eq 0 ] || sudo="sudo"
 missing=()
@@ -57,6 +58,15 @@ if ! {
     echo "the Python module could not be built (see $pylog); tests/python.rs will fail"
 fi
 export HPRT_PYTHON="$pyvenv/bin/python" HPRT_PYTHON_INSTALL_LOG="$pylog"
+
+# The web viewer's WebAssembly module for tests/web.rs (the wasm32 target and wasm-bindgen's
+# tool installed when missing). If it cannot be built, that test fails and shows this log.
+weblog="$PWD/target/web-build.log"
+echo "building the web viewer's module into web/pkg (log: $weblog)"
+if ! web/build.sh >"$weblog" 2>&1; then
+    echo "the web viewer could not be built (see $weblog); tests/web.rs will fail"
+fi
+export HPRT_WEB_BUILD_LOG="$weblog"
 
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 cargo test --workspace --locked "$@"
