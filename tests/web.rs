@@ -248,4 +248,13 @@ fn a_site_served_without_its_scene_or_with_a_damaged_one_says_what_is_wrong() {
     assert_eq!(page["state"], "error", "{page:#}");
     let text = page["text"].as_str().unwrap();
     assert!(text.contains("scene.bin") && text.contains("404"), "{text}");
+    // Without its module the page says which file is missing, before it ever asks for data.
+    std::fs::remove_file(site.join("web_bg.wasm.gz")).unwrap();
+    let page = open_page(&site, "webgl2", 0);
+    assert_eq!(page["state"], "error", "{page:#}");
+    let text = page["text"].as_str().unwrap();
+    assert!(
+        text.contains("web_bg.wasm.gz") && text.contains("404"),
+        "{text}"
+    );
 }
