@@ -258,3 +258,54 @@ fn a_site_served_without_its_scene_or_with_a_damaged_one_says_what_is_wrong() {
         "{text}"
     );
 }
+
+/// `hprt report --web` writes the scene's viewer beside the report, every reported map in its
+/// chooser, and the report links to it; the viewer opens.
+#[test]
+fn a_report_written_with_web_links_to_a_viewer_that_opens() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let bake = common::bake_teapot(d, "t.bake", &["--samples", "64", "--bounces", "1"]);
+    let teapot = common::scene("teapot.toml");
+    let maps = ["sunrise.exr", "city.exr"].map(|m| common::repo().join("scenes/env").join(m));
+    let out = hprt(
+        d,
+        &[
+            "report",
+            teapot.to_str().unwrap(),
+            "--bake",
+            bake.to_str().unwrap(),
+            "--envs",
+            maps[0].to_str().unwrap(),
+            maps[1].to_str().unwrap(),
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--spp",
+            "16",
+            "--thresholds",
+            "0.05",
+            "--frames",
+            "1",
+            "--web",
+            "-o",
+            "out",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "report: {}{}",
+        stderr(&out),
+        build_log()
+    );
+    let html = std::fs::read_to_string(d.join("out/report.html")).unwrap();
+    assert!(
+        html.contains("href=\"web/index.html\""),
+        "no link in report.html"
+    );
+    let page = open_page(&d.join("out/web"), "webgl2", 0);
+    assert_eq!(page["state"], "ready", "{page:#}");
+    assert_eq!(page["size"], serde_json::json!([64, 48]));
+    assert_eq!(page["maps"], serde_json::json!(["sunrise", "city"]));
+}

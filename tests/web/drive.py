@@ -111,7 +111,8 @@ class Driver:
 
 
 STATE = "return window.hprt ? {state: hprt.state, message: hprt.message || null, " \
-    "backend: hprt.backend || null, firstFrameMs: hprt.firstFrameMs || null} : {state: 'absent'}"
+    "backend: hprt.backend || null, firstFrameMs: hprt.firstFrameMs || null, " \
+    "maps: hprt.maps || null} : {state: 'absent'}"
 READ = "const done = arguments[arguments.length - 1];" \
     "hprt.readFrame().then(f => done({frame: f, size: hprt.size}), e => done({error: String(e)}));"
 
