@@ -39,9 +39,10 @@ pub(crate) fn write(
         runtime::DecomposeMode::Consistent,
     );
     let size = write_site(&out.join("web"), &package, &bundle)?;
+    // `out` is the report's folder while it is written, not where it will be: name the page
+    // relative to report.html.
     observer.line(&format!(
-        "web viewer: {}/web/index.html ({:.1} MB)",
-        out.display(),
+        "web viewer: web/index.html beside report.html ({:.1} MB)",
         size.total as f64 / 1e6
     ));
     Ok("web/index.html".into())
