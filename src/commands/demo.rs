@@ -37,6 +37,11 @@ pub struct DemoArgs {
     /// Graphics backend: auto, vulkan or gl.
     #[arg(long, default_value = "auto")]
     pub backend: runtime::render::Backend,
+    /// Leave the reports' web viewers out (else the page's module is built once with
+    /// web/build.sh when it is missing: a few minutes, the wasm32 target and wasm-bindgen's
+    /// command line installed).
+    #[arg(long)]
+    pub no_web: bool,
 }
 
 /// A bundled file: `path` under the working directory, else in the source tree the program was
@@ -108,7 +113,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         thresholds: vec![0.0, 0.02, 0.05, 0.1, 0.2, 0.4],
         frames: 5,
         backend: args.backend,
-        web: web_viewer_built(),
+        web: !args.no_web && web_viewer_built(),
     };
     write_report(&scene, &envs, &options, &args.output)?;
     // The composites, the capture and the room need what the page does not draw (a
@@ -144,9 +149,30 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     )
 }
 
-/// Whether the page's module is built (`web/build.sh`), for the web viewers of the teapot's,
-/// the glossy scenes' and the glTF sample's reports; says why not when it is not.
+/// Whether the page's module is built, for the web viewers of the teapot's, the glossy
+/// scenes' and the glTF sample's reports: built here with `web/build.sh` of the checkout this
+/// program came from when it is missing; says why not when that fails.
 fn web_viewer_built() -> bool {
+    if report::web::WebPackage::locate(None).is_ok() {
+        return true;
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let script = root.join("web/build.sh");
+    let log = root.join("target/web-build.log");
+    if script.is_file() {
+        println!(
+            "building the web viewer's module once with {} (a few minutes; log: {})",
+            script.display(),
+            log.display()
+        );
+        if let Err(e) = run_logged(&script, &log) {
+            println!(
+                "the web viewer is left out: {} failed: {e}",
+                script.display()
+            );
+            return false;
+        }
+    }
     match report::web::WebPackage::locate(None) {
         Ok(_) => true,
         Err(e) => {
@@ -154,6 +180,21 @@ fn web_viewer_built() -> bool {
             false
         }
     }
+}
+
+/// Runs the shell script `script`, its output into `log`.
+fn run_logged(script: &Path, log: &Path) -> anyhow::Result<()> {
+    if let Some(dir) = log.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let out = std::fs::File::create(log)?;
+    let status = std::process::Command::new("bash")
+        .arg(script)
+        .stdout(out.try_clone()?)
+        .stderr(out)
+        .status()?;
+    anyhow::ensure!(status.success(), "{status} (see its log)");
+    Ok(())
 }
 
 /// Glossy materials: shadowed highlights from the lights, prefiltered reflections of the
