@@ -5,17 +5,6 @@
 // where `sh` is the SH part of the lighting and `lights_sh` the directional lights projected
 // into SH (their bounce light; their direct light is drawn with shadow maps).
 
-struct Lighting {
-    vertex_count: u32,
-    // Coefficients used per channel (n² of the bake's order).
-    coeff_count: u32,
-    _pad0: u32,
-    _pad1: u32,
-    // RGB coefficient k in sh[k].xyz.
-    sh: array<vec4<f32>, MAX_SH_COEFFS>,
-    lights_sh: array<vec4<f32>, MAX_SH_COEFFS>,
-};
-
 @group(0) @binding(0) var<uniform> lighting: Lighting;
 // Layout [vertex][channel][coefficient].
 @group(0) @binding(1) var<storage, read> full_transfer: array<f32>;

@@ -6,17 +6,6 @@
 // copies come out as the f32 vec4s the geometry pass reads. The transfer lies in float textures,
 // each vertex's 3·n floats ([channel][coefficient]) starting a new texel.
 
-struct Lighting {
-    vertex_count: u32,
-    coeff_count: u32,
-    // Texels to a row of the transfer textures.
-    transfer_width: u32,
-    // Texels (vertices) to a row of the targets.
-    target_width: u32,
-    sh: array<vec4<f32>, MAX_SH_COEFFS>,
-    lights_sh: array<vec4<f32>, MAX_SH_COEFFS>,
-};
-
 @group(0) @binding(0) var<uniform> lighting: Lighting;
 @group(0) @binding(1) var full_transfer: texture_2d<f32>;
 @group(0) @binding(2) var indirect_transfer: texture_2d<f32>;

@@ -33,9 +33,14 @@ pub enum ReportError {
     PathTraceCancelled(#[from] reference::RenderError),
     #[error(transparent)]
     BakeFile(#[from] precompute::bakefile::BakeFileError),
-    /// The web viewer beside the report.
-    #[error(transparent)]
-    Web(#[from] crate::web::WebError),
+    /// The web viewer's module is missing (the first of its files that is).
+    #[error(
+        "the web viewer's WebAssembly module is not built ({} is missing): run web/build.sh in \
+         hprt's checkout (it installs the wasm32 target and wasm-bindgen), or name a built \
+         module's folder with HPRT_WEB_PACKAGE",
+        .0.display()
+    )]
+    WebNotBuilt(PathBuf),
     /// A map that cannot be loaded.
     #[error("cannot load the environment map")]
     Map(#[from] foundation::envmap::EnvMapError),

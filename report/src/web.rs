@@ -3,6 +3,7 @@
 //! module (`web/pkg`, built by `web/build.sh`) and the scene ([`runtime::bundle`]). Written by
 //! `hprt export web` and beside reports.
 
+use crate::error::{ReportError, Result};
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::infra::atomic_file::{AtomicOutput, commit_all};
@@ -23,24 +24,6 @@ const BUILT_PACKAGE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../web/pkg");
 /// Names another folder holding the module.
 pub const PACKAGE_VARIABLE: &str = "HPRT_WEB_PACKAGE";
 
-#[derive(Debug, thiserror::Error)]
-pub enum WebError {
-    #[error(
-        "the web viewer's WebAssembly module is not built ({} is missing): run web/build.sh in \
-         hprt's checkout (it installs the wasm32 target and wasm-bindgen), or name a built \
-         module's folder with {PACKAGE_VARIABLE}",
-        .0.display()
-    )]
-    NotBuilt(PathBuf),
-    #[error("{action} {}", path.display())]
-    File {
-        action: &'static str,
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
-}
-
 /// A built WebAssembly module of the page.
 #[derive(Debug, Clone)]
 pub struct WebPackage {
@@ -50,7 +33,7 @@ pub struct WebPackage {
 impl WebPackage {
     /// `dir`, else `$HPRT_WEB_PACKAGE`, else `web/pkg` of the checkout hprt was built from;
     /// refused unless it holds the module.
-    pub fn locate(dir: Option<&Path>) -> Result<Self, WebError> {
+    pub fn locate(dir: Option<&Path>) -> Result<Self> {
         let dir = match (dir, std::env::var_os(PACKAGE_VARIABLE)) {
             (Some(dir), _) => dir.to_owned(),
             (None, Some(dir)) => PathBuf::from(dir),
@@ -58,7 +41,7 @@ impl WebPackage {
         };
         for name in MODULE_FILES {
             if !dir.join(name).is_file() {
-                return Err(WebError::NotBuilt(dir.join(name)));
+                return Err(ReportError::WebNotBuilt(dir.join(name)));
             }
         }
         Ok(Self { dir })
@@ -119,32 +102,20 @@ pub struct SiteSize {
 }
 
 /// Writes the viewer of `bundle` into `dir` (made if missing): every file or none.
-pub fn write_site(
-    dir: &Path,
-    package: &WebPackage,
-    bundle: &SceneBundle,
-) -> Result<SiteSize, WebError> {
-    let file_error = |action, path: &Path| {
-        let path = path.to_owned();
-        move |source| WebError::File {
-            action,
-            path,
-            source,
-        }
-    };
-    std::fs::create_dir_all(dir).map_err(file_error("cannot create the folder", dir))?;
+pub fn write_site(dir: &Path, package: &WebPackage, bundle: &SceneBundle) -> Result<SiteSize> {
+    std::fs::create_dir_all(dir).map_err(ReportError::file("cannot create the folder", dir))?;
     let scene = bundle
         .to_bytes()
-        .map_err(file_error("cannot write", &dir.join(SCENE_FILE)))?;
+        .map_err(ReportError::file("cannot write", &dir.join(SCENE_FILE)))?;
     let mut contents = vec![PAGE.as_bytes().to_vec(), scene];
     for name in MODULE_FILES {
         let path = package.dir.join(name);
-        contents.push(std::fs::read(&path).map_err(file_error("cannot read", &path))?);
+        contents.push(std::fs::read(&path).map_err(ReportError::file("cannot read", &path))?);
     }
     let files = site_files(dir);
     let mut outputs = Vec::new();
     for (path, bytes) in files.iter().zip(contents) {
-        let output = AtomicOutput::create(path).map_err(file_error("cannot write", path))?;
+        let output = AtomicOutput::create(path).map_err(ReportError::file("cannot write", path))?;
         outputs.push((output, bytes));
     }
     let size = |range: std::ops::Range<usize>| -> u64 {
@@ -155,6 +126,6 @@ pub fn write_site(
         module: size(2..4),
         total: size(0..4),
     };
-    commit_all(outputs).map_err(file_error("cannot write the web viewer into", dir))?;
+    commit_all(outputs).map_err(ReportError::file("cannot write the web viewer into", dir))?;
     Ok(sizes)
 }

@@ -218,7 +218,7 @@ impl GpuContext {
 /// The adapter's own limits (large scenes need big storage buffers). With
 /// `HPRT_GPU_LIMITS=webgl2`, a browser's WebGL2 limits instead (no compute, no storage
 /// buffers; the adapter's texture sizes), so that the paths a WebGL2 page takes run natively
-/// and are tested there (DEVELOPERS.md, "The web viewer").
+/// and are tested there (CONVENTIONS.md, "The web viewer").
 fn required_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
     #[cfg(not(target_arch = "wasm32"))]
     if std::env::var("HPRT_GPU_LIMITS").as_deref() == Ok("webgl2") {

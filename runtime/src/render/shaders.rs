@@ -75,17 +75,18 @@ impl Shader {
 
     /// The shared WGSL the shader builds on: the structs of `shaders/common.wgsl` for the
     /// render passes, the full-screen triangle of `shaders/fullscreen.wgsl` for full-screen
-    /// passes.
+    /// passes, the transfer passes' lighting struct of `shaders/transfer_lighting.wgsl`.
     fn prelude(self) -> &'static [&'static str] {
         const COMMON: &str = include_str!("../../../shaders/common.wgsl");
         const FULLSCREEN: &str = include_str!("../../../shaders/fullscreen.wgsl");
         const GLOSSY: &str = include_str!("../../../shaders/glossy.wgsl");
         const ENVIRONMENT: &str = include_str!("../../../shaders/environment.wgsl");
         const COMPOSITE: &str = include_str!("../../../shaders/composite.wgsl");
+        const LIGHTING: &str = include_str!("../../../shaders/transfer_lighting.wgsl");
 
         match self {
-            Shader::Transfer => &[],
-            Shader::TransferTexels => &[FULLSCREEN],
+            Shader::Transfer => &[LIGHTING],
+            Shader::TransferTexels => &[LIGHTING, FULLSCREEN],
             Shader::Geometry => &[COMMON, GLOSSY],
             Shader::Shadow => &[COMMON],
             Shader::Lights => &[COMMON, FULLSCREEN, GLOSSY, ENVIRONMENT, COMPOSITE],

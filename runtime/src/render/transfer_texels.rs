@@ -4,6 +4,7 @@
 //! pass reads, so everything after this pass is the same on every device.
 
 use super::bindings::TRANSFER_TEXELS;
+use super::pass_helpers::{FullscreenPass, begin_pass, color_attachment, texture, writable_buffer};
 use super::shaders::Shader;
 use super::uniforms::LightingUniform;
 use foundation::sh::num_coeffs;
@@ -27,6 +28,7 @@ pub(super) struct TexelTransfer {
     pipeline: wgpu::RenderPipeline,
     bind_group: wgpu::BindGroup,
     targets: [wgpu::Texture; 2],
+    target_views: [wgpu::TextureView; 2],
     radiance: [wgpu::Buffer; 2],
 }
 
@@ -79,50 +81,32 @@ impl TexelTransfer {
         indirect_radiance: &wgpu::Buffer,
     ) -> Self {
         let vertices = transfer.direct.vertex_count();
-        let order = transfer.settings.order;
-        let texture = |label, format, width, height, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let (rows, target) = (transfer_rows(vertices, order), target_rows(vertices));
+        let rows = transfer_rows(vertices, transfer.settings.order);
         let sampled = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
-        let drawn = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-        let (bake, drawn_to) = (
-            (TRANSFER_FORMAT, TRANSFER_WIDTH),
-            (TARGET_FORMAT, TARGET_WIDTH),
-        );
-        let full = texture("full transfer", bake.0, bake.1, rows, sampled);
-        let indirect = texture("indirect transfer", bake.0, bake.1, rows, sampled);
-        let targets = [
-            texture("vertex radiance", drawn_to.0, drawn_to.1, target, drawn),
+        let bake = |label| {
             texture(
-                "vertex indirect radiance",
-                drawn_to.0,
-                drawn_to.1,
-                target,
-                drawn,
-            ),
+                device,
+                label,
+                (TRANSFER_WIDTH, rows, 1),
+                TRANSFER_FORMAT,
+                sampled,
+            )
+        };
+        let drawn = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let size = (TARGET_WIDTH, target_rows(vertices), 1);
+        let target = |label| texture(device, label, size, TARGET_FORMAT, drawn);
+        let (full, indirect) = (bake("full transfer"), bake("indirect transfer"));
+        let targets = [
+            target("vertex radiance"),
+            target("vertex indirect radiance"),
         ];
-        let lighting_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("lighting"),
-            size: std::mem::size_of::<LightingUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let lighting_buffer = writable_buffer(
+            device,
+            "lighting",
+            std::mem::size_of::<LightingUniform>(),
+            wgpu::BufferUsages::UNIFORM,
+        );
         let layout = TRANSFER_TEXELS.layout(device);
-        let pipeline = pipeline(device, &layout);
         let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
         let bind_group = TRANSFER_TEXELS.bind_group(
             device,
@@ -143,8 +127,9 @@ impl TexelTransfer {
             full,
             indirect,
             lighting_buffer,
-            pipeline,
+            pipeline: pipeline(device, &layout),
             bind_group,
+            target_views: targets.each_ref().map(view),
             targets,
             radiance: [radiance.clone(), indirect_radiance.clone()],
         };
@@ -179,27 +164,13 @@ impl TexelTransfer {
         uniform.transfer_width = TRANSFER_WIDTH;
         uniform.target_width = TARGET_WIDTH;
         queue.write_buffer(&self.lighting_buffer, 0, bytemuck::bytes_of(&uniform));
-        let views = self
-            .targets
+        let clear = Some(wgpu::Color::TRANSPARENT);
+        let attachments = self
+            .target_views
             .each_ref()
-            .map(|t| t.create_view(&wgpu::TextureViewDescriptor::default()));
-        let attachments = views.each_ref().map(|view| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })
-        });
+            .map(|v| color_attachment(v, clear));
         {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("transfer texels"),
-                color_attachments: &attachments,
-                ..Default::default()
-            });
+            let mut pass = begin_pass(encoder, "transfer texels", &attachments, None);
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(TRANSFER_TEXELS.group, &self.bind_group, &[]);
             pass.draw(0..3, 0..1);
@@ -227,33 +198,16 @@ fn pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::Rend
         bind_group_layouts: &[Some(layout)],
         immediate_size: 0,
     });
-    let module = Shader::TransferTexels.module(device);
-    let target = Some(wgpu::ColorTargetState {
-        format: TARGET_FORMAT,
-        blend: None,
-        write_mask: wgpu::ColorWrites::ALL,
-    });
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("transfer texels"),
+    let target = Some(wgpu::ColorTargetState::from(TARGET_FORMAT));
+    FullscreenPass {
+        label: "transfer texels",
+        entry_point: "fs_transfer",
+        module: &Shader::TransferTexels.module(device),
         layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some(Shader::FULLSCREEN_VERTEX),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_transfer"),
-            compilation_options: Default::default(),
-            targets: &[target.clone(), target],
-        }),
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: None,
-        multisample: wgpu::MultisampleState::default(),
-        multiview_mask: None,
-        cache: None,
-    })
+        targets: &[target.clone(), target],
+        constants: &[],
+    }
+    .pipeline(device)
 }
 
 #[cfg(test)]

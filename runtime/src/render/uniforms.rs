@@ -12,7 +12,7 @@ use foundation::camera::Camera;
 use foundation::sh::{ShCoeffs, clamped_cosine_bands, num_coeffs};
 use glam::Mat4;
 
-/// Matches `Lighting` in `shaders/transfer.wgsl` and `shaders/transfer_texels.wgsl`: the SH
+/// Matches `Lighting` in `shaders/transfer_lighting.wgsl`: the SH
 /// lighting the transfer pass dots with every vertex's transfer.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
