@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 const BVHS: EntryKind = EntryKind {
     folder: "bvhs",
-    tag: "hprt bvh v1 (obvhs 0.4 slow build, four-wide)",
+    tag: "hprt bvh v2 (obvhs 0.4 slow build, four-wide, padded boxes)",
 };
 
 const FORMAT: Format = Format {

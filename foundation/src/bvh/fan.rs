@@ -4,64 +4,45 @@
 //! [`SceneBvh::occluded`]), bit for bit; what it saves is the box and triangle work its
 //! neighbours share.
 //!
-//! Where two triangles are hit at exactly the same distance (overlapping triangles of a
-//! scanned mesh), a lone ray keeps the one it meets first, which depends on the order it
-//! visits the tree in; a packet visits it in another. Such a lane is traced again alone, so
-//! that its answer is the lone ray's (about one ray in 10⁴ on the dragon).
+//! What a ray hits does not depend on the tree, so neither does any bake (issue 57, 2026-12-07,
+//! when bake answers were let change once): nothing nearer than `MIN_BOX_DISTANCE` counts,
+//! triangles held to the boxes' floor (before, a hit that near counted only where its leaf's
+//! box reached past the floor); of triangles hit at the same distance the lowest scene index
+//! wins (before, the first a traversal met, so packets traced tied lanes again alone); every
+//! box is padded by 2⁻²⁰ of the scene's largest coordinate (the builder's split boxes of a long
+//! triangle can leave its edge by an ulp); and a waiting child is kept or left by the entry
+//! test's slack. `every_tree_gives_the_same_hits` builds four trees and checks it, and fails
+//! without the floor, the tie rule or the padding. The 871k-triangle dragon's bake (256
+//! samples, 1 bounce) moved at 1,147 of 435,161 vertices' direct transfer (by up to 0.19, an
+//! RMS of 0.0005 over all coefficients) and its white-furnace mean from 0.50772 to 0.50783:
+//! rays that stopped on a neighbour within 1e-4 of their origin now pass it.
 //!
-//! Exact ties are not the only place where order shows. The lone ray's pruning can hide a
-//! triangle an ulp nearer on an edge it shares with the one kept (that box's entry rounds past
-//! the hit), and a hit nearer the origin than boxes are entered (`MIN_BOX_DISTANCE`) is found
-//! only through the boxes a ray happens to visit. Packets visit the same boxes with the same
-//! arithmetic, and the bundled bakes come out byte-identical to lone rays. A traversal of
-//! another tree must also trace those lanes again alone: prune and test a little past the
-//! closest so far (`ROUNDING`), and re-trace a lane whose closest has a rival that near or lies
-//! nearer than `MIN_BOX_DISTANCE`. An eight-wide tree for the fans was tried that way
-//! (2026-12-03, branch `attempt/bvh8-fans`): byte-identical bakes, but 5–10% slower than these
-//! packets, which test each child box for their eight lanes, so a wider node costs them more
-//! than the levels it saves.
+//! Trees measured since (871k dragon, 256 samples, direct pass, 2 threads, Xeon, 2026-12-07):
+//! obvhs's slow preset as before 5.43 M rays/s; more reinsertion (`0.5`, `1×` after collapse)
+//! 5.17; the very slow preset's search with full reinsertion 4.99; four triangles a leaf
+//! 4.84; a collapse cost of 2 instead of 3 5.16. The slow preset stays. On the same rays
+//! Embree 4.4's single-ray closest hit traced 3.91 M rays/s.
 //!
-//! Cheaper arithmetic per node did not pay either (2026-12-03, same machine, byte-identical
-//! bakes each time): culling a node's children by the packet's frustum before the lane-by-lane
-//! test made the dragon slower (branch `attempt/packet-frustum`); a vector reduction for the
-//! children's nearest entries, a branch-free ranking of them, and tracing each fan in the four
-//! runs its rotation's wrap cuts the sample curve into gained no more than the machine's noise
-//! (`attempt/packet-ordering`). Four-lane packets, whose operations this machine's Zen 1 cores
-//! do not split in two, were slower still (`attempt/packet4`). Tracing every fan twice in a
-//! row took 1.74 times as long as once (`attempt/fan-twice`): the second pass, from a warm
-//! cache, costs three quarters of the first, so cache misses are not where most of the time
-//! goes either. Sixteen-lane packets were no faster than eight (`attempt/packet16`), and
-//! packets of eight rays from different vertices, a chunk's rays sorted by direction, were
-//! much slower (1.8 against 3.2 M rays/s, `attempt/bundles`): lanes that start at different
-//! points part in the first leaves, where a fan's lanes, sharing their origin, stay together.
+//! Earlier attempts, answers unchanged each time (2026-12-03, Zen 1): an eight-wide tree for
+//! the fans, 5–10% slower than these packets, which test each child box for their eight
+//! lanes, so a wider node costs them more than the levels it saves (`attempt/bvh8-fans`);
+//! culling a node's children by the packet's frustum (`attempt/packet-frustum`), a vector
+//! reduction for the children's nearest entries and a branch-free ranking of them
+//! (`attempt/packet-ordering`), four-lane packets (`attempt/packet4`), sixteen-lane packets
+//! (`attempt/packet16`) and laying a node's inner children side by side
+//! (`attempt/node-layout`) gained nothing; packets of eight rays from different vertices,
+//! a chunk's rays sorted by direction, were much slower (1.8 against 3.2 M rays/s,
+//! `attempt/bundles`): lanes that start at different points part in the first leaves, where
+//! a fan's lanes, sharing their origin, stay together. Tracing every fan twice in a row took
+//! 1.74 times as long as once: cache misses are not where most of the time goes.
 //!
-//! A better tree does pay: more of obvhs's SAH reinsertion (`reinsertion_batch_ratio` 0.5, 1×
-//! after collapse), built on every thread, cut the dragon's fan work by 7–9% and the 810k
-//! bake's trace by 9–15% (branch `attempt/build-params`, 2026-12-03). It is not in: another
-//! tree changes more than ties. One vertex of the 810k-triangle bake came out with a direct
-//! transfer 0.046 apart, and 464 others' indirect moved by more than 1e-6, so that tree waits
-//! on a decision to let a bake's answers change.
-//!
-//! The near rule is what makes trees disagree (2026-12-04): with triangles held to the boxes'
-//! floor, so that nothing nearer than `MIN_BOX_DISTANCE` is hit in whichever leaf it lies,
-//! the two trees' 810k bakes agree (the direct transfer bit for bit; the indirect at all but 8
-//! vertices, one of them off by more than 1e-6; branch `attempt/build-params-floor`). That
-//! floor alone moves today's answers, though (173 vertices' direct transfer on the 810k bake,
-//! by up to 0.17; `attempt/near-floor`), and dropping the boxes' floor instead fails the open
-//! box's white furnace. Timed alternately with the floor in both, the better tree traced the
-//! 810k bake in 51.2 s against 55.0 s: 7%, too little to change answers for. Laying a node's
-//! inner children side by side in memory, which changes no answer, gained nothing (2.70
-//! against 2.68 M rays/s on the 810k bake's direct pass, `attempt/node-layout`).
-//!
-//! Where Embree is ahead is the lone ray. On the 810k bake's own rays (256 a vertex, 2
-//! threads, 2026-12-04) Embree's single-ray closest hit traced 3.12 M rays/s, these packets
-//! 2.39–2.72, and the same traversal with every lane alone 1.97 (`attempt/alone-probe`).
-//! What Embree does differently there (its own tree, one fused multiply-add a plane) changes
-//! the leaves or the boxes' rounding, and so, through the near rule, can move today's answers.
+//! Not tried, and why: Embree's box test (one fused multiply-add a plane) needs FMA, which the
+//! portable build (x86-64 without FMA) would call through libm, so portable and native builds
+//! would trace differently fast and, where its rounding leaves the padding, differently.
 
 use super::packet::{LANES, RayPacket};
 use super::stack::{Stack, insert_farthest_first};
-use super::wide::ChildRef;
+use super::wide::{ChildRef, ROUNDING};
 use super::{Hit, NoTally, SceneBvh, SegmentRay, Skip};
 use glam::Vec3;
 use wide::f32x8;
@@ -79,12 +60,10 @@ struct Pending {
     near: f32x8,
 }
 
-/// A packet's closest hits so far: per lane, its distance (the search's far end) and slot,
-/// and the lanes that met two triangles at their closest distance.
+/// A packet's closest hits so far: per lane, its distance (the search's far end) and slot.
 struct Closest {
     tmax: f32x8,
     slot: [Option<usize>; LANES],
-    tied: u32,
 }
 
 impl SceneBvh {
@@ -104,16 +83,12 @@ impl SceneBvh {
             let closest = self.packet_closest(&packet, tmin, tmax, skip);
             let distances = closest.tmax.to_array();
             for (lane, direction) in chunk.iter().enumerate() {
-                hits.push(if closest.tied & (1 << lane) != 0 {
-                    self.closest_hit(origin, *direction, tmin, tmax, skip)
-                } else {
-                    let ray = SegmentRay {
-                        origin: origin.into(),
-                        direction: (*direction).into(),
-                        tmax: distances[lane],
-                    };
-                    closest.slot[lane].map(|slot| self.finish(&ray, slot))
-                });
+                let ray = SegmentRay {
+                    origin: origin.into(),
+                    direction: (*direction).into(),
+                    tmax: distances[lane],
+                };
+                hits.push(closest.slot[lane].map(|slot| self.finish(&ray, slot)));
             }
         }
     }
@@ -131,7 +106,7 @@ impl SceneBvh {
         blocked.clear();
         for chunk in directions.chunks(LANES) {
             let packet = RayPacket::new(origin, chunk, tmin);
-            let mask = self.packet_occluded(&packet, tmin, tmax, skip);
+            let mask = self.packet_occluded(&packet, tmax, skip);
             blocked.extend((0..chunk.len()).map(|lane| mask & (1 << lane) != 0));
         }
     }
@@ -140,7 +115,6 @@ impl SceneBvh {
         let mut closest = Closest {
             tmax: f32x8::splat(tmax),
             slot: [None; LANES],
-            tied: 0,
         };
         let Some(mut current) = self.tree.root() else {
             return closest;
@@ -156,7 +130,7 @@ impl SceneBvh {
                     continue;
                 }
             } else {
-                self.leaf_closest(current, lanes, packet, (tmin, skip), &mut closest);
+                self.leaf_closest(current, lanes, packet, skip, &mut closest);
             }
             // The next child some lane still has to visit: one whose box it enters before
             // its closest hit so far.
@@ -164,7 +138,9 @@ impl SceneBvh {
                 let Some(pending) = stack.pop() else {
                     return closest;
                 };
-                let open = pending.lanes & pending.near.simd_le(closest.tmax).to_bitmask();
+                // The entry test's slack, as a single ray's (`SceneBvh::closest_below`).
+                let far = closest.tmax * f32x8::splat(ROUNDING);
+                let open = pending.lanes & pending.near.simd_le(far).to_bitmask();
                 if open != 0 {
                     (current, lanes) = (pending.child, open);
                     break;
@@ -225,11 +201,8 @@ impl SceneBvh {
             let lane = lanes.trailing_zeros() as usize;
             lanes &= lanes - 1;
             let ray = packet.lane(lane, tmin);
-            let search = (&ray, tmin, skip);
             let slot = &mut closest.slot[lane];
-            if self.closest_below(start, search, &mut tmax[lane], slot, &mut NoTally) {
-                closest.tied |= 1 << lane;
-            }
+            self.closest_below(start, (&ray, skip), &mut tmax[lane], slot, &mut NoTally);
         }
         closest.tmax = f32x8::new(tmax);
     }
@@ -241,13 +214,13 @@ impl SceneBvh {
         leaf: ChildRef,
         lanes: u32,
         packet: &RayPacket,
-        (tmin, skip): (f32, Skip),
+        skip: Skip,
         closest: &mut Closest,
     ) {
         let first = leaf.index as usize;
         for slot in first..first + leaf.count as usize {
             let triangle = self.packets[slot / 4].lane(slot % 4);
-            let (t, hits) = packet.intersect(triangle, tmin, closest.tmax);
+            let (t, hits) = packet.intersect(triangle, closest.tmax);
             let mut hits = hits & lanes;
             if hits == 0 || self.skipped(slot, skip) {
                 continue;
@@ -257,9 +230,7 @@ impl SceneBvh {
             while hits != 0 {
                 let lane = hits.trailing_zeros() as usize;
                 hits &= hits - 1;
-                if self.keep_closer(t[lane], slot, &mut tmax[lane], &mut closest.slot[lane]) {
-                    closest.tied |= 1 << lane;
-                }
+                self.keep_closer(t[lane], slot, &mut tmax[lane], &mut closest.slot[lane]);
             }
             closest.tmax = f32x8::new(tmax);
         }
@@ -267,7 +238,7 @@ impl SceneBvh {
 
     /// The mask of the packet's lanes that something but `skip` blocks; a lane stops at its
     /// first blocker, the packet when every lane has.
-    fn packet_occluded(&self, packet: &RayPacket, tmin: f32, tmax: f32, skip: Skip) -> u32 {
+    fn packet_occluded(&self, packet: &RayPacket, tmax: f32, skip: Skip) -> u32 {
         let far = f32x8::splat(tmax);
         let mut blocked = 0;
         let Some(mut current) = self.tree.root() else {
@@ -290,7 +261,7 @@ impl SceneBvh {
                 let first = current.index as usize;
                 for slot in first..first + current.count as usize {
                     let triangle = self.packets[slot / 4].lane(slot % 4);
-                    let (_, hits) = packet.intersect(triangle, tmin, far);
+                    let (_, hits) = packet.intersect(triangle, far);
                     let hits = hits & lanes & !blocked;
                     if hits != 0 && !self.skipped(slot, skip) {
                         blocked |= hits;
@@ -358,8 +329,8 @@ mod tests {
 
     /// Two tessellations of one square, cells of 1 and of 2, split along opposite diagonals:
     /// every ray meets two triangles at exactly the same distance (all the arithmetic is
-    /// exact up to powers of two), often in different leaves, where a lone ray keeps the one
-    /// its order meets first. Fans must keep the same one.
+    /// exact up to powers of two), often in different leaves. Fans and lone rays keep the
+    /// same one, the first tessellation's (the lower index).
     #[test]
     fn fans_settle_ties_as_single_rays_do() {
         let mut mesh = TriangleMesh::default();
@@ -402,6 +373,7 @@ mod tests {
             for (k, &direction) in directions.iter().enumerate() {
                 let alone = bvh.closest_hit(origin, direction, 0.0, f32::INFINITY, Skip::Nothing);
                 assert_eq!(found[k], alone, "fan {fan}, ray {k}");
+                assert!(alone.is_none_or(|h| h.triangle < 128), "fan {fan}, ray {k}");
                 hits += usize::from(alone.is_some());
             }
         }

@@ -9,7 +9,7 @@ use glam::{Vec3, Vec3A};
 use obvhs::bvh2::builder::build_bvh2_from_tris;
 use obvhs::triangle::Triangle;
 use stack::{Stack, insert_farthest_first};
-use wide::{Bvh4, ChildRef, NO_TRIANGLE, TrianglePacket, WideRay, moller_trumbore};
+use wide::{Bvh4, ChildRef, NO_TRIANGLE, ROUNDING, TrianglePacket, WideRay, moller_trumbore};
 
 mod cache;
 mod fan;
@@ -22,6 +22,10 @@ mod wide;
 /// Where the ray-epsilon scale of a scene comes from: a fraction of its bounding-box diagonal.
 /// The bake and the reference offset every ray by it, so both see the same geometry.
 pub const RAY_OFFSET_FRACTION: f32 = 1e-5;
+
+/// How obvhs builds the tree: its slow preset (pre-split triangles, a wider PLOC search), 0.3 s
+/// more to build the 202k-triangle dragon than its medium one, for a tree that traces faster.
+const TREE: obvhs::BvhBuildParams = obvhs::BvhBuildParams::slow_build();
 
 /// The closest intersection of a ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,6 +68,12 @@ struct SegmentRay {
 
 impl SceneBvh {
     pub fn build(mesh: &TriangleMesh) -> Self {
+        Self::build_with(mesh, TREE)
+    }
+
+    /// The tree `params` build. Which tree it is changes the work a ray costs, never what it
+    /// hits (the tests build others to show it).
+    fn build_with(mesh: &TriangleMesh, params: obvhs::BvhBuildParams) -> Self {
         let tris: Vec<Triangle> = (0..mesh.triangle_count())
             .map(|t| {
                 let [a, b, c] = mesh.corners(t);
@@ -74,13 +84,7 @@ impl SceneBvh {
                 }
             })
             .collect();
-        // The slow preset (pre-split triangles, a wider PLOC search): 0.3 s more to build the
-        // 202k-triangle dragon, and a tree that traces faster.
-        let bvh2 = build_bvh2_from_tris(
-            &tris,
-            obvhs::BvhBuildParams::slow_build(),
-            &mut std::time::Duration::default(),
-        );
+        let bvh2 = build_bvh2_from_tris(&tris, params, &mut std::time::Duration::default());
         let (tree, ids) = Bvh4::from_bvh2(&bvh2);
         let packets = TrianglePacket::pack(&ids, |i| {
             let t = &tris[i as usize];
@@ -138,7 +142,7 @@ impl SceneBvh {
         };
         let wide = WideRay::new(ray.origin, ray.direction, tmin);
         let mut closest = None;
-        let search = (&wide, tmin, skip);
+        let search = (&wide, skip);
         self.closest_below(
             self.tree.root()?,
             search,
@@ -151,18 +155,16 @@ impl SceneBvh {
 
     /// Searches the subtree at `start` for a hit nearer than `tmax` (the closest so far, in
     /// slot `closest`), updating both; children are visited nearest first, and of equidistant
-    /// triangles the first met is kept. Returns whether a triangle other than the closest was
-    /// met at its very distance (a tie, which only this order settles).
+    /// triangles the lowest scene index is kept ([`Self::keep_closer`]).
     #[inline(always)]
     fn closest_below(
         &self,
         start: ChildRef,
-        (wide, tmin, skip): (&WideRay, f32, Skip),
+        (wide, skip): (&WideRay, Skip),
         tmax: &mut f32,
         closest: &mut Option<usize>,
         tally: &mut impl Tally,
-    ) -> bool {
-        let mut tied = false;
+    ) {
         let mut stack = Stack::new();
         let mut current = start;
         loop {
@@ -188,22 +190,24 @@ impl SceneBvh {
                 }
             } else {
                 for packet in Self::packets_of(current) {
-                    let (t, mut hits) = self.packets[packet].intersect(wide, tmin, *tmax);
+                    let (t, mut hits) = self.packets[packet].intersect(wide, *tmax);
                     while hits != 0 {
                         let lane = hits.trailing_zeros() as usize;
                         hits &= hits - 1;
                         let slot = 4 * packet + lane;
                         if !self.skipped(slot, skip) {
-                            tied |= self.keep_closer(t[lane], slot, tmax, closest);
+                            self.keep_closer(t[lane], slot, tmax, closest);
                         }
                     }
                 }
             }
             loop {
                 let Some((child, t)) = stack.pop() else {
-                    return tied;
+                    return;
                 };
-                if t <= *tmax {
+                // The entry test's own slack ([`wide::ROUNDING`]), so that a child is kept or
+                // left by the same rule whenever its turn comes.
+                if t <= *tmax * ROUNDING {
                     current = child;
                     break;
                 }
@@ -212,23 +216,15 @@ impl SceneBvh {
     }
 
     /// Keeps a hit at `t` on the triangle in `slot` if it is nearer than the closest so far
-    /// (at `tmax`, in slot `closest`). Returns whether it is a tie: as near, on another
-    /// triangle (a triangle the builder split sits in several leaves: meeting it again is no
-    /// tie). Of equidistant triangles the first met stays.
+    /// (at `tmax`, in slot `closest`) or as near on a triangle of lower scene index: the
+    /// answer is then the same whatever order a tree visits its leaves in.
     #[inline(always)]
-    fn keep_closer(
-        &self,
-        t: f32,
-        slot: usize,
-        tmax: &mut f32,
-        closest: &mut Option<usize>,
-    ) -> bool {
-        if t < *tmax {
+    fn keep_closer(&self, t: f32, slot: usize, tmax: &mut f32, closest: &mut Option<usize>) {
+        let nearer =
+            t < *tmax || (t == *tmax && closest.is_some_and(|c| self.ids[slot] < self.ids[c]));
+        if nearer {
             *tmax = t;
             *closest = Some(slot);
-            false
-        } else {
-            t == *tmax && closest.is_some_and(|c| self.ids[c] != self.ids[slot])
         }
     }
 
@@ -258,7 +254,7 @@ impl SceneBvh {
                 }
             } else {
                 for packet in Self::packets_of(current) {
-                    let (_, mut hits) = self.packets[packet].intersect(&wide, tmin, tmax);
+                    let (_, mut hits) = self.packets[packet].intersect(&wide, tmax);
                     while hits != 0 {
                         let lane = hits.trailing_zeros() as usize;
                         hits &= hits - 1;
@@ -418,6 +414,66 @@ mod tests {
         }
         // Both outcomes are well represented.
         assert!((1000..3000).contains(&hits), "{hits} hits of 4000");
+    }
+
+    /// What a ray hits is the scene's, not the tree's: four trees of obvhs's presets (one
+    /// triangle a leaf and no splits, up to eight with pre-split triangles, more or less
+    /// reinsertion) give the same hits bit for bit, single rays and fans, on a soup and on an
+    /// unwelded box whose rays leave from its surface, where a neighbour touches the origin
+    /// (hits nearer than the floor) and edges are shared (hits an ulp apart).
+    #[test]
+    fn every_tree_gives_the_same_hits() {
+        use obvhs::BvhBuildParams as P;
+        let mut soup = Soup::new(5);
+        let mut mesh = box_mesh(Vec3::splat(-1.0), Vec3::ONE, [6, 5, 4], [false; 6]);
+        let offset = mesh.positions.len() as u32;
+        mesh.positions.extend(&soup.mesh.positions);
+        mesh.normals.extend(&soup.mesh.normals);
+        (mesh.triangles).extend(soup.mesh.triangles.iter().map(|t| t.map(|i| i + offset)));
+        let presets = [
+            P::fastest_build(),
+            P::medium_build(),
+            TREE,
+            P::very_slow_build(),
+        ];
+        let trees = presets.map(|p| SceneBvh::build_with(&mesh, p));
+        let mut hits = 0;
+        let (mut fan, mut first_fan) = (Vec::new(), Vec::new());
+        for k in 0..600u32 {
+            // From a point of a triangle of the box (its skin, where seams are) or the soup.
+            let triangle = if k % 2 == 0 {
+                k % 240
+            } else {
+                k * 7 % mesh.triangle_count() as u32
+            };
+            let [a, b, c] = mesh.corners(triangle as usize);
+            let (u, v) = (soup.point(0.5).x + 0.5, soup.point(0.5).y + 0.5);
+            let (u, v) = if u + v > 1.0 {
+                (1.0 - u, 1.0 - v)
+            } else {
+                (u, v)
+            };
+            // Some from an edge shared with a neighbour.
+            let (u, v) = if k % 5 == 0 { (u, 0.0) } else { (u, v) };
+            let origin = a + (b - a) * u + (c - a) * v;
+            let skip = Skip::Triangle(triangle);
+            let directions: Vec<Vec3> = (0..16).map(|j| soup.direction(k * 16 + j)).collect();
+            for (t, tree) in trees.iter().enumerate() {
+                tree.closest_hits(origin, &directions, (0.0, f32::INFINITY), skip, &mut fan);
+                if t == 0 {
+                    first_fan.clone_from(&fan);
+                }
+                assert_eq!(fan, first_fan, "fan {k}, tree {t}");
+                for (j, &d) in directions.iter().enumerate() {
+                    let alone = tree.closest_hit(origin, d, 0.0, f32::INFINITY, skip);
+                    assert_eq!(alone, first_fan[j], "ray {k}.{j}, tree {t}");
+                    let blocked = tree.occluded(origin, d, 0.0, f32::INFINITY, skip);
+                    assert_eq!(blocked, alone.is_some(), "ray {k}.{j}, tree {t}");
+                }
+            }
+            hits += first_fan.iter().flatten().count();
+        }
+        assert!(hits > 3000, "{hits} hits of 9600 rays");
     }
 
     #[test]

@@ -56,8 +56,8 @@ pub(super) struct RayPacket {
     origin: [f32; 3],
     direction: [f32x8; 3],
     inv: [f32x8; 3],
-    /// Nearest box entry (the single ray's rule, [`MIN_BOX_DISTANCE`]).
-    box_tmin: f32x8,
+    /// Nearest box entry and triangle hit (the single ray's rule, [`MIN_BOX_DISTANCE`]).
+    tmin: f32x8,
     /// Per axis, whether the direction is positive, when that is so of every lane or of none.
     octant: Option<[bool; 3]>,
     /// The lanes that hold a ray (a fan's last packet may be partial).
@@ -82,7 +82,7 @@ impl RayPacket {
             direction,
             inv,
             octant,
-            box_tmin: f32x8::splat(tmin.max(MIN_BOX_DISTANCE)),
+            tmin: f32x8::splat(tmin.max(MIN_BOX_DISTANCE)),
             lanes: (1 << directions.len()) - 1,
         }
     }
@@ -134,9 +134,7 @@ impl RayPacket {
             let (near_x, far_x) = slab(0);
             let (near_y, far_y) = slab(1);
             let (near_z, far_z) = slab(2);
-            let t_near = near_x
-                .fast_max(near_y)
-                .fast_max(near_z.fast_max(self.box_tmin));
+            let t_near = near_x.fast_max(near_y).fast_max(near_z.fast_max(self.tmin));
             let t_far = far_x.fast_min(far_y).fast_min(far_z.fast_min(tmax)) * ROUNDING_X8;
             let entered = t_near.simd_le(t_far) & lanes;
             entries.near[k] = t_near;
@@ -147,14 +145,10 @@ impl RayPacket {
     }
 
     /// Möller–Trumbore for the eight rays against one triangle (its first vertex and edges):
-    /// the distances, and the mask of the lanes hitting it within `[tmin, tmax]`.
+    /// the distances, and the mask of the lanes hitting it within `[tmin, tmax]` (`tmin`
+    /// floored as the boxes' is).
     #[inline(always)]
-    pub(super) fn intersect(
-        &self,
-        [v0, e1, e2]: [[f32; 3]; 3],
-        tmin: f32,
-        tmax: f32x8,
-    ) -> (f32x8, u32) {
+    pub(super) fn intersect(&self, [v0, e1, e2]: [[f32; 3]; 3], tmax: f32x8) -> (f32x8, u32) {
         // `moller_trumbore`'s operations in its order, the origin's terms once for all lanes.
         let s = [
             self.origin[0] - v0[0],
@@ -171,7 +165,7 @@ impl RayPacket {
         let hit = u.simd_ge(f32x8::ZERO)
             & v.simd_ge(f32x8::ZERO)
             & (u + v).simd_le(<f32x8 as Lanes>::ONE)
-            & t.simd_ge(f32x8::splat(tmin))
+            & t.simd_ge(self.tmin)
             & t.simd_le(tmax);
         (t, hit.to_bitmask())
     }

@@ -2,7 +2,7 @@
 //! every one of them.
 
 use super::Skip;
-use super::wide::moller_trumbore;
+use super::wide::{MIN_BOX_DISTANCE, moller_trumbore};
 use crate::mesh::TriangleMesh;
 use glam::Vec3;
 use rand_core::Rng;
@@ -54,7 +54,8 @@ impl Soup {
     }
 
     /// The closest hit `(t, triangle)` by testing every triangle, with the acceptance rule
-    /// written out; equidistant triangles go to the lowest index.
+    /// written out: nothing nearer than [`MIN_BOX_DISTANCE`], equidistant triangles to the
+    /// lowest index.
     pub(super) fn closest(
         &self,
         origin: Vec3,
@@ -78,7 +79,7 @@ impl Soup {
             (b - a).to_array(),
             (c - a).to_array(),
         );
-        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && d >= 0.0 && d <= tmax {
+        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && d >= MIN_BOX_DISTANCE && d <= tmax {
             d
         } else {
             f32::INFINITY

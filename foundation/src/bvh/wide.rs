@@ -55,6 +55,8 @@ pub(super) struct Bvh4 {
 /// packets of four).
 struct Builder<'a> {
     bvh2: &'a Bvh2,
+    /// Added to every box on every side ([`BOX_PADDING`]).
+    padding: f32,
     nodes: Vec<Node4>,
     slots: Vec<u32>,
 }
@@ -64,8 +66,13 @@ impl Bvh4 {
     /// opening its largest inner child (by surface area) until it has four. Returns the tree
     /// and, per triangle slot, the obvhs primitive it holds ([`NO_TRIANGLE`] for padding).
     pub(super) fn from_bvh2(bvh2: &Bvh2) -> (Self, Vec<u32>) {
+        let magnitude = bvh2.nodes.first().map_or(0.0, |root| {
+            let aabb = root.aabb();
+            aabb.min.abs().max(aabb.max.abs()).max_element()
+        });
         let mut builder = Builder {
             bvh2,
+            padding: magnitude * BOX_PADDING,
             nodes: Vec::new(),
             slots: Vec::new(),
         };
@@ -150,8 +157,8 @@ impl Builder<'_> {
             };
             let n = &mut self.nodes[index];
             for axis in 0..3 {
-                n.planes[axis][k] = aabb.min[axis];
-                n.planes[3 + axis][k] = aabb.max[axis];
+                n.planes[axis][k] = aabb.min[axis] - self.padding;
+                n.planes[3 + axis][k] = aabb.max[axis] + self.padding;
             }
             n.child[k] = reference.index;
             n.count[k] = reference.count;
@@ -260,9 +267,14 @@ impl Bvh4 {
 }
 
 /// Slack on the far distance so that rounding never loses a box the ray grazes (Ize 2013:
-/// `1 + 2γ₃`).
+/// `1 + 2γ₃`); a child waiting on the stack is kept or left by the same slack.
 pub(super) const ROUNDING: f32 =
     1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+
+/// Padding of every box, relative to the scene's largest coordinate (2⁻²⁰): the builder's
+/// split boxes of a long triangle (pre-splits) meet its edges at rounded points, so a box
+/// can leave the triangle's true edge by an ulp of the coordinates; padded, it holds it.
+const BOX_PADDING: f32 = 1.0 / (1u32 << 20) as f32;
 
 /// A ray prepared for box and packet tests: each component splatted across four lanes.
 #[derive(Debug, Clone, Copy)]
@@ -302,9 +314,6 @@ impl WideRay {
             inv: inv.map(Vec4::splat),
             near: [near(0), near(1), near(2)],
             far: [far(0), far(1), far(2)],
-            // obvhs's rule, kept: a box the ray has left within `MIN_BOX_DISTANCE` is not
-            // entered, so a ray leaving a seam of an unwelded mesh does not stop on the
-            // neighbour touching its origin (the bake's furnace tests rest on it).
             tmin: tmin.max(MIN_BOX_DISTANCE),
         }
     }
@@ -321,7 +330,12 @@ pub(super) fn safe_inverse(d: f32) -> f32 {
     }
 }
 
-/// Nearest distance at which a box counts as entered (obvhs's `EPSILON`).
+/// Nearest distance at which anything counts: a box is entered and a triangle hit only at
+/// `t >= MIN_BOX_DISTANCE` (obvhs's `EPSILON` for boxes). So a ray leaving a seam of an
+/// unwelded mesh does not stop on the neighbour touching its origin (the bake's furnace tests
+/// rest on it), and, the triangles held to the boxes' floor, what a ray hits is the same in
+/// every tree: a hit nearer than the floor no longer counts only where its leaf's box happens
+/// to reach past it.
 pub(super) const MIN_BOX_DISTANCE: f32 = 1e-4;
 
 /// Arithmetic on one value or on four side by side: what the triangle test is written over.
@@ -417,14 +431,15 @@ impl TrianglePacket {
         }))
     }
 
-    /// Distances to the four triangles, and the mask of those hit within `[tmin, tmax]`.
+    /// Distances to the four triangles, and the mask of those hit within `[tmin, tmax]` (the
+    /// ray's `tmin`, floored at [`MIN_BOX_DISTANCE`] as its boxes are).
     #[inline(always)]
-    pub(super) fn intersect(&self, ray: &WideRay, tmin: f32, tmax: f32) -> (Vec4, u32) {
+    pub(super) fn intersect(&self, ray: &WideRay, tmax: f32) -> (Vec4, u32) {
         let (u, v, t) = moller_trumbore(ray.origin, ray.direction, self.v0, self.e1, self.e2);
         let hit = u.cmpge(Vec4::ZERO)
             & v.cmpge(Vec4::ZERO)
             & (u + v).cmple(Vec4::ONE)
-            & t.cmpge(Vec4::splat(tmin))
+            & t.cmpge(Vec4::splat(ray.tmin))
             & t.cmple(Vec4::splat(tmax));
         (t, hit.bitmask())
     }
