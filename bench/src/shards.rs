@@ -186,7 +186,8 @@ pub fn shards_header(whole: &Run) -> String {
 
 /// What every row was checked for, and what its times hold.
 pub const SHARDS_NOTE: &str = "every merge equals the one-machine bake byte for byte; shard \
-    times include each process's scene load, BVH build and cost estimate";
+    times include each process's scene load, its BVH (built by the first process, read from \
+    the cache by the others) and the cost estimate";
 
 impl ShardRow {
     /// The row as the table shows it.

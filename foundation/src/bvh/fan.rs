@@ -21,7 +21,10 @@
 //! obvhs's slow preset as before 5.43 M rays/s; more reinsertion (`0.5`, `1×` after collapse)
 //! 5.17; the very slow preset's search with full reinsertion 4.99; four triangles a leaf
 //! 4.84; a collapse cost of 2 instead of 3 5.16. The slow preset stays. On the same rays
-//! Embree 4.4's single-ray closest hit traced 3.91 M rays/s.
+//! Embree 4.4's single-ray closest hit traced 3.91 M rays/s. Tracing a packet's lanes alone
+//! once two or three remain, rather than one, was no faster on the bundled dragon at 64
+//! samples, where packets part most (2.05–2.34 against 2.20–2.46 M rays/s, measured beside
+//! another job).
 //!
 //! Earlier attempts, answers unchanged each time (2026-12-03, Zen 1): an eight-wide tree for
 //! the fans, 5–10% slower than these packets, which test each child box for their eight
@@ -36,9 +39,15 @@
 //! a fan's lanes, sharing their origin, stay together. Tracing every fan twice in a row took
 //! 1.74 times as long as once: cache misses are not where most of the time goes.
 //!
-//! Not tried, and why: Embree's box test (one fused multiply-add a plane) needs FMA, which the
-//! portable build (x86-64 without FMA) would call through libm, so portable and native builds
-//! would trace differently fast and, where its rounding leaves the padding, differently.
+//! Not built, and why. Embree's box test (one fused multiply-add a plane, the origin's term
+//! folded in): a fan's packets already pay one multiply a plane and lane, the origin's offset
+//! to a node's planes taken once for its eight rays, and the single-ray test would need FMA,
+//! which the portable build (x86-64 without it) calls through libm. Compressed nodes
+//! (quantised child boxes): they save memory traffic, and a fan traced twice in a row from a
+//! warm cache costs three quarters of the first pass, so traffic is not where the time goes,
+//! while dequantising adds work per box. An eight-wide single-ray path for the lanes a packet
+//! leaves alone: it needs a second, eight-wide tree beside the four-wide one the packets
+//! trace (eight-wide costs the packets 5–10%, above), and memory is not to grow.
 
 use super::packet::{LANES, RayPacket};
 use super::stack::{Stack, insert_farthest_first};

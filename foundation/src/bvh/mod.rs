@@ -39,10 +39,11 @@ pub struct Hit {
 }
 
 impl Hit {
-    /// Weights of the three vertices.
+    /// Weights of the three vertices, each at least 0: on the edge opposite the first vertex
+    /// `1 - b1 - b2` can round to just below 0 (`-2⁻²⁴`), which no point of the triangle has.
     #[inline]
     pub fn barycentrics(&self) -> [f32; 3] {
-        [1.0 - self.b1 - self.b2, self.b1, self.b2]
+        [(1.0 - self.b1 - self.b2).max(0.0), self.b1, self.b2]
     }
 }
 
@@ -474,6 +475,29 @@ mod tests {
             hits += first_fan.iter().flatten().count();
         }
         assert!(hits > 3000, "{hits} hits of 9600 rays");
+    }
+
+    /// Rays aimed at the edges of the soup's triangles, where one weight is 0 up to rounding:
+    /// no weight is negative (a shard holding one is refused as damaged).
+    #[test]
+    fn hits_on_edges_have_no_negative_weight() {
+        let mut soup = Soup::new(9);
+        let bvh = SceneBvh::build(&soup.mesh);
+        let mut on_edge = 0;
+        for k in 0..20000u32 {
+            let t = (k * 7919) as usize % soup.mesh.triangle_count();
+            let [a, b, c] = soup.mesh.corners(t);
+            let s = soup.point(0.5).x + 0.5;
+            let target = [b + (c - b) * s, a + (b - a) * s, a + (c - a) * s][k as usize % 3];
+            let origin = target + soup.point(1.0);
+            let Some(hit) = bvh.intersect(origin, (target - origin).normalize(), 0.0, 1e9) else {
+                continue;
+            };
+            let weights = hit.barycentrics();
+            assert!(weights.iter().all(|w| *w >= 0.0), "ray {k}: {weights:?}");
+            on_edge += usize::from(weights.contains(&0.0));
+        }
+        assert!(on_edge > 100, "{on_edge} hits on an edge");
     }
 
     #[test]

@@ -14,7 +14,8 @@ use crate::mesh::{
 use crate::probe::ProbeSource;
 use crate::texture::AlbedoTexture;
 use glam::{Mat3, Mat4, Vec3};
-use std::path::Path;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 impl Scene {
@@ -54,8 +55,9 @@ impl Scene {
             return Err(invalid("the scene has no [[object]]".into()));
         }
         let mut geometry = SceneMesh::default();
+        let mut models = ModelFiles::default();
         for (index, object) in file.objects.iter().enumerate() {
-            add_object(&mut geometry, path, dir, index, object)?;
+            add_object(&mut geometry, (path, dir), index, object, &mut models)?;
         }
         if let Some(env) = &file.environment
             && !env.rotation_deg.is_finite()
@@ -187,10 +189,10 @@ fn check_probes(geometry: &SceneMesh, probes: &[ProbeSource]) -> Result<(), Stri
 /// transform, and adds its parts to `geometry`.
 fn add_object(
     geometry: &mut SceneMesh,
-    path: &Path,
-    dir: &Path,
+    (path, dir): (&Path, &Path),
     index: usize,
     object: &ObjectSpec,
+    models: &mut ModelFiles,
 ) -> Result<(), SceneError> {
     let invalid = |message: String| SceneError::Invalid {
         path: path.to_owned(),
@@ -208,7 +210,7 @@ fn add_object(
         )));
     }
     let material = object_material(object).map_err(|m| invalid(format!("{name}: {m}")))?;
-    let parts = load_object_parts(dir, object).map_err(|e| match e {
+    let parts = load_object_parts(dir, object, models).map_err(|e| match e {
         ObjectError::Mesh(cause) => SceneError::Mesh {
             scene: path.to_owned(),
             object: name.clone(),
@@ -328,6 +330,7 @@ pub(super) enum SpecError {
 }
 
 /// One part of an object: a glTF primitive, or the whole of any other object.
+#[derive(Clone)]
 struct ObjectPart {
     name: String,
     mesh: TriangleMesh,
@@ -336,7 +339,19 @@ struct ObjectPart {
     texture: Option<Arc<AlbedoTexture>>,
 }
 
-fn load_object_parts(dir: &Path, object: &ObjectSpec) -> Result<Vec<ObjectPart>, ObjectError> {
+/// The model files a scene has read, by file and the options it was read with: a scene of many
+/// copies of one model (a benchmark's 45 dragons, each shard of its bake) reads and cleans it
+/// once.
+#[derive(Default)]
+struct ModelFiles(HashMap<ModelKey, Vec<ObjectPart>>);
+
+type ModelKey = (PathBuf, Option<u32>, Vec<usize>, Option<bool>);
+
+fn load_object_parts(
+    dir: &Path,
+    object: &ObjectSpec,
+    models: &mut ModelFiles,
+) -> Result<Vec<ObjectPart>, ObjectError> {
     let whole = |mesh| {
         vec![ObjectPart {
             name: String::new(),
@@ -352,29 +367,48 @@ fn load_object_parts(dir: &Path, object: &ObjectSpec) -> Result<Vec<ObjectPart>,
                 skip_patches: object.skip_patches.clone(),
             };
             let path = dir.join(file);
-            let cleanup = MeshCleanup {
-                weld: object.weld,
-                ..Default::default()
-            };
-            mesh::read_model(&path, &options)
-                .map_err(ObjectError::Mesh)?
-                .into_iter()
-                .map(|part| {
-                    let (mesh, _report) =
-                        cleanup.run(&path, part.mesh).map_err(ObjectError::Mesh)?;
-                    Ok(ObjectPart {
-                        albedo: part.material.as_ref().map(|m| material_albedo(&path, m)),
-                        texture: part.material.and_then(|m| m.texture),
-                        name: part.name,
-                        mesh,
-                    })
-                })
-                .collect()
+            let key = (
+                path,
+                options.patch_segments,
+                options.skip_patches.clone(),
+                object.weld,
+            );
+            if let Some(parts) = models.0.get(&key) {
+                return Ok(parts.clone());
+            }
+            let parts = read_model_parts(&key.0, &options, object.weld)?;
+            models.0.insert(key, parts.clone());
+            Ok(parts)
         }
         (None, Some(b), None) => box_object(b).map(whole),
         (None, None, Some(a)) => annulus_object(a).map(whole),
         _ => Err(SpecError::Shape.into()),
     }
+}
+
+/// A model file's parts, read and cleaned.
+fn read_model_parts(
+    path: &Path,
+    options: &LoadOptions,
+    weld: Option<bool>,
+) -> Result<Vec<ObjectPart>, ObjectError> {
+    let cleanup = MeshCleanup {
+        weld,
+        ..Default::default()
+    };
+    mesh::read_model(path, options)
+        .map_err(ObjectError::Mesh)?
+        .into_iter()
+        .map(|part| {
+            let (mesh, _report) = cleanup.run(path, part.mesh).map_err(ObjectError::Mesh)?;
+            Ok(ObjectPart {
+                albedo: part.material.as_ref().map(|m| material_albedo(path, m)),
+                texture: part.material.and_then(|m| m.texture),
+                name: part.name,
+                mesh,
+            })
+        })
+        .collect()
 }
 
 /// Largest albedo a model's material may give: albedos must stay below 1 (a white furnace

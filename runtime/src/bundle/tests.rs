@@ -227,7 +227,7 @@ fn with_header(edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
     let mut header: serde_json::Value = serde_json::from_slice(&inner[16..16 + len]).unwrap();
     edit(&mut header);
     let mut json = serde_json::to_vec(&header).unwrap();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let body_start = 16 + len.div_ceil(4) * 4;
@@ -240,11 +240,14 @@ fn with_header(edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
     gzip(&out)
 }
 
+/// A change to a bundle's JSON header.
+type HeaderEdit = dyn Fn(&mut serde_json::Value);
+
 #[test]
 fn hostile_headers_are_refused_before_use() {
     // The unedited header passes, so the refusals below are the edits'.
     assert!(SceneBundle::from_bytes("scene.bin", &with_header(|_| ())).is_ok());
-    let cases: [(&str, Box<dyn Fn(&mut serde_json::Value)>); 6] = [
+    let cases: [(&str, Box<HeaderEdit>); 6] = [
         ("SH order", Box::new(|h| h["bake"]["order"] = 40.into())),
         (
             "no environment map",
