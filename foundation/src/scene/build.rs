@@ -3,20 +3,16 @@
 
 use super::description::*;
 use super::geometry::SceneMesh;
+use super::model_files::{ModelFiles, ObjectPart, read_model_parts};
 use super::{Scene, SceneError};
 use crate::color::Rgb;
 use crate::infra::limits::{MAX_SCENE_TRIANGLES, ReadError, read_text_file};
 use crate::infra::names::check_file_name;
 use crate::material::{MAX_SHININESS, Material, check_energy};
-use crate::mesh::{
-    self, LoadOptions, MeshCleanup, MeshError, TriangleMesh, annulus_mesh, box_mesh,
-};
+use crate::mesh::{LoadOptions, MeshError, TriangleMesh, annulus_mesh, box_mesh};
 use crate::probe::ProbeSource;
-use crate::texture::AlbedoTexture;
 use glam::{Mat3, Mat4, Vec3};
-use std::collections::HashMap;
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::path::Path;
 
 impl Scene {
     /// Loads a scene file and every mesh it names.
@@ -329,24 +325,6 @@ pub(super) enum SpecError {
     AnnulusSegments([u32; 2]),
 }
 
-/// One part of an object: a glTF primitive, or the whole of any other object.
-#[derive(Clone)]
-struct ObjectPart {
-    name: String,
-    mesh: TriangleMesh,
-    /// The albedo the model file gives (glTF materials); the texture's factor if textured.
-    albedo: Option<Rgb>,
-    texture: Option<Arc<AlbedoTexture>>,
-}
-
-/// The model files a scene has read, by file and the options it was read with: a scene of many
-/// copies of one model (a benchmark's 45 dragons, each shard of its bake) reads and cleans it
-/// once.
-#[derive(Default)]
-struct ModelFiles(HashMap<ModelKey, Vec<ObjectPart>>);
-
-type ModelKey = (PathBuf, Option<u32>, Vec<usize>, Option<bool>);
-
 fn load_object_parts(
     dir: &Path,
     object: &ObjectSpec,
@@ -373,65 +351,18 @@ fn load_object_parts(
                 options.skip_patches.clone(),
                 object.weld,
             );
-            if let Some(parts) = models.0.get(&key) {
-                return Ok(parts.clone());
+            if let Some(parts) = models.get(&key) {
+                return Ok(parts);
             }
-            let parts = read_model_parts(&key.0, &options, object.weld)?;
-            models.0.insert(key, parts.clone());
+            let parts =
+                read_model_parts(&key.0, &options, object.weld).map_err(ObjectError::Mesh)?;
+            models.insert(key, parts.clone());
             Ok(parts)
         }
         (None, Some(b), None) => box_object(b).map(whole),
         (None, None, Some(a)) => annulus_object(a).map(whole),
         _ => Err(SpecError::Shape.into()),
     }
-}
-
-/// A model file's parts, read and cleaned.
-fn read_model_parts(
-    path: &Path,
-    options: &LoadOptions,
-    weld: Option<bool>,
-) -> Result<Vec<ObjectPart>, ObjectError> {
-    let cleanup = MeshCleanup {
-        weld,
-        ..Default::default()
-    };
-    mesh::read_model(path, options)
-        .map_err(ObjectError::Mesh)?
-        .into_iter()
-        .map(|part| {
-            let (mesh, _report) = cleanup.run(path, part.mesh).map_err(ObjectError::Mesh)?;
-            Ok(ObjectPart {
-                albedo: part.material.as_ref().map(|m| material_albedo(path, m)),
-                texture: part.material.and_then(|m| m.texture),
-                name: part.name,
-                mesh,
-            })
-        })
-        .collect()
-}
-
-/// Largest albedo a model's material may give: albedos must stay below 1 (a white furnace
-/// would never converge); a glTF base colour of 1 (its default) becomes this.
-pub const MAX_MATERIAL_ALBEDO: f32 = 0.99;
-
-/// The albedo of a glTF material: its base colour factor (which multiplies its texture, if it
-/// has one), kept below 1.
-fn material_albedo(path: &Path, material: &mesh::PartMaterial) -> Rgb {
-    let albedo = material.base_color;
-    // A texture's factor is usually 1 (glTF's default): the texels are the albedo.
-    if material.texture.is_some() {
-        return albedo.clamp(Rgb::ZERO, Rgb::ONE);
-    }
-    if albedo.max_element() > MAX_MATERIAL_ALBEDO {
-        log::warn!(
-            "{}: {}: base colour {:.3?} clamped to {MAX_MATERIAL_ALBEDO} (albedos stay below 1)",
-            path.display(),
-            material.name,
-            albedo.to_array()
-        );
-    }
-    albedo.clamp(Rgb::ZERO, Rgb::splat(MAX_MATERIAL_ALBEDO))
 }
 
 fn box_object(b: &BoxSpec) -> Result<TriangleMesh, ObjectError> {

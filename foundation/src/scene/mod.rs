@@ -6,16 +6,17 @@ mod build;
 mod description;
 mod geometry;
 pub mod model;
+mod model_files;
 mod path;
 mod rotation;
 
 pub use backplate::{BackplateError, load_backplate_image};
-pub use build::MAX_MATERIAL_ALBEDO;
 pub use description::{
     AnnulusSpec, Backplate, BackplateSpec, BoxSpec, EnvironmentSpec, ObjectRole, ObjectSpec,
     ProbeSpec, Scale, SceneFile, Transform,
 };
 pub use geometry::{NO_TEXTURE, SceneMesh, SceneObject};
+pub use model_files::MAX_MATERIAL_ALBEDO;
 pub use path::{Crossing, ModelPath, PathSpec, Pose, mesh_crosses};
 pub use rotation::rotation_from_deg;
 
