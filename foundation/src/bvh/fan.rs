@@ -89,7 +89,7 @@ impl SceneBvh {
         hits.clear();
         for chunk in directions.chunks(LANES) {
             let packet = RayPacket::new(origin, chunk, tmin);
-            let closest = self.packet_closest(&packet, tmin, tmax, skip);
+            let closest = self.packet_closest(&packet, tmax, skip);
             let distances = closest.tmax.to_array();
             for (lane, direction) in chunk.iter().enumerate() {
                 let ray = SegmentRay {
@@ -120,7 +120,7 @@ impl SceneBvh {
         }
     }
 
-    fn packet_closest(&self, packet: &RayPacket, tmin: f32, tmax: f32, skip: Skip) -> Closest {
+    fn packet_closest(&self, packet: &RayPacket, tmax: f32, skip: Skip) -> Closest {
         let mut closest = Closest {
             tmax: f32x8::splat(tmax),
             slot: [None; LANES],
@@ -132,7 +132,7 @@ impl SceneBvh {
         let mut stack = Stack::<Pending>::new();
         loop {
             if lanes.count_ones() <= ALONE {
-                self.lanes_alone(current, lanes, packet, (tmin, skip), &mut closest);
+                self.lanes_alone(current, lanes, packet, skip, &mut closest);
             } else if current.is_inner() {
                 if let Some(next) = self.descend(current, lanes, packet, closest.tmax, &mut stack) {
                     (current, lanes) = next;
@@ -202,14 +202,14 @@ impl SceneBvh {
         start: ChildRef,
         mut lanes: u32,
         packet: &RayPacket,
-        (tmin, skip): (f32, Skip),
+        skip: Skip,
         closest: &mut Closest,
     ) {
         let mut tmax = closest.tmax.to_array();
         while lanes != 0 {
             let lane = lanes.trailing_zeros() as usize;
             lanes &= lanes - 1;
-            let ray = packet.lane(lane, tmin);
+            let ray = packet.lane(lane);
             let slot = &mut closest.slot[lane];
             self.closest_below(start, (&ray, skip), &mut tmax[lane], slot, &mut NoTally);
         }

@@ -88,8 +88,9 @@ impl RayPacket {
     }
 
     /// Lane `lane`'s ray alone.
-    pub(super) fn lane(&self, lane: usize, tmin: f32) -> WideRay {
+    pub(super) fn lane(&self, lane: usize) -> WideRay {
         let get = |v: &[f32x8; 3]| v.map(|a| a.as_array()[lane]);
+        let tmin = self.tmin.as_array()[0];
         WideRay::with_inverse(self.origin, get(&self.direction), get(&self.inv), tmin)
     }
 

@@ -3,7 +3,7 @@
 
 use super::description::*;
 use super::geometry::SceneMesh;
-use super::model_files::{ModelFiles, ObjectPart, read_model_parts};
+use super::model_files::{ModelFiles, ObjectPart};
 use super::{Scene, SceneError};
 use crate::color::Rgb;
 use crate::infra::limits::{MAX_SCENE_TRIANGLES, ReadError, read_text_file};
@@ -345,19 +345,9 @@ fn load_object_parts(
                 skip_patches: object.skip_patches.clone(),
             };
             let path = dir.join(file);
-            let key = (
-                path,
-                options.patch_segments,
-                options.skip_patches.clone(),
-                object.weld,
-            );
-            if let Some(parts) = models.get(&key) {
-                return Ok(parts);
-            }
-            let parts =
-                read_model_parts(&key.0, &options, object.weld).map_err(ObjectError::Mesh)?;
-            models.insert(key, parts.clone());
-            Ok(parts)
+            models
+                .parts(path, &options, object.weld)
+                .map_err(ObjectError::Mesh)
         }
         (None, Some(b), None) => box_object(b).map(whole),
         (None, None, Some(a)) => annulus_object(a).map(whole),

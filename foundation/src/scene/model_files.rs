@@ -24,20 +24,33 @@ pub(super) struct ObjectPart {
 #[derive(Default)]
 pub(super) struct ModelFiles(HashMap<ModelKey, Vec<ObjectPart>>);
 
-pub(super) type ModelKey = (PathBuf, Option<u32>, Vec<usize>, Option<bool>);
+type ModelKey = (PathBuf, Option<u32>, Vec<usize>, Option<bool>);
 
 impl ModelFiles {
-    pub(super) fn get(&self, key: &ModelKey) -> Option<Vec<ObjectPart>> {
-        self.0.get(key).cloned()
-    }
-
-    pub(super) fn insert(&mut self, key: ModelKey, parts: Vec<ObjectPart>) {
-        self.0.insert(key, parts);
+    /// The parts of the model at `path` read with `options` and `weld`: read and cleaned the
+    /// first time they are asked for, a copy of those after.
+    pub(super) fn parts(
+        &mut self,
+        path: PathBuf,
+        options: &LoadOptions,
+        weld: Option<bool>,
+    ) -> Result<Vec<ObjectPart>, MeshError> {
+        let key = (
+            path,
+            options.patch_segments,
+            options.skip_patches.clone(),
+            weld,
+        );
+        if let Some(parts) = self.0.get(&key) {
+            return Ok(parts.clone());
+        }
+        let parts = read_model_parts(&key.0, options, weld)?;
+        Ok(self.0.entry(key).or_insert(parts).clone())
     }
 }
 
 /// A model file's parts, read and cleaned.
-pub(super) fn read_model_parts(
+fn read_model_parts(
     path: &Path,
     options: &LoadOptions,
     weld: Option<bool>,
