@@ -24,7 +24,7 @@ pub enum CacheError {
 /// Bakes in the cache. Version 2: keys from the one key function (`foundation::infra::cache`).
 const BAKES: EntryKind = EntryKind {
     folder: "bakes",
-    tag: "hprt bake v3 (hits held to the near floor, no negative weight)",
+    tag: "hprt bake v4 (near floor on backs only, no negative weight)",
 };
 
 /// The key of the bake of `scene` with `settings`: the scene's geometry (mesh and materials,

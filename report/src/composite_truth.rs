@@ -87,7 +87,7 @@ fn render(
 /// (`foundation::infra::cache`).
 const COMPOSITES: EntryKind = EntryKind {
     folder: "composites",
-    tag: "hprt composite truth v3 (hits held to the near floor, no negative weight)",
+    tag: "hprt composite truth v4 (near floor on backs only, no negative weight)",
 };
 
 /// The cache key: everything the renders depend on (the backplate is applied after).

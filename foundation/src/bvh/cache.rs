@@ -9,8 +9,8 @@
 //! ([`PACKET_FLOATS`] floats each), each slot's triangle, and each slot's three corners. A file
 //! that fails its checksum, or whose indices leave its arrays, is built again.
 
-use super::SceneBvh;
 use super::wide::{Bvh4, ChildRef, NO_TRIANGLE, NODE_WORDS, Node4, TrianglePacket};
+use super::{FLIPPED, SceneBvh, packed_corners};
 use crate::infra::atomic_file::AtomicOutput;
 use crate::infra::cache::{CacheFolderError, CacheKey, Entry, EntryKind};
 use crate::infra::container::{self, ContainerError, Format, Reader};
@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 const BVHS: EntryKind = EntryKind {
     folder: "bvhs",
-    tag: "hprt bvh v2 (obvhs 0.4 slow build, four-wide, padded boxes)",
+    tag: "hprt bvh v3 (obvhs 0.4 slow build, four-wide, padded boxes, fronts counter-clockwise)",
 };
 
 const FORMAT: Format = Format {
@@ -63,7 +63,8 @@ struct Header {
     root: Option<[u32; 2]>,
 }
 
-/// The key of `mesh`'s BVH: its positions and triangles (nothing else shapes the tree).
+/// The key of `mesh`'s BVH: its positions, triangles and which side of each is its front
+/// (nothing else shapes the tree or its packets).
 pub fn bvh_key(mesh: &TriangleMesh) -> CacheKey {
     CacheKey::new(BVHS, |k| {
         let positions: Vec<u8> = (mesh.positions.iter())
@@ -73,7 +74,10 @@ pub fn bvh_key(mesh: &TriangleMesh) -> CacheKey {
         let triangles: Vec<u8> = (mesh.triangles.iter().flatten())
             .flat_map(|i| i.to_le_bytes())
             .collect();
-        k.bytes(&positions).bytes(&triangles);
+        let fronts: Vec<u8> = (0..mesh.triangle_count())
+            .map(|t| u8::from(packed_corners(mesh, t).1))
+            .collect();
+        k.bytes(&positions).bytes(&triangles).bytes(&fronts);
     })
 }
 
@@ -168,7 +172,7 @@ fn read(path: &Path, mesh: &TriangleMesh) -> Result<SceneBvh, BvhFileError> {
         .map(|c| [c[0], c[1], c[2]])
         .collect();
     let root = header.root.map(|[index, count]| ChildRef { index, count });
-    let in_range = |i: u32, n: usize| i == NO_TRIANGLE || (i as usize) < n;
+    let in_range = |i: u32, n: usize| i == NO_TRIANGLE || ((i & !FLIPPED) as usize) < n;
     if !tree_in_range(&nodes, root, ids.len())
         || !ids.iter().all(|&i| in_range(i, triangles))
         || !corners.iter().flatten().all(|&i| in_range(i, vertices))

@@ -52,10 +52,30 @@ pub struct SceneBvh {
     tree: Bvh4,
     /// The leaves' triangles, four to a packet, slot `4k + lane` in packet `k`.
     packets: HugePageTable<TrianglePacket>,
-    /// Scene triangle index of each leaf slot ([`NO_TRIANGLE`] for padding).
+    /// Scene triangle index of each leaf slot ([`NO_TRIANGLE`] for padding), with
+    /// [`FLIPPED`] set where the packet holds the triangle's corners as `[a, c, b]`.
     ids: HugePageTable<u32>,
     /// Vertex indices of each leaf slot's triangle (the bake skips a vertex's own triangles).
     corners: HugePageTable<[u32; 3]>,
+}
+
+/// Set in a slot's id when its packet holds the triangle's corners as `[a, c, b]`: packed, every
+/// triangle winds counter-clockwise seen from its front (the side its vertex normals face,
+/// [`TriangleMesh::front_normal`]), so the sign of a hit's determinant says which side it meets.
+const FLIPPED: u32 = 1 << 31;
+
+/// Triangle `t`'s corners as packed (front counter-clockwise), and whether they were swapped.
+pub(super) fn packed_corners(mesh: &TriangleMesh, t: usize) -> ([Vec3; 3], bool) {
+    let [a, b, c] = mesh.corners(t);
+    let shading: Vec3 = mesh.triangles[t]
+        .iter()
+        .map(|&i| mesh.normals[i as usize])
+        .sum();
+    if (b - a).cross(c - a).dot(shading) < 0.0 {
+        ([a, c, b], true)
+    } else {
+        ([a, b, c], false)
+    }
 }
 
 /// A ray: where it starts, where it goes, and how far it is searched (`tmax` shrinks to the
@@ -75,16 +95,17 @@ impl SceneBvh {
     /// The tree `params` build. Which tree it is changes the work a ray costs, never what it
     /// hits (the tests build others to show it).
     fn build_with(mesh: &TriangleMesh, params: obvhs::BvhBuildParams) -> Self {
-        let tris: Vec<Triangle> = (0..mesh.triangle_count())
+        let (tris, flipped): (Vec<Triangle>, Vec<bool>) = (0..mesh.triangle_count())
             .map(|t| {
-                let [a, b, c] = mesh.corners(t);
-                Triangle {
+                let ([a, b, c], flipped) = packed_corners(mesh, t);
+                let triangle = Triangle {
                     v0: a.into(),
                     v1: b.into(),
                     v2: c.into(),
-                }
+                };
+                (triangle, flipped)
             })
-            .collect();
+            .unzip();
         let bvh2 = build_bvh2_from_tris(&tris, params, &mut std::time::Duration::default());
         let (tree, ids) = Bvh4::from_bvh2(&bvh2);
         let packets = TrianglePacket::pack(&ids, |i| {
@@ -97,10 +118,14 @@ impl SceneBvh {
                 .copied()
                 .unwrap_or([NO_TRIANGLE; 3])
         }));
+        let flag = |i: u32| match flipped.get(i as usize) {
+            Some(true) => i | FLIPPED,
+            _ => i,
+        };
         Self {
             tree,
             packets,
-            ids: HugePageTable::new(ids.into_iter()),
+            ids: HugePageTable::new(ids.into_iter().map(flag)),
             corners,
         }
     }
@@ -222,7 +247,7 @@ impl SceneBvh {
     #[inline(always)]
     fn keep_closer(&self, t: f32, slot: usize, tmax: &mut f32, closest: &mut Option<usize>) {
         let nearer =
-            t < *tmax || (t == *tmax && closest.is_some_and(|c| self.ids[slot] < self.ids[c]));
+            t < *tmax || (t == *tmax && closest.is_some_and(|c| self.id(slot) < self.id(c)));
         if nearer {
             *tmax = t;
             *closest = Some(slot);
@@ -274,10 +299,15 @@ impl SceneBvh {
 
     fn finish(&self, ray: &SegmentRay, slot: usize) -> Hit {
         let [v0, e1, e2] = self.packets[slot / 4].lane(slot % 4);
-        let (b1, b2, _) =
+        let (u, v, _, _) =
             moller_trumbore(ray.origin.to_array(), ray.direction.to_array(), v0, e1, e2);
+        let (b1, b2) = if self.ids[slot] & FLIPPED != 0 {
+            (v, u)
+        } else {
+            (u, v)
+        };
         Hit {
-            triangle: self.ids[slot],
+            triangle: self.id(slot),
             t: ray.tmax,
             b1,
             b2,
@@ -311,12 +341,18 @@ impl SceneBvh {
         self.closest_hit(origin, direction, tmin, tmax, Skip::Nothing)
     }
 
+    /// The scene index of the triangle in `slot`.
+    #[inline(always)]
+    fn id(&self, slot: usize) -> u32 {
+        self.ids[slot] & !FLIPPED
+    }
+
     /// Whether a ray leaving with `skip` ignores the triangle in `slot`.
     #[inline(always)]
     fn skipped(&self, slot: usize, skip: Skip) -> bool {
         match skip {
             Skip::Nothing => false,
-            Skip::Triangle(t) => self.ids[slot] == t,
+            Skip::Triangle(t) => self.id(slot) == t,
             Skip::VertexTriangles(v) => self.corners[slot].contains(&v),
         }
     }

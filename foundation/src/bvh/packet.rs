@@ -4,7 +4,7 @@
 //! share is computed once: the origin's offsets to the box planes, and the triangle terms that
 //! depend on the origin alone.
 
-use super::wide::{Lanes, MIN_BOX_DISTANCE, ROUNDING, WideRay, cross, dot};
+use super::wide::{Floors, Lanes, ROUNDING, WideRay, cross, dot};
 use glam::{Vec3, Vec4};
 use wide::{f32x8, i32x8};
 
@@ -56,8 +56,11 @@ pub(super) struct RayPacket {
     origin: [f32; 3],
     direction: [f32x8; 3],
     inv: [f32x8; 3],
-    /// Nearest box entry and triangle hit (the single ray's rule, [`MIN_BOX_DISTANCE`]).
+    /// Nearest box entry (the single ray's rule, [`Floors`]).
     tmin: f32x8,
+    /// Nearest hit on a triangle's front, on its back.
+    front: f32x8,
+    back: f32x8,
     /// Per axis, whether the direction is positive, when that is so of every lane or of none.
     octant: Option<[bool; 3]>,
     /// The lanes that hold a ray (a fan's last packet may be partial).
@@ -82,7 +85,9 @@ impl RayPacket {
             direction,
             inv,
             octant,
-            tmin: f32x8::splat(tmin.max(MIN_BOX_DISTANCE)),
+            tmin: f32x8::splat(Floors::new(tmin).boxes()),
+            front: f32x8::splat(Floors::new(tmin).front),
+            back: f32x8::splat(Floors::new(tmin).back),
             lanes: (1 << directions.len()) - 1,
         }
     }
@@ -146,8 +151,8 @@ impl RayPacket {
     }
 
     /// Möller–Trumbore for the eight rays against one triangle (its first vertex and edges):
-    /// the distances, and the mask of the lanes hitting it within `[tmin, tmax]` (`tmin`
-    /// floored as the boxes' is).
+    /// the distances (a front hit behind the origin at 0), and the mask of the lanes hitting
+    /// it within the floors ([`Floors`]) and `tmax`.
     #[inline(always)]
     pub(super) fn intersect(&self, [v0, e1, e2]: [[f32; 3]; 3], tmax: f32x8) -> (f32x8, u32) {
         // `moller_trumbore`'s operations in its order, the origin's terms once for all lanes.
@@ -163,12 +168,16 @@ impl RayPacket {
         let u = dot(splat(s), p) * inv_det;
         let v = dot(self.direction, splat(q)) * inv_det;
         let t = f32x8::splat(dot(e2, q)) * inv_det;
+        let floor = inv_det
+            .simd_gt(f32x8::ZERO)
+            .bitselect(self.front, self.back);
+        let distance = t.fast_max(f32x8::ZERO);
         let hit = u.simd_ge(f32x8::ZERO)
             & v.simd_ge(f32x8::ZERO)
             & (u + v).simd_le(<f32x8 as Lanes>::ONE)
-            & t.simd_ge(self.tmin)
-            & t.simd_le(tmax);
-        (t, hit.to_bitmask())
+            & t.simd_ge(floor)
+            & distance.simd_le(tmax);
+        (distance, hit.to_bitmask())
     }
 }
 

@@ -2,6 +2,7 @@
 //! every one of them.
 
 use super::Skip;
+use super::packed_corners;
 use super::wide::{MIN_BOX_DISTANCE, moller_trumbore};
 use crate::mesh::TriangleMesh;
 use glam::Vec3;
@@ -54,8 +55,8 @@ impl Soup {
     }
 
     /// The closest hit `(t, triangle)` by testing every triangle, with the acceptance rule
-    /// written out: nothing nearer than [`MIN_BOX_DISTANCE`], equidistant triangles to the
-    /// lowest index.
+    /// written out: a back no nearer than [`MIN_BOX_DISTANCE`], a front from that far behind
+    /// the origin (at 0), equidistant triangles to the lowest index.
     pub(super) fn closest(
         &self,
         origin: Vec3,
@@ -71,16 +72,23 @@ impl Soup {
     }
 
     fn distance(&self, t: usize, origin: Vec3, direction: Vec3, tmax: f32) -> f32 {
-        let [a, b, c] = self.mesh.corners(t);
-        let (u, v, d) = moller_trumbore(
+        let ([a, b, c], _) = packed_corners(&self.mesh, t);
+        let (u, v, d, inv_det) = moller_trumbore(
             origin.to_array(),
             direction.to_array(),
             a.to_array(),
             (b - a).to_array(),
             (c - a).to_array(),
         );
-        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && d >= MIN_BOX_DISTANCE && d <= tmax {
-            d
+        let floor = if inv_det > 0.0 {
+            -MIN_BOX_DISTANCE
+        } else {
+            MIN_BOX_DISTANCE
+        };
+        // A front hit behind the origin counts at +0 (as `maxps` gives it).
+        let distance = if d > 0.0 { d } else { 0.0 };
+        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && d >= floor && distance <= tmax {
+            distance
         } else {
             f32::INFINITY
         }

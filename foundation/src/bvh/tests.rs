@@ -64,18 +64,29 @@ fn traversals_agree_with_testing_every_triangle() {
 
 /// What a ray hits is the scene's, not the tree's: four trees of obvhs's presets (one
 /// triangle a leaf and no splits, up to eight with pre-split triangles, more or less
-/// reinsertion) give the same hits bit for bit, single rays and fans, on a soup and on an
-/// unwelded box whose rays leave from its surface, where a neighbour touches the origin
-/// (hits nearer than the floor) and edges are shared (hits an ulp apart).
+/// reinsertion) give the same hits bit for bit, single rays and fans, on a soup and on two
+/// unwelded boxes, one resting on the other, whose rays leave from their surface, where a
+/// neighbour touches the origin (hits nearer than the floor, in front and behind) and edges
+/// are shared (hits an ulp apart).
 #[test]
 fn every_tree_gives_the_same_hits() {
     use obvhs::BvhBuildParams as P;
     let mut soup = Soup::new(5);
     let mut mesh = box_mesh(Vec3::splat(-1.0), Vec3::ONE, [6, 5, 4], [false; 6]);
-    let offset = mesh.positions.len() as u32;
-    mesh.positions.extend(&soup.mesh.positions);
-    mesh.normals.extend(&soup.mesh.normals);
-    (mesh.triangles).extend(soup.mesh.triangles.iter().map(|t| t.map(|i| i + offset)));
+    // A second box resting on the first, its base on the first's top (coincident faces).
+    let resting = box_mesh(
+        Vec3::new(-0.6, 1.0, -0.5),
+        Vec3::new(0.4, 1.7, 0.5),
+        [3; 3],
+        [false; 6],
+    );
+    for part in [&resting, &soup.mesh] {
+        let offset = mesh.positions.len() as u32;
+        mesh.positions.extend(&part.positions);
+        mesh.normals.extend(&part.normals);
+        (mesh.triangles).extend(part.triangles.iter().map(|t| t.map(|i| i + offset)));
+    }
+    let skin = 240 + resting.triangle_count() as u32;
     let presets = [
         P::fastest_build(),
         P::medium_build(),
@@ -86,9 +97,10 @@ fn every_tree_gives_the_same_hits() {
     let mut hits = 0;
     let (mut fan, mut first_fan) = (Vec::new(), Vec::new());
     for k in 0..600u32 {
-        // From a point of a triangle of the box (its skin, where seams are) or the soup.
+        // From a point of a triangle of the boxes (their skin, where seams are and one rests
+        // on the other) or the soup.
         let triangle = if k % 2 == 0 {
-            k % 240
+            k % skin
         } else {
             k * 7 % mesh.triangle_count() as u32
         };
@@ -120,6 +132,73 @@ fn every_tree_gives_the_same_hits() {
         hits += first_fan.iter().flatten().count();
     }
     assert!(hits > 3000, "{hits} hits of 9600 rays");
+}
+
+/// A box standing on a ground quad, unwelded (its faces meet at seams). From a point of a
+/// side face's bottom edge (on the ground, as the bake's rays leave a vertex there), rays
+/// going down stop on the ground at once, its front touching the origin; rays going up pass
+/// the ground's back, and the box's own bottom face, whose back they leave through, stops
+/// none of them. From the ground under the box, rays going up stop on the box's base.
+#[test]
+fn a_surface_resting_on_another_sees_it() {
+    let mut mesh = box_mesh(
+        Vec3::new(-0.5, 0.0, -0.5),
+        Vec3::new(0.5, 1.0, 0.5),
+        [2; 3],
+        [false; 6],
+    );
+    let ground = box_mesh(
+        Vec3::new(-3.0, -1.0, -3.0),
+        Vec3::new(3.0, 0.0, 3.0),
+        [4; 3],
+        [true, true, false, true, true, true],
+    );
+    let base = mesh.positions.len() as u32;
+    mesh.positions.extend(&ground.positions);
+    mesh.normals.extend(&ground.normals);
+    (mesh.triangles).extend(ground.triangles.iter().map(|t| t.map(|i| i + base)));
+    let is_ground = |t: u32| t as usize >= mesh.triangle_count() - ground.triangle_count();
+    let bvh = SceneBvh::build(&mesh);
+    // A side face (+x) point on its bottom edge, nudged off the face along its normal.
+    let edge = Vec3::new(0.5 + 1e-5, 0.0, 0.1);
+    let mut soup = Soup::new(3);
+    let (mut down, mut up) = (0, 0);
+    for k in 0..400 {
+        let d = soup.direction(k + 2);
+        let d = Vec3::new(d.x.abs(), d.y, d.z).normalize();
+        let hit = bvh.closest_hit(edge, d, 0.0, f32::INFINITY, Skip::Nothing);
+        if d.y < -1e-3 {
+            let hit = hit.unwrap_or_else(|| panic!("ray {k} down along {d} passed the ground"));
+            assert!(is_ground(hit.triangle) && hit.t == 0.0, "ray {k}: {hit:?}");
+            down += 1;
+        } else if d.y > 1e-3 {
+            assert!(hit.is_none(), "ray {k} up along {d} stopped: {hit:?}");
+            up += 1;
+        }
+    }
+    assert!(down > 100 && up > 100, "{down} down, {up} up");
+    // The ground under the box is covered; beside it, open.
+    for x in [-0.3, 0.0, 0.45] {
+        let hit = bvh.closest_hit(
+            Vec3::new(x, 0.0, 0.2),
+            Vec3::new(0.1, 1.0, 0.2).normalize(),
+            0.0,
+            9.0,
+            Skip::Nothing,
+        );
+        assert!(
+            hit.is_some_and(|h| h.t == 0.0 && !is_ground(h.triangle)),
+            "{x}: {hit:?}"
+        );
+    }
+    let beside = bvh.closest_hit(
+        Vec3::new(0.7, 0.0, 0.2),
+        Vec3::new(0.5, 1.0, 0.2).normalize(),
+        0.0,
+        9.0,
+        Skip::Nothing,
+    );
+    assert!(beside.is_none(), "{beside:?}");
 }
 
 /// Rays aimed at the edges of the soup's triangles, where one weight is 0 up to rounding:

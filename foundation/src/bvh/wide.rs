@@ -286,7 +286,10 @@ pub(super) struct WideRay {
     /// max (`axis + 3`) for a negative one; `far` is the other.
     near: [usize; 3],
     far: [usize; 3],
+    /// Where boxes start counting ([`Floors::boxes`]).
     tmin: f32,
+    /// Where a hit on a triangle's front and on its back starts counting.
+    floors: Floors,
 }
 
 impl WideRay {
@@ -314,7 +317,8 @@ impl WideRay {
             inv: inv.map(Vec4::splat),
             near: [near(0), near(1), near(2)],
             far: [far(0), far(1), far(2)],
-            tmin: tmin.max(MIN_BOX_DISTANCE),
+            tmin: Floors::new(tmin).boxes(),
+            floors: Floors::new(tmin),
         }
     }
 }
@@ -330,13 +334,46 @@ pub(super) fn safe_inverse(d: f32) -> f32 {
     }
 }
 
-/// Nearest distance at which anything counts: a box is entered and a triangle hit only at
-/// `t >= MIN_BOX_DISTANCE` (obvhs's `EPSILON` for boxes). So a ray leaving a seam of an
-/// unwelded mesh does not stop on the neighbour touching its origin (the bake's furnace tests
-/// rest on it), and, the triangles held to the boxes' floor, what a ray hits is the same in
-/// every tree: a hit nearer than the floor no longer counts only where its leaf's box happens
-/// to reach past it.
+/// How near a hit on the back of a triangle may be and still count: `t >= MIN_BOX_DISTANCE`
+/// (obvhs's `EPSILON` for boxes). So a ray leaving a seam of an unwelded mesh does not stop
+/// on the neighbour touching its origin, whose back it leaves through (the bake's furnace
+/// tests rest on it). The front of a triangle counts however near, down to this distance
+/// behind the origin, as `t = 0` ([`Floors`]): a surface lying on another (a crate standing
+/// on a plinth) sees it, as it would from a hair above it. Boxes are entered from the same
+/// distance behind, so what a ray hits is the same in every tree: no near hit counts only
+/// where its leaf's box happens to reach far enough.
 pub(super) const MIN_BOX_DISTANCE: f32 = 1e-4;
+
+/// Where hits start counting for a ray searched from `tmin`: on a triangle's front, on its
+/// back, and (the lower) for boxes. A `tmin` past [`MIN_BOX_DISTANCE`] is every floor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Floors {
+    pub front: f32,
+    pub back: f32,
+}
+
+impl Floors {
+    #[inline(always)]
+    pub(super) fn new(tmin: f32) -> Self {
+        if tmin > MIN_BOX_DISTANCE {
+            Self {
+                front: tmin,
+                back: tmin,
+            }
+        } else {
+            Self {
+                front: -MIN_BOX_DISTANCE,
+                back: MIN_BOX_DISTANCE,
+            }
+        }
+    }
+
+    /// Where boxes start counting: the nearer floor (a box holds every hit that counts).
+    #[inline(always)]
+    pub(super) fn boxes(self) -> f32 {
+        self.front.min(self.back)
+    }
+}
 
 /// Arithmetic on one value or on four side by side: what the triangle test is written over.
 pub(super) trait Lanes:
@@ -377,8 +414,9 @@ pub(super) fn dot<T: Lanes>(a: [T; 3], b: [T; 3]) -> T {
 
 /// Möller–Trumbore, for one triangle (`f32`) or four (`Vec4`): the same operations in the
 /// same order, so a packet's lane gives its triangle's answer bit for bit. Returns `(u, v,
-/// t)`: the barycentric weights of the second and third vertex and the distance; all NaN for
-/// a ray in the triangle's plane (which then fails every comparison).
+/// t, 1/det)`: the barycentric weights of the second and third vertex, the distance (all NaN
+/// for a ray in the triangle's plane, which then fails every comparison), and the inverse
+/// determinant, positive when the ray meets the front (counter-clockwise) side.
 #[inline(always)]
 pub(super) fn moller_trumbore<T: Lanes>(
     origin: [T; 3],
@@ -386,7 +424,7 @@ pub(super) fn moller_trumbore<T: Lanes>(
     v0: [T; 3],
     e1: [T; 3],
     e2: [T; 3],
-) -> (T, T, T) {
+) -> (T, T, T, T) {
     let p = cross(direction, e2);
     let inv_det = T::ONE / dot(e1, p);
     let s = [origin[0] - v0[0], origin[1] - v0[1], origin[2] - v0[2]];
@@ -395,6 +433,7 @@ pub(super) fn moller_trumbore<T: Lanes>(
         dot(s, p) * inv_det,
         dot(direction, q) * inv_det,
         dot(e2, q) * inv_det,
+        inv_det,
     )
 }
 
@@ -431,17 +470,24 @@ impl TrianglePacket {
         }))
     }
 
-    /// Distances to the four triangles, and the mask of those hit within `[tmin, tmax]` (the
-    /// ray's `tmin`, floored at [`MIN_BOX_DISTANCE`] as its boxes are).
+    /// Distances to the four triangles (a front hit behind the origin at 0), and the mask of
+    /// those hit within the ray's floors ([`Floors`]) and `tmax`.
     #[inline(always)]
     pub(super) fn intersect(&self, ray: &WideRay, tmax: f32) -> (Vec4, u32) {
-        let (u, v, t) = moller_trumbore(ray.origin, ray.direction, self.v0, self.e1, self.e2);
+        let (u, v, t, inv_det) =
+            moller_trumbore(ray.origin, ray.direction, self.v0, self.e1, self.e2);
+        let floor = Vec4::select(
+            inv_det.cmpgt(Vec4::ZERO),
+            Vec4::splat(ray.floors.front),
+            Vec4::splat(ray.floors.back),
+        );
+        let distance = t.max(Vec4::ZERO);
         let hit = u.cmpge(Vec4::ZERO)
             & v.cmpge(Vec4::ZERO)
             & (u + v).cmple(Vec4::ONE)
-            & t.cmpge(Vec4::splat(ray.tmin))
-            & t.cmple(Vec4::splat(tmax));
-        (t, hit.bitmask())
+            & t.cmpge(floor)
+            & distance.cmple(Vec4::splat(tmax));
+        (distance, hit.bitmask())
     }
 
     /// One lane's triangle: first vertex and edges.

@@ -56,7 +56,7 @@ pub struct ReferenceRequest {
 /// the specular part. Version 5: keys from the one key function (`foundation::infra::cache`).
 const REFERENCES: EntryKind = EntryKind {
     folder: "references",
-    tag: "hprt reference v6 (halves, files by sample count; hits held to the near floor, no negative weight)",
+    tag: "hprt reference v7 (halves, files by sample count; near floor on backs only, no negative weight)",
 };
 
 /// Everything that determines the reference's samples, hashed: the cache key (the map by its

@@ -105,12 +105,19 @@ fn indices_outside_the_arrays_are_refused_even_with_a_good_checksum() {
 }
 
 #[test]
-fn keys_follow_the_positions_and_triangles() {
+fn keys_follow_the_positions_triangles_and_fronts() {
     let mesh = boxes();
     let mut moved = mesh.clone();
     moved.positions[0].x += 1e-3;
     assert_ne!(bvh_key(&mesh), bvh_key(&moved));
-    let mut normals = mesh.clone();
-    normals.normals.iter_mut().for_each(|n| *n = -*n);
-    assert_eq!(bvh_key(&mesh), bvh_key(&normals));
+    // Normals shape the packets only through which side of each triangle is its front.
+    let mut tilted = mesh.clone();
+    tilted
+        .normals
+        .iter_mut()
+        .for_each(|n| *n = (*n * 2.0 + Vec3::X * 0.1).normalize());
+    assert_eq!(bvh_key(&mesh), bvh_key(&tilted));
+    let mut turned = mesh.clone();
+    turned.normals.iter_mut().for_each(|n| *n = -*n);
+    assert_ne!(bvh_key(&mesh), bvh_key(&turned));
 }
