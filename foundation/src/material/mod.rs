@@ -13,6 +13,7 @@
 
 mod bsdf;
 mod lobe;
+pub mod metallic_roughness;
 
 pub use bsdf::{BsdfEval, PhongBsdf};
 

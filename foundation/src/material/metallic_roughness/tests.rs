@@ -1,0 +1,177 @@
+use super::*;
+use crate::sampling::hammersley;
+
+/// `∫ g(ω) dω` over the upper hemisphere by the midpoint rule in `(x, φ)` with
+/// `cos θ = 1 − x²` (samples crowd the pole, where the narrowest lobe tested is: α = 0.0625,
+/// about 4°, seen along the normal).
+fn hemisphere(g: impl Fn(Vec3) -> f64) -> f64 {
+    let (nt, np) = (3000, 256);
+    let mut total = 0.0;
+    for i in 0..nt {
+        let x = (i as f32 + 0.5) / nt as f32;
+        let mu = 1.0 - x * x;
+        let sin = (1.0 - mu * mu).max(0.0).sqrt();
+        let weight = f64::from(2.0 * x);
+        for j in 0..np {
+            let phi = (j as f32 + 0.5) / np as f32 * TAU;
+            total += weight * g(Vec3::new(sin * phi.cos(), sin * phi.sin(), mu));
+        }
+    }
+    total * std::f64::consts::TAU / f64::from(nt * np)
+}
+
+fn view(theta_deg: f32) -> Vec3 {
+    let t = theta_deg.to_radians();
+    Vec3::new(t.sin(), 0.0, t.cos())
+}
+
+const ROUGHNESS: [f32; 4] = [0.25, 0.5, 0.75, 1.0];
+
+/// The distribution is normalised (`∫ D (n·h) dω = 1`) and so are the visible normals
+/// (`∫ G₁(v) max(0, v·h) D dω = n·v`): the identities sampling by visible normals rests on.
+#[test]
+fn the_distribution_and_its_visible_normals_are_normalised() {
+    for roughness in ROUGHNESS {
+        let alpha = roughness * roughness;
+        let d = hemisphere(|h| f64::from(ggx_distribution(h.z, alpha) * h.z));
+        assert!((d - 1.0).abs() < 2e-3, "α {alpha}: ∫ D cos = {d}");
+        for theta in [0.0, 45.0, 80.0] {
+            let v = view(theta);
+            let g1 = smith_masking(v.z, alpha);
+            let visible =
+                hemisphere(|h| f64::from(g1 * v.dot(h).max(0.0) * ggx_distribution(h.z, alpha)));
+            assert!(
+                (visible - f64::from(v.z)).abs() < 3e-3,
+                "α {alpha}, θ {theta}: {visible}"
+            );
+        }
+    }
+}
+
+/// Importance sampling agrees with the BSDF and its pdf: the mean of `f cos / pdf` over
+/// sampled directions is the directional albedo the quadrature of `f cos` gives, for metals
+/// and dielectrics, several roughnesses and views; and the pdf holds the mass the samples
+/// leave above the horizon.
+#[test]
+fn samples_follow_the_pdf_and_give_the_directional_albedo() {
+    let n = 1 << 16;
+    for roughness in ROUGHNESS {
+        for metallic in [0.0, 1.0] {
+            for theta in [0.0, 60.0] {
+                let material = MetallicRoughness {
+                    base_color: Rgb::new(0.9, 0.6, 0.3),
+                    metallic,
+                    roughness,
+                };
+                let b = MetallicRoughnessBsdf::new(Vec3::Z, &material, view(theta));
+                let albedo = hemisphere(|w| {
+                    let f = b.eval(w);
+                    f64::from(luminance(f.diffuse + f.specular))
+                });
+                let (mut sampled, mut above) = (0.0f64, 0);
+                for i in 0..n {
+                    let w = b.sample(hammersley(i, n));
+                    let f = b.eval(w);
+                    if f.pdf > 0.0 {
+                        sampled += f64::from(luminance(f.diffuse + f.specular) / f.pdf);
+                        above += 1;
+                    }
+                }
+                let sampled = sampled / f64::from(n);
+                let case = format!("roughness {roughness}, metallic {metallic}, θ {theta}");
+                assert!(
+                    (sampled / albedo - 1.0).abs() < 0.01,
+                    "{case}: {sampled} vs {albedo}"
+                );
+                let mass = hemisphere(|w| f64::from(b.pdf(w)));
+                let share = f64::from(above) / f64::from(n);
+                assert!(
+                    (mass - share).abs() < 5e-3,
+                    "{case}: pdf mass {mass}, {share} above"
+                );
+            }
+        }
+    }
+}
+
+/// A white metal's directional albedo: near one when smooth (a mirror loses nothing), and
+/// falling with roughness as single scattering loses the light that bounces between
+/// microfacets. At roughness 1 (`α = 1`: `D = 1/π`, `V = 1/(2(n·l + n·v))`) it has a closed
+/// form, `E(μ) = 1 − μ ln(1 + 1/μ)` for a view at `cos θ = μ`: 1 − ln 2 along the normal.
+#[test]
+fn a_white_metal_loses_light_only_as_it_roughens() {
+    let white = |roughness| MetallicRoughness {
+        base_color: Rgb::ONE,
+        metallic: 1.0,
+        roughness,
+    };
+    let albedo = |roughness, theta| {
+        let b = MetallicRoughnessBsdf::new(Vec3::Z, &white(roughness), view(theta));
+        hemisphere(|w| f64::from(b.eval(w).specular.x))
+    };
+    let smooth = albedo(0.25, 0.0);
+    assert!((smooth - 1.0).abs() < 5e-3, "{smooth}");
+    let mut last = smooth;
+    for roughness in [0.5, 0.75, 1.0] {
+        let e = albedo(roughness, 0.0);
+        assert!(e < last, "roughness {roughness}: {e} after {last}");
+        last = e;
+    }
+    for theta in [0.0f64, 45.0, 80.0] {
+        let mu = theta.to_radians().cos();
+        let exact = 1.0 - mu * (1.0 + 1.0 / mu).ln();
+        let e = albedo(1.0, theta as f32);
+        assert!((e - exact).abs() < 2e-3, "θ {theta}: {e} vs {exact}");
+    }
+}
+
+/// Swapping light and view leaves the BRDF (`f cos / cos`) unchanged.
+#[test]
+fn the_brdf_is_reciprocal() {
+    let material = MetallicRoughness {
+        base_color: Rgb::new(0.8, 0.5, 0.2),
+        metallic: 0.4,
+        roughness: 0.6,
+    };
+    for (a, b) in [(10.0, 50.0), (70.0, -20.0), (0.0, 85.0)] {
+        let (v, l) = (view(a), Vec3::new(0.3, 0.2, 0.0) + view(b));
+        let l = l.normalize();
+        let f = |v: Vec3, l: Vec3| {
+            let e = MetallicRoughnessBsdf::new(Vec3::Z, &material, v).eval(l);
+            (e.diffuse + e.specular) * (1.0 / l.z)
+        };
+        let (x, y) = (f(v, l), f(l, v));
+        assert!(
+            (x - y).abs().max_element() < 1e-4 * x.max_element(),
+            "{x:?} vs {y:?}"
+        );
+    }
+}
+
+/// Nothing reflects below the surface; a black metal reflects only what Schlick's Fresnel
+/// gives at grazing angles.
+#[test]
+fn nothing_below_the_surface_and_black_metal_only_at_grazing() {
+    let material = MetallicRoughness {
+        base_color: Rgb::splat(0.5),
+        metallic: 0.0,
+        roughness: 0.5,
+    };
+    let b = MetallicRoughnessBsdf::new(Vec3::Z, &material, view(30.0));
+    assert_eq!(b.pdf(-Vec3::Z), 0.0);
+    assert_eq!(
+        b.eval(Vec3::new(1.0, 0.0, -0.1).normalize()).specular,
+        Rgb::ZERO
+    );
+    let black = MetallicRoughness {
+        base_color: Rgb::ZERO,
+        metallic: 1.0,
+        roughness: 0.3,
+    };
+    let e = |theta| {
+        let b = MetallicRoughnessBsdf::new(Vec3::Z, &black, view(theta));
+        hemisphere(|w| f64::from(b.eval(w).specular.x + b.eval(w).diffuse.x))
+    };
+    assert!(e(0.0) < 1e-3, "{}", e(0.0));
+    assert!(e(85.0) > 0.1, "{}", e(85.0));
+}
