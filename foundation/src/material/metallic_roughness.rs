@@ -214,5 +214,75 @@ impl MetallicRoughnessBsdf {
     }
 }
 
+/// The split-sum terms of the specular layer's directional albedo for a view at
+/// `cos_v = n·v`: `E = F₀ A + B` (Schlick's Fresnel is linear in `F₀`). What a renderer
+/// scales its prefiltered reflections by (Karis 2013; Filament's DFG). Estimated by
+/// sampling visible normals, whose weight is `G₂ / G₁(v)` whatever the normal drawn.
+pub fn split_sum_terms(cos_v: f32, roughness: f32, samples: u32) -> (f32, f32) {
+    let alpha = (roughness * roughness).max(MIN_ALPHA);
+    let cos_v = cos_v.clamp(1e-4, 1.0);
+    let v = Vec3::new((1.0 - cos_v * cos_v).sqrt(), 0.0, cos_v);
+    let g1 = smith_masking(cos_v, alpha);
+    let (mut a, mut b) = (0.0f64, 0.0f64);
+    for i in 0..samples {
+        let h = sample_visible_normal(v, alpha, crate::sampling::hammersley(i, samples));
+        let vh = v.dot(h);
+        let l = 2.0 * vh * h - v;
+        if l.z <= 0.0 || vh <= 0.0 {
+            continue;
+        }
+        let g2 = 4.0 * smith_visibility(l.z, cos_v, alpha) * l.z * cos_v;
+        let weight = f64::from(g2 / g1);
+        let fc = f64::from((1.0 - vh).powi(5));
+        a += weight * (1.0 - fc);
+        b += weight * fc;
+    }
+    let n = f64::from(samples.max(1));
+    ((a / n) as f32, (b / n) as f32)
+}
+
+/// [`split_sum_terms`] tabulated over `n·v` (columns) and roughness (rows), both from 0 to
+/// 1 at the texel centres, read back bilinearly: the table a GPU pass samples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SplitSumTable {
+    size: usize,
+    /// `(A, B)` per texel, row by row.
+    terms: Vec<[f32; 2]>,
+}
+
+impl SplitSumTable {
+    /// A `size × size` table, each texel from `samples` visible normals.
+    pub fn new(size: usize, samples: u32) -> Self {
+        let size = size.max(2);
+        let centre = |k: usize| (k as f32 + 0.5) / size as f32;
+        let terms = (0..size * size)
+            .map(|i| {
+                let (a, b) = split_sum_terms(centre(i % size), centre(i / size), samples);
+                [a, b]
+            })
+            .collect();
+        Self { size, terms }
+    }
+
+    /// `(A, B)` at `cos_v` and `roughness`, bilinear between texel centres (clamped at the
+    /// edges).
+    pub fn lookup(&self, cos_v: f32, roughness: f32) -> (f32, f32) {
+        let n = self.size;
+        let coordinate = |x: f32| {
+            let p = (x.clamp(0.0, 1.0) * n as f32 - 0.5).clamp(0.0, (n - 1) as f32);
+            let k = (p.floor() as usize).min(n - 2);
+            (k, p - k as f32)
+        };
+        let ((i, fx), (j, fy)) = (coordinate(cos_v), coordinate(roughness));
+        let at = |i: usize, j: usize| self.terms[j * n + i];
+        let mix =
+            |a: [f32; 2], b: [f32; 2], t: f32| [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
+        let top = mix(at(i, j), at(i + 1, j), fx);
+        let bottom = mix(at(i, j + 1), at(i + 1, j + 1), fx);
+        let [a, b] = mix(top, bottom, fy);
+        (a, b)
+    }
+}
+
 #[cfg(test)]
 mod tests;
