@@ -89,6 +89,16 @@ impl Frame {
     pub fn to_world(&self, v: Vec3) -> Vec3 {
         self.tangent * v.x + self.bitangent * v.y + self.normal * v.z
     }
+
+    /// World to local (+Z = normal).
+    #[inline]
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(
+            v.dot(self.tangent),
+            v.dot(self.bitangent),
+            v.dot(self.normal),
+        )
+    }
 }
 
 /// SplitMix64 finaliser: a well-mixed 64-bit hash of `x` (seeds per vertex or per pixel).

@@ -67,11 +67,7 @@ const FLIPPED: u32 = 1 << 31;
 /// Triangle `t`'s corners as packed (front counter-clockwise), and whether they were swapped.
 pub(super) fn packed_corners(mesh: &TriangleMesh, t: usize) -> ([Vec3; 3], bool) {
     let [a, b, c] = mesh.corners(t);
-    let shading: Vec3 = mesh.triangles[t]
-        .iter()
-        .map(|&i| mesh.normals[i as usize])
-        .sum();
-    if (b - a).cross(c - a).dot(shading) < 0.0 {
+    if (b - a).cross(c - a).dot(mesh.front_normal(t)) < 0.0 {
         ([a, c, b], true)
     } else {
         ([a, b, c], false)

@@ -80,14 +80,15 @@ impl RayPacket {
             .iter()
             .all(|&s| s == 0 || s == 0xff)
             .then(|| signs.map(|s| s == 0xff));
+        let floors = Floors::new(tmin);
         Self {
             origin: origin.to_array(),
             direction,
             inv,
             octant,
-            tmin: f32x8::splat(Floors::new(tmin).boxes()),
-            front: f32x8::splat(Floors::new(tmin).front),
-            back: f32x8::splat(Floors::new(tmin).back),
+            tmin: f32x8::splat(floors.boxes()),
+            front: f32x8::splat(floors.front),
+            back: f32x8::splat(floors.back),
             lanes: (1 << directions.len()) - 1,
         }
     }

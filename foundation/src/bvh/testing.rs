@@ -3,7 +3,7 @@
 
 use super::Skip;
 use super::packed_corners;
-use super::wide::{MIN_BOX_DISTANCE, moller_trumbore};
+use super::wide::{Floors, moller_trumbore};
 use crate::mesh::TriangleMesh;
 use glam::Vec3;
 use rand_core::Rng;
@@ -55,7 +55,7 @@ impl Soup {
     }
 
     /// The closest hit `(t, triangle)` by testing every triangle, with the acceptance rule
-    /// written out: a back no nearer than [`MIN_BOX_DISTANCE`], a front from that far behind
+    /// written out: a back no nearer than [`super::wide::MIN_BOX_DISTANCE`], a front from that far behind
     /// the origin (at 0), equidistant triangles to the lowest index.
     pub(super) fn closest(
         &self,
@@ -80,10 +80,11 @@ impl Soup {
             (b - a).to_array(),
             (c - a).to_array(),
         );
+        let floors = Floors::new(0.0);
         let floor = if inv_det > 0.0 {
-            -MIN_BOX_DISTANCE
+            floors.front
         } else {
-            MIN_BOX_DISTANCE
+            floors.back
         };
         // A front hit behind the origin counts at +0 (as `maxps` gives it).
         let distance = if d > 0.0 { d } else { 0.0 };

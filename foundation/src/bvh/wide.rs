@@ -257,7 +257,7 @@ impl Bvh4 {
         let slab = |plane: usize, axis: usize| (n.planes[plane] - ray.origin[axis]) * ray.inv[axis];
         let t_near = slab(ray.near[0], 0)
             .max(slab(ray.near[1], 1))
-            .max(slab(ray.near[2], 2).max(Vec4::splat(ray.tmin)));
+            .max(slab(ray.near[2], 2).max(Vec4::splat(ray.floors.boxes())));
         let t_far = slab(ray.far[0], 0)
             .min(slab(ray.far[1], 1))
             .min(slab(ray.far[2], 2).min(Vec4::splat(tmax)))
@@ -286,9 +286,8 @@ pub(super) struct WideRay {
     /// max (`axis + 3`) for a negative one; `far` is the other.
     near: [usize; 3],
     far: [usize; 3],
-    /// Where boxes start counting ([`Floors::boxes`]).
-    tmin: f32,
-    /// Where a hit on a triangle's front and on its back starts counting.
+    /// Where a hit on a triangle's front and on its back starts counting (and boxes,
+    /// [`Floors::boxes`]).
     floors: Floors,
 }
 
@@ -317,7 +316,6 @@ impl WideRay {
             inv: inv.map(Vec4::splat),
             near: [near(0), near(1), near(2)],
             far: [far(0), far(1), far(2)],
-            tmin: Floors::new(tmin).boxes(),
             floors: Floors::new(tmin),
         }
     }
@@ -368,10 +366,11 @@ impl Floors {
         }
     }
 
-    /// Where boxes start counting: the nearer floor (a box holds every hit that counts).
+    /// Where boxes start counting: the front's floor, never past the back's (a box holds
+    /// every hit that counts).
     #[inline(always)]
     pub(super) fn boxes(self) -> f32 {
-        self.front.min(self.back)
+        self.front
     }
 }
 

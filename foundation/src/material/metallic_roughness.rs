@@ -127,12 +127,8 @@ impl MetallicRoughnessBsdf {
     /// even a black metal reflects at grazing angles (Schlick's Fresnel).
     pub fn new(n: Vec3, material: &MetallicRoughness, wo: Vec3) -> Self {
         let frame = Frame::from_normal(n);
-        let local = Vec3::new(
-            wo.dot(frame.tangent),
-            wo.dot(frame.bitangent),
-            wo.dot(n).abs().max(1e-4),
-        )
-        .normalize();
+        let local = frame.to_local(wo);
+        let local = Vec3::new(local.x, local.y, local.z.abs().max(1e-4)).normalize();
         let (diffuse, f0) = material.diffuse_and_f0();
         // Shares of the reflected light, roughly: the layer's Fresnel at the view (kept above
         // zero: microfacets tilted from the view reflect even where `F₀` is 0), the base what
@@ -149,18 +145,10 @@ impl MetallicRoughnessBsdf {
         }
     }
 
-    fn local(&self, w: Vec3) -> Vec3 {
-        Vec3::new(
-            w.dot(self.frame.tangent),
-            w.dot(self.frame.bitangent),
-            w.dot(self.frame.normal),
-        )
-    }
-
     /// `f cos` toward `w` (unit, world) of the diffuse and specular parts, and the pdf of
     /// sampling `w`.
     pub fn eval(&self, w: Vec3) -> BsdfEval {
-        let l = self.local(w);
+        let l = self.frame.to_local(w);
         if l.z <= 0.0 {
             return BsdfEval {
                 diffuse: Rgb::ZERO,
