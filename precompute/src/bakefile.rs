@@ -86,17 +86,23 @@ pub fn encode(transfer: &Transfer, mesh_hash: &[u8; 32]) -> Vec<u8> {
     out.extend_from_slice(&SAMPLING_COSINE_HAMMERSLEY.to_le_bytes());
     out.extend_from_slice(&transfer.textured_vertices.to_le_bytes());
     out.resize(HEADER_SIZE, 0);
-    for x in transfer
-        .direct
-        .as_slice()
-        .iter()
-        .chain(transfer.indirect.as_slice())
-    {
-        out.extend_from_slice(&x.to_le_bytes());
-    }
+    extend_le(&mut out, transfer.direct.as_slice());
+    extend_le(&mut out, transfer.indirect.as_slice());
     let crc = crc32fast::hash(&out);
     out.extend_from_slice(&crc.to_le_bytes());
     out
+}
+
+/// Appends `values` little-endian: a straight copy where the machine is little-endian (a
+/// quarter of a second on the 871k dragon's 261 MB against one float at a time).
+fn extend_le(out: &mut Vec<u8>, values: &[f32]) {
+    if cfg!(target_endian = "little") {
+        out.extend_from_slice(bytemuck::cast_slice(values));
+    } else {
+        for x in values {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+    }
 }
 
 /// The little-endian u32 at `offset` (checked in bounds by the caller).

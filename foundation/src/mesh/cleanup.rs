@@ -184,10 +184,21 @@ fn bounds_diagonal(positions: &[Vec3]) -> f32 {
 }
 
 /// Merges vertices closer than `tolerance`. Returns the old-to-new index map and, for each
-/// new vertex, the old vertex it keeps.
+/// new vertex, the old vertex it keeps. A vertex joins the first kept vertex within reach,
+/// searching the 27 grid cells around it in a fixed order and each cell in the order its
+/// vertices were kept.
 fn weld_positions(positions: &[Vec3], tolerance: f32) -> (Vec<u32>, Vec<u32>) {
+    /// A grid cell's kept vertices, as a chain through `next`: its first and last.
+    struct Cell {
+        first: u32,
+        last: u32,
+    }
+    const END: u32 = u32::MAX;
     let cell_of = |p: Vec3| (p / tolerance).floor().as_ivec3();
-    let mut grid: HashMap<IVec3, Vec<u32>> = HashMap::with_capacity(positions.len());
+    // A fast fixed hash: the cells are the mesh's own, nothing adversarial to spread.
+    let mut grid: HashMap<IVec3, Cell, foldhash::fast::FixedState> =
+        HashMap::with_capacity_and_hasher(positions.len(), Default::default());
+    let mut next: Vec<u32> = Vec::new();
     let mut remap = Vec::with_capacity(positions.len());
     let mut kept: Vec<u32> = Vec::new();
     for p in positions {
@@ -196,14 +207,16 @@ fn weld_positions(positions: &[Vec3], tolerance: f32) -> (Vec<u32>, Vec<u32>) {
         'search: for dz in -1..=1 {
             for dy in -1..=1 {
                 for dx in -1..=1 {
-                    let near =
-                        |&&c: &&u32| positions[kept[c as usize] as usize].distance(*p) <= tolerance;
-                    if let Some(&c) = grid
-                        .get(&(cell + IVec3::new(dx, dy, dz)))
-                        .and_then(|candidates| candidates.iter().find(near))
-                    {
-                        found = Some(c);
-                        break 'search;
+                    let Some(near) = grid.get(&(cell + IVec3::new(dx, dy, dz))) else {
+                        continue;
+                    };
+                    let mut c = near.first;
+                    while c != END {
+                        if positions[kept[c as usize] as usize].distance(*p) <= tolerance {
+                            found = Some(c);
+                            break 'search;
+                        }
+                        c = next[c as usize];
                     }
                 }
             }
@@ -211,7 +224,22 @@ fn weld_positions(positions: &[Vec3], tolerance: f32) -> (Vec<u32>, Vec<u32>) {
         let index = found.unwrap_or_else(|| {
             let new = kept.len() as u32;
             kept.push(remap.len() as u32);
-            grid.entry(cell).or_default().push(new);
+            next.push(END);
+            match grid.get_mut(&cell) {
+                Some(chain) => {
+                    next[chain.last as usize] = new;
+                    chain.last = new;
+                }
+                None => {
+                    grid.insert(
+                        cell,
+                        Cell {
+                            first: new,
+                            last: new,
+                        },
+                    );
+                }
+            }
             new
         });
         remap.push(index);
@@ -341,6 +369,45 @@ mod tests {
             .run(&PathBuf::from("flat.obj"), raw)
             .unwrap_err();
         assert!(matches!(err, MeshError::Empty { .. }), "{err}");
+    }
+
+    /// The chained grid against a plain one (a list per cell): the same vertices kept, the
+    /// same vertex joined, on a cloud with several vertices per cell and per reach.
+    #[test]
+    fn welding_keeps_the_first_vertex_within_reach_in_search_order() {
+        let tolerance = 0.01;
+        let mut state = 7u64;
+        let mut next = || {
+            state = crate::sampling::mix64(state);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let positions: Vec<Vec3> = (0..4000)
+            .map(|_| Vec3::new(next(), next(), next()) * 0.2)
+            .collect();
+        let cell_of = |p: Vec3| (p / tolerance).floor().as_ivec3();
+        let mut grid: HashMap<IVec3, Vec<u32>> = HashMap::new();
+        let (mut remap, mut kept) = (Vec::new(), Vec::<u32>::new());
+        for (i, p) in positions.iter().enumerate() {
+            let cell = cell_of(*p);
+            let mut found = None;
+            for (dz, dy, dx) in
+                (-1..=1).flat_map(|z| (-1..=1).flat_map(move |y| (-1..=1).map(move |x| (z, y, x))))
+            {
+                let list = grid.get(&(cell + IVec3::new(dx, dy, dz)));
+                let near =
+                    |&&c: &&u32| positions[kept[c as usize] as usize].distance(*p) <= tolerance;
+                found = found.or_else(|| list.and_then(|l| l.iter().find(near)).copied());
+            }
+            remap.push(found.unwrap_or_else(|| {
+                kept.push(i as u32);
+                grid.entry(cell).or_default().push(kept.len() as u32 - 1);
+                kept.len() as u32 - 1
+            }));
+        }
+        let (welded_remap, welded_kept) = weld_positions(&positions, tolerance);
+        assert!(kept.len() < 3000 && kept.len() > 500, "{} kept", kept.len());
+        assert_eq!(welded_kept, kept);
+        assert_eq!(welded_remap, remap);
     }
 
     #[test]
