@@ -71,10 +71,7 @@ fn prefiltered_reflections_match_the_exact_convolution() {
     let cam = camera(Vec3::new(0.0, 0.4, 3.5), Vec3::ZERO, 64, 64);
     let pixels = sphere_pixels(&cam, 0.3);
     for shininess in [8.0, 60.0, 400.0] {
-        let material = Material {
-            specular: Rgb::ONE,
-            shininess,
-        };
+        let material = Material::phong(Rgb::ONE, shininess);
         let geometry = glossy_sphere(Rgb::ZERO, material);
         let transfer = bake_of(&geometry, 5, 64, 0);
         // Turned: the maps stay in the map's frame and the lookup turns.
@@ -118,13 +115,7 @@ fn prefiltered_reflections_match_the_exact_convolution() {
 #[test]
 fn sh_reflections_are_the_zonal_convolution_at_the_mirror_direction() {
     let shininess = 20.0;
-    let geometry = glossy_sphere(
-        Rgb::ZERO,
-        Material {
-            specular: Rgb::ONE,
-            shininess,
-        },
-    );
+    let geometry = glossy_sphere(Rgb::ZERO, Material::phong(Rgb::ONE, shininess));
     let transfer = bake_of(&geometry, 5, 64, 0);
     let mut sh = ShCoeffs::zeros(5);
     for (k, c) in sh.as_mut_slice().iter_mut().enumerate() {
@@ -157,10 +148,7 @@ fn sh_reflections_are_the_zonal_convolution_at_the_mirror_direction() {
 fn glossy_white_furnace_on_the_gpu() {
     let geometry = glossy_sphere(
         Rgb::new(0.5, 0.3, 0.1),
-        Material {
-            specular: Rgb::new(0.5, 0.7, 0.9),
-            shininess: 60.0,
-        },
+        Material::phong(Rgb::new(0.5, 0.7, 0.9), 60.0),
     );
     let transfer = bake_of(&geometry, 5, 256, 1);
     let map = EnvMap::uniform(64, 32, Rgb::ONE);
@@ -195,10 +183,7 @@ fn glossy_highlights_follow_the_reference() {
         &sphere_mesh(Vec3::new(0.0, 1.0, 0.0), 1.0, 5),
         Rgb::splat(0.3),
     );
-    geometry.objects[0].material = Material {
-        specular: Rgb::splat(0.5),
-        shininess: 60.0,
-    };
+    geometry.objects[0].material = Material::phong(Rgb::splat(0.5), 60.0);
     let floor = box_mesh(
         Vec3::new(-4.0, -0.2, -4.0),
         Vec3::new(4.0, 0.0, 4.0),

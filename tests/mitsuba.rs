@@ -13,7 +13,11 @@
 //! On the floor lies a poster textured with four colours, one per quadrant (an OBJ with
 //! `map_Kd`): a texture exported mirrored, turned or as its mean moves colour between blocks.
 //! The cube is glossy (a Phong lobe of shininess 40 over its diffuse colour): Mitsuba renders it
-//! with the `hprtphong` plugin the export writes (CONVENTIONS.md, "Glossy materials").
+//! with the `hprtphong` plugin the export writes (CONVENTIONS.md, "Glossy materials"). In front
+//! lie a copper ingot and a green slab of glTF's metallic-roughness material (a metal of
+//! roughness 0.35, a dielectric of 0.6): Mitsuba renders them with the
+//! `hprtmetallicroughness` plugin, which evaluates the formula itself and samples GGX's
+//! visible normals with Mitsuba's own sampler.
 
 mod common;
 
@@ -109,6 +113,20 @@ box = {{ min = [-0.5, 0, -0.6], max = [0.5, 1.2, 0.4], skip_faces = ["-y"] }}
 albedo = [0.6, 0.3, 0.15]
 specular = [0.3, 0.4, 0.5]
 shininess = 40
+
+[[object]]
+name = "ingot"
+box = {{ min = [-1.7, 0, 0.8], max = [-0.7, 0.45, 1.6], skip_faces = ["-y"] }}
+base_color = [0.95, 0.64, 0.54]
+metallic = 1
+roughness = 0.35
+
+[[object]]
+name = "slab"
+box = {{ min = [-0.4, 0, 1.2], max = [0.5, 0.25, 2.0], skip_faces = ["-y"] }}
+base_color = [0.2, 0.5, 0.3]
+metallic = 0
+roughness = 0.6
 "#
         ),
     )
@@ -258,6 +276,7 @@ mi.set_variant("scalar_rgb")
 sys.path.insert(0, "mts")
 import thinsheet
 import phong
+import metallic_roughness
 scene = mi.load_file("mts/scene.xml", surface="thinsheet")
 for seed in (0, 1):
     mi.util.write_bitmap(f"mitsuba-{seed}.exr", mi.render(scene, seed=seed))

@@ -2,7 +2,8 @@
 //! multiple importance sampling (power heuristic) with sampling of the surface's BRDF:
 //! cosine-weighted for a Lambertian surface; for a glossy one ([`foundation::material`]) the
 //! diffuse part or the Phong lobe, chosen by their reflectances' luminance (one-sample MIS
-//! over the two: the pdf is their mixture).
+//! over the two: the pdf is their mixture); for a metallic-roughness one the diffuse base or
+//! the GGX layer's visible normals, alike.
 
 use super::light::{EnvironmentLight, PendingTexel};
 use super::sampler::PathSampler;
@@ -10,7 +11,7 @@ use foundation::bvh::RAY_OFFSET_FRACTION;
 use foundation::bvh::{Hit, SceneBvh, Skip};
 use foundation::color::{Rgb, luminance};
 use foundation::infra::huge_pages::HugePageTable;
-use foundation::material::{Material, PhongBsdf};
+use foundation::material::{Material, SurfaceBsdf};
 use foundation::sampling::{Frame, cosine_hemisphere, cosine_hemisphere_pdf, power_heuristic};
 use foundation::scene::{NO_TEXTURE, SceneMesh};
 use glam::Vec3;
@@ -115,7 +116,7 @@ impl<'a> Integrator<'a> {
             } else {
                 Vec::new()
             },
-            triangle_materials: if geometry.is_glossy() {
+            triangle_materials: if !geometry.is_lambertian() {
                 geometry.triangle_materials()
             } else {
                 Vec::new()
@@ -223,20 +224,22 @@ impl<'a> Integrator<'a> {
         let mut light_sample = self.light.sample_texel(sampler.next_2d());
         for depth in 0..=self.bounces {
             let point = path.point;
-            let glossy = if point.material.is_glossy() {
-                match PhongBsdf::new(point.shading_normal, point.albedo, point.material, path.wo) {
+            let bsdf = if point.material.is_lambertian() {
+                None
+            } else {
+                let bsdf =
+                    SurfaceBsdf::new(point.shading_normal, point.albedo, &point.material, path.wo);
+                match bsdf {
                     Some(bsdf) => Some(bsdf),
                     None => break,
                 }
-            } else {
-                None
             };
             if let Some(sample) = light_sample {
-                self.next_event(&path, glossy.as_ref(), sample, depth, rays, &mut out);
+                self.next_event(&path, bsdf.as_ref(), sample, depth, rays, &mut out);
             }
             // Continuation by the BSDF; on escape it is the other MIS strategy for the
             // environment.
-            let Some(scatter) = path.scatter(glossy.as_ref(), sampler.next_2d(), depth) else {
+            let Some(scatter) = path.scatter(bsdf.as_ref(), sampler.next_2d(), depth) else {
                 break;
             };
             let w = scatter.direction;
@@ -287,7 +290,7 @@ impl<'a> Integrator<'a> {
     fn next_event(
         &self,
         path: &PathVertex,
-        glossy: Option<&PhongBsdf>,
+        bsdf: Option<&SurfaceBsdf>,
         (w, texel): (Vec3, PendingTexel),
         depth: u32,
         rays: &mut u64,
@@ -312,7 +315,7 @@ impl<'a> Integrator<'a> {
         if !visible || pdf_light <= 0.0 {
             return;
         }
-        match glossy {
+        match bsdf {
             None => {
                 // A Lambertian point's weight (cos/pdf cancels): the arithmetic of a diffuse
                 // path is the same as before glossy surfaces existed.
@@ -358,17 +361,17 @@ struct Scatter {
 }
 
 impl PathVertex {
-    /// Draws the continuation from the point's BSDF (`glossy`, or Lambertian) and moves the
+    /// Draws the continuation from the point's BSDF (`bsdf`, or Lambertian) and moves the
     /// path's weights past the point; `None` where the sampled direction reflects nothing.
     #[inline]
     fn scatter(
         &mut self,
-        glossy: Option<&PhongBsdf>,
+        bsdf: Option<&SurfaceBsdf>,
         u: glam::Vec2,
         depth: u32,
     ) -> Option<Scatter> {
         let albedo = self.point.albedo;
-        let (scatter, weight, specular_weight) = match glossy {
+        let (scatter, weight, specular_weight) = match bsdf {
             None => {
                 let n = self.point.shading_normal;
                 let w = Frame::from_normal(n).to_world(cosine_hemisphere(u));
@@ -398,7 +401,7 @@ impl PathVertex {
                 )
             }
         };
-        self.specular_before = match (depth, glossy) {
+        self.specular_before = match (depth, bsdf) {
             (0, Some(_)) => self.before * specular_weight,
             (0, None) => Rgb::ZERO,
             _ => self.specular_before * specular_weight,

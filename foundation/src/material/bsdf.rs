@@ -96,10 +96,7 @@ mod tests {
     use crate::sampling::hammersley;
 
     fn bsdf(view: Vec3) -> PhongBsdf {
-        let material = Material {
-            specular: Rgb::splat(0.3),
-            shininess: 80.0,
-        };
+        let material = Material::phong(Rgb::splat(0.3), 80.0);
         PhongBsdf::new(Vec3::Z, Rgb::splat(0.5), material, view.normalize()).unwrap()
     }
 

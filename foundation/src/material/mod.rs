@@ -1,5 +1,6 @@
 //! Surface materials: Lambertian diffuse plus an optional normalised Phong lobe
-//! (CONVENTIONS.md, "Glossy materials").
+//! (CONVENTIONS.md, "Glossy materials"), or glTF's metallic-roughness layer over a base colour
+//! ([`metallic_roughness`]).
 //!
 //! `f(ω_i, ω_o) = k_d/π + k_s (s + 1)/(2π) cos^s α / (n·ω_i)`, with `α` the angle between the
 //! incident direction and the mirror direction `r` of the view, for `n·ω_i > 0`. Dividing the
@@ -14,8 +15,10 @@
 mod bsdf;
 mod lobe;
 pub mod metallic_roughness;
+mod surface;
 
 pub use bsdf::{BsdfEval, PhongBsdf};
+pub use surface::SurfaceBsdf;
 
 pub use lobe::{mirror, phong_lobe, phong_zonal};
 
@@ -24,13 +27,25 @@ use crate::color::Rgb;
 /// Largest shininess a scene may give (a lobe about 0.6° wide).
 pub const MAX_SHININESS: f32 = 10_000.0;
 
-/// The glossy part of a surface (its diffuse albedo lives with the geometry).
+/// What a surface does beyond the colour that lives with the geometry (the albedo, or the
+/// base colour under a metallic-roughness layer).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Material {
-    /// `k_s` per channel; zero for a purely diffuse surface.
+    /// `k_s` per channel; zero for a purely diffuse surface (and under a `layer`).
     pub specular: Rgb,
     /// Phong exponent `s` (meaningless when `specular` is zero).
     pub shininess: f32,
+    /// glTF's metallic-roughness layer: the geometry's colour is then its base colour, and
+    /// there is no Phong lobe.
+    pub layer: Option<Layer>,
+}
+
+/// The metallic-roughness factors of a surface ([`metallic_roughness::MetallicRoughness`]
+/// with its base colour), each in [0, 1].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Layer {
+    pub metallic: f32,
+    pub roughness: f32,
 }
 
 impl Material {
@@ -38,10 +53,38 @@ impl Material {
     pub const DIFFUSE: Material = Material {
         specular: Rgb::ZERO,
         shininess: 0.0,
+        layer: None,
     };
 
+    /// A Phong lobe over the Lambertian albedo.
+    pub const fn phong(specular: Rgb, shininess: f32) -> Material {
+        Material {
+            specular,
+            shininess,
+            layer: None,
+        }
+    }
+
+    /// glTF's metallic-roughness material over the base colour.
+    pub const fn metallic_roughness(metallic: f32, roughness: f32) -> Material {
+        Material {
+            specular: Rgb::ZERO,
+            shininess: 0.0,
+            layer: Some(Layer {
+                metallic,
+                roughness,
+            }),
+        }
+    }
+
+    /// Whether it has a Phong lobe.
     pub fn is_glossy(&self) -> bool {
         self.specular.max_element() > 0.0
+    }
+
+    /// Whether anything about it depends on the view (a Phong lobe or a layer).
+    pub fn is_lambertian(&self) -> bool {
+        !self.is_glossy() && self.layer.is_none()
     }
 }
 

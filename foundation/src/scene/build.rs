@@ -198,14 +198,22 @@ fn add_object(
         .name
         .clone()
         .unwrap_or_else(|| format!("#{}", index + 1));
-    if let Some(albedo) = object.albedo
+    if object.albedo.is_some() && object.base_color.is_some() {
+        return Err(invalid(format!(
+            "{name}: give albedo or base_color, not both (base_color is the albedo of a \
+             metallic-roughness material)"
+        )));
+    }
+    // The colour the geometry carries: the albedo, or the base colour under a layer.
+    let colour = object.albedo.or(object.base_color);
+    if let Some(albedo) = colour
         && !albedo.iter().all(|a| (0.0..1.0).contains(a))
     {
         return Err(invalid(format!(
             "{name}: albedo {albedo:?} must be in [0, 1) per channel"
         )));
     }
-    let material = object_material(object).map_err(|m| invalid(format!("{name}: {m}")))?;
+    let material = object_material(&name, object).map_err(|m| invalid(format!("{name}: {m}")))?;
     let parts = load_object_parts(dir, object, models).map_err(|e| match e {
         ObjectError::Mesh(cause) => SceneError::Mesh {
             scene: path.to_owned(),
@@ -216,16 +224,12 @@ fn add_object(
     })?;
     let single = parts.len() == 1;
     for part in parts {
-        let albedo = object
-            .albedo
-            .map(Rgb::from)
-            .or(part.albedo)
-            .ok_or_else(|| {
-                invalid(format!(
-                    "{name}: give it an albedo = [r, g, b] (its file gives it no \
+        let albedo = colour.map(Rgb::from).or(part.albedo).ok_or_else(|| {
+            invalid(format!(
+                "{name}: give it an albedo = [r, g, b] (its file gives it no \
                      material hprt can read)"
-                ))
-            })?;
+            ))
+        })?;
         let part_name = match single {
             true => name.clone(),
             false => format!("{name}/{}", part.name),
@@ -244,7 +248,7 @@ fn add_object(
                 .map_err(|m| invalid(format!("{part_name}: {m}")))?;
         }
         // An albedo in the scene file replaces the model's material, texture included.
-        match (object.albedo, part.texture) {
+        match (colour, part.texture) {
             (None, Some(texture)) => {
                 geometry.push_textured_object(part_name, &world, albedo, texture)
             }
@@ -258,9 +262,17 @@ fn add_object(
     Ok(())
 }
 
-/// The specular lobe an object asks for (its energy is checked against each part's albedo).
-fn object_material(object: &ObjectSpec) -> Result<Material, SpecError> {
+/// The material an object asks for: a Phong lobe (its energy is checked against each part's
+/// albedo), a metallic-roughness layer, or neither.
+fn object_material(name: &str, object: &ObjectSpec) -> Result<Material, SpecError> {
+    let layered =
+        object.metallic.is_some() || object.roughness.is_some() || object.base_color.is_some();
     match (object.specular, object.shininess) {
+        (Some(_), _) | (_, Some(_)) if layered => Err(SpecError::PhongAndLayer),
+        (None, None) if layered => Ok(Material::metallic_roughness(
+            layer_factor(name, "metallic", object.metallic)?,
+            layer_factor(name, "roughness", object.roughness)?,
+        )),
         (None, None) => Ok(Material::DIFFUSE),
         (None, Some(_)) => Err(SpecError::ShininessWithoutSpecular),
         (Some(_), None) => Err(SpecError::SpecularWithoutShininess),
@@ -271,12 +283,23 @@ fn object_material(object: &ObjectSpec) -> Result<Material, SpecError> {
             if !(shininess > 0.0 && shininess <= MAX_SHININESS) {
                 return Err(SpecError::Shininess(shininess));
             }
-            Ok(Material {
-                specular: Rgb::from(specular),
-                shininess,
-            })
+            Ok(Material::phong(Rgb::from(specular), shininess))
         }
     }
+}
+
+/// A metallic or roughness factor: glTF's default (1) when absent, clamped to [0, 1] as glTF
+/// clamps it (with a warning), an error when not a number.
+fn layer_factor(name: &str, what: &'static str, value: Option<f32>) -> Result<f32, SpecError> {
+    let value = value.unwrap_or(1.0);
+    if !value.is_finite() {
+        return Err(SpecError::Factor { what, value });
+    }
+    let clamped = value.clamp(0.0, 1.0);
+    if clamped != value {
+        log::warn!("{name}: {what} {value} is outside [0, 1]: clamped to {clamped}, as glTF does");
+    }
+    Ok(clamped)
 }
 
 /// Face names of `skip_faces`, in the order of `box_mesh`'s `skip` flags.
@@ -304,6 +327,13 @@ pub(super) enum SpecError {
     Specular([f32; 3]),
     #[error("shininess {0} must be in (0, {max}]", max = MAX_SHININESS)]
     Shininess(f32),
+    #[error(
+        "give a Phong lobe (specular, shininess) or a metallic-roughness material \
+         (base_color, metallic, roughness), not both"
+    )]
+    PhongAndLayer,
+    #[error("{what} {value} is not a number")]
+    Factor { what: &'static str, value: f32 },
     #[error(
         "give exactly one of `mesh = \"file\"`, `box = {{ min, max }}` or `annulus = {{ outer_radius }}`"
     )]

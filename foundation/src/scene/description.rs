@@ -157,6 +157,17 @@ pub struct ObjectSpec {
     /// Phong exponent `s` of the specular lobe, in (0, 10000].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shininess: Option<f32>,
+    /// glTF's metallic-roughness material (CONVENTIONS.md, "Metallic-roughness materials"):
+    /// its base colour, each channel in [0, 1) (in place of `albedo`); given any of the three,
+    /// the others default as in glTF (white, 1, 1). Not with `specular`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub base_color: Option<[f32; 3]>,
+    /// 0 (dielectric) to 1 (metal); values outside are clamped, as glTF does, with a warning.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub metallic: Option<f32>,
+    /// Perceptual roughness, 0 to 1 (GGX's `α` is its square); clamped like `metallic`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub roughness: Option<f32>,
     #[serde(default)]
     pub transform: Transform,
     /// Quads per Bézier patch side (BPT meshes).

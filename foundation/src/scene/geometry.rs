@@ -249,10 +249,20 @@ impl SceneMesh {
         out
     }
 
-    /// BLAKE3 hash of the objects' materials where any is glossy (part of
+    /// Whether any object has a metallic-roughness layer.
+    pub fn has_layers(&self) -> bool {
+        self.objects.iter().any(|o| o.material.layer.is_some())
+    }
+
+    /// Whether every object is Lambertian (no lobe, no layer).
+    pub fn is_lambertian(&self) -> bool {
+        self.objects.iter().all(|o| o.material.is_lambertian())
+    }
+
+    /// BLAKE3 hash of the objects' materials where any is not Lambertian (part of
     /// [`Self::content_hash`]); `None` for a diffuse scene.
     pub(crate) fn material_hash(&self) -> Option<[u8; 32]> {
-        if !self.is_glossy() {
+        if self.is_lambertian() {
             return None;
         }
         let mut hasher = blake3::Hasher::new();
@@ -263,6 +273,12 @@ impl SceneMesh {
                 hasher.update(&c.to_le_bytes());
             }
             hasher.update(&o.material.shininess.to_le_bytes());
+            // Only layered objects add bytes: the hashes of Phong scenes stay as they were.
+            if let Some(layer) = o.material.layer {
+                hasher.update(b"layer");
+                hasher.update(&layer.metallic.to_le_bytes());
+                hasher.update(&layer.roughness.to_le_bytes());
+            }
         }
         Some(*hasher.finalize().as_bytes())
     }

@@ -342,10 +342,7 @@ mod tests {
         .unwrap();
         assert_eq!(
             good.geometry.objects[0].material,
-            Material {
-                specular: Rgb::new(0.5, 0.6, 0.7),
-                shininess: 60.0
-            }
+            Material::phong(Rgb::new(0.5, 0.6, 0.7), 60.0)
         );
         assert!(good.geometry.is_glossy() && good.geometry.material_hash().is_some());
         // The interreflection carries the lobe's energy: albedo + specular.
@@ -378,6 +375,56 @@ mod tests {
             let err = Scene::load(&write_scene(dir.path(), &object(extra)))
                 .unwrap_err()
                 .to_string();
+            assert!(
+                err.contains("s.toml") && err.contains(needle),
+                "{extra}: {err}"
+            );
+        }
+    }
+
+    #[test]
+    fn metallic_roughness_materials_are_read_and_checked() {
+        let dir = tempfile::tempdir().unwrap();
+        let object = |extra: &str| {
+            format!("{CAMERA}[[object]]\nbox = {{ min = [0,0,0], max = [1,1,1] }}\n{extra}\n")
+        };
+        let load = |extra: &str| Scene::load(&write_scene(dir.path(), &object(extra)));
+        let metal = load("base_color = [0.9, 0.6, 0.3]\nmetallic = 1\nroughness = 0.4").unwrap();
+        let o = &metal.geometry.objects[0];
+        assert_eq!(o.material, Material::metallic_roughness(1.0, 0.4));
+        assert_eq!(o.albedo, Rgb::new(0.9, 0.6, 0.3));
+        assert!(!metal.geometry.is_lambertian() && metal.geometry.material_hash().is_some());
+        // glTF's defaults for what is not given; its clamping (with a warning) for what is
+        // out of range.
+        let defaults = load("albedo = [0.5, 0.5, 0.5]\nroughness = 0.2").unwrap();
+        assert_eq!(
+            defaults.geometry.objects[0].material,
+            Material::metallic_roughness(1.0, 0.2)
+        );
+        let clamped = load("base_color = [0.5, 0.5, 0.5]\nmetallic = -0.5\nroughness = 1.5");
+        assert_eq!(
+            clamped.unwrap().geometry.objects[0].material,
+            Material::metallic_roughness(0.0, 1.0)
+        );
+        let mut rougher = metal.geometry.clone();
+        rougher.objects[0].material = Material::metallic_roughness(1.0, 0.5);
+        assert_ne!(rougher.content_hash(), metal.geometry.content_hash());
+        for (extra, needle) in [
+            (
+                "base_color = [0.5, 0.5, 0.5]\nmetallic = nan",
+                "not a number",
+            ),
+            (
+                "base_color = [0.5, 0.5, 0.5]\nspecular = [0.1, 0.1, 0.1]\nshininess = 8",
+                "not both",
+            ),
+            (
+                "albedo = [0.5, 0.5, 0.5]\nbase_color = [0.5, 0.5, 0.5]",
+                "not both",
+            ),
+            ("base_color = [1.5, 0.5, 0.5]", "[0, 1)"),
+        ] {
+            let err = load(extra).unwrap_err().to_string();
             assert!(
                 err.contains("s.toml") && err.contains(needle),
                 "{extra}: {err}"

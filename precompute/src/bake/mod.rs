@@ -247,6 +247,13 @@ pub fn bake(
     progress: &dyn Progress,
 ) -> Result<(Transfer, BakeStats), BakeError> {
     let start = Instant::now();
+    if geometry.has_layers() {
+        foundation::infra::warn_once(
+            "the bake treats metallic-roughness surfaces as diffuse ones of their base colour \
+             for now (the path tracer, `hprt reference`, draws their GGX layer)"
+                .into(),
+        );
+    }
     let traced = trace(geometry, bvh, settings, progress)?;
     let (transfer, mut stats) = sum_bounces(geometry, settings, traced, progress)?;
     foundation::infra::memory::release_freed_memory();

@@ -143,8 +143,9 @@ pub(crate) fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> Stri
     <!-- How the backs of triangles look. twosided: as surfaces of their own, facing the
          other way. hprt shows the front's radiance on both sides (CONVENTIONS.md,
          "Surfaces"); for exactly that, import thinsheet.py from this folder and load with
-         surface="thinsheet". Glossy objects use hprt's Phong material: import phong.py
-         from this folder before loading. -->
+         surface="thinsheet". Glossy objects use hprt's Phong material, metallic-roughness
+         ones glTF's: import phong.py and metallic_roughness.py from this folder before
+         loading. -->
     <default name="surface" value="twosided"/>
     <integrator type="path">
         <!-- hprt bounces = {bounces} -->
@@ -193,7 +194,8 @@ pub(crate) fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> Stri
     xml
 }
 
-/// One object as a Mitsuba shape: its mesh file and its BSDF (diffuse, or hprt's Phong).
+/// One object as a Mitsuba shape: its mesh file and its BSDF (diffuse, hprt's Phong, or
+/// glTF's metallic-roughness).
 fn shape_xml(o: &SceneObject, i: usize) -> String {
     let a = o.albedo;
     let reflectance = match o.texture {
@@ -212,7 +214,16 @@ fn shape_xml(o: &SceneObject, i: usize) -> String {
         ),
     };
     let m = &o.material;
-    let inner = if m.is_glossy() {
+    let inner = if let Some(layer) = m.layer {
+        format!(
+            r#"<bsdf type="hprtmetallicroughness">
+                {reflectance}
+                <float name="metallic" value="{}"/>
+                <float name="roughness" value="{}"/>
+            </bsdf>"#,
+            layer.metallic, layer.roughness
+        )
+    } else if m.is_glossy() {
         format!(
             r#"<bsdf type="hprtphong">
                 {reflectance}
@@ -257,6 +268,10 @@ pub(crate) const THIN_SHEET_PLUGIN: &str = include_str!("thinsheet.py");
 /// CONVENTIONS.md, "Glossy materials"), registered as `hprtphong` when imported.
 pub(crate) const PHONG_PLUGIN: &str = include_str!("phong.py");
 
+/// glTF's metallic-roughness material as a Mitsuba 3 BSDF plugin, registered as
+/// `hprtmetallicroughness` when imported.
+pub(crate) const METALLIC_ROUGHNESS_PLUGIN: &str = include_str!("metallic_roughness.py");
+
 /// Every file [`export_mitsuba`] writes into `dir` for `geometry`.
 pub fn export_files(dir: &Path, geometry: &SceneMesh) -> Vec<PathBuf> {
     let objects = geometry.objects.iter().enumerate();
@@ -266,11 +281,18 @@ pub fn export_files(dir: &Path, geometry: &SceneMesh) -> Vec<PathBuf> {
     let textures = objects
         .filter(|(_, o)| o.texture.is_some())
         .map(|(i, o)| dir.join("textures").join(texture_file_for(&o.name, i)));
-    let fixed = ["envmap.exr", "thinsheet.py", "phong.py", "scene.xml"].map(|f| dir.join(f));
+    let fixed = [
+        "envmap.exr",
+        "thinsheet.py",
+        "phong.py",
+        "metallic_roughness.py",
+        "scene.xml",
+    ]
+    .map(|f| dir.join(f));
     meshes.chain(textures).chain(fixed).collect()
 }
 
-/// Writes `dir/scene.xml`, `dir/thinsheet.py`, `dir/phong.py`, `dir/envmap.exr`, `dir/meshes/*.ply` and, for
+/// Writes `dir/scene.xml`, the plugins (`dir/*.py`), `dir/envmap.exr`, `dir/meshes/*.ply` and, for
 /// textured objects, `dir/textures/*.exr`.
 pub fn export_mitsuba(
     dir: &Path,
@@ -305,6 +327,7 @@ pub fn export_mitsuba(
     for (name, plugin) in [
         ("thinsheet.py", THIN_SHEET_PLUGIN),
         ("phong.py", PHONG_PLUGIN),
+        ("metallic_roughness.py", METALLIC_ROUGHNESS_PLUGIN),
     ] {
         let plugin_path = dir.join(name);
         write_atomic(&plugin_path, plugin.as_bytes())

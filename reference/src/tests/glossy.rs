@@ -3,10 +3,7 @@
 use super::*;
 
 fn glossy(mut geometry: SceneMesh, object: usize, specular: Rgb, shininess: f32) -> SceneMesh {
-    geometry.objects[object].material = foundation::material::Material {
-        specular,
-        shininess,
-    };
+    geometry.objects[object].material = foundation::material::Material::phong(specular, shininess);
     geometry
 }
 

@@ -7,6 +7,7 @@ use foundation::mesh::{TriangleMesh, box_mesh, sphere_mesh};
 use glam::Vec3;
 
 mod glossy;
+mod metallic_roughness;
 
 fn scene_of(objects: &[(&TriangleMesh, Rgb)]) -> SceneMesh {
     let mut s = SceneMesh::default();

@@ -86,6 +86,9 @@ struct ObjectEntry {
     texture: Option<usize>,
     specular: [f32; 3],
     shininess: f32,
+    /// A metallic-roughness layer's `[metallic, roughness]` (absent in older bundles).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    layer: Option<[f32; 2]>,
     role: ObjectRole,
 }
 
@@ -229,6 +232,7 @@ fn object_entry(o: &SceneObject) -> ObjectEntry {
         texture: o.texture,
         specular: o.material.specular.to_array(),
         shininess: o.material.shininess,
+        layer: o.material.layer.map(|l| [l.metallic, l.roughness]),
         role: o.role,
     }
 }
@@ -378,9 +382,9 @@ fn scene_object(o: &ObjectEntry) -> SceneObject {
         vertices: o.vertices[0]..o.vertices[1],
         triangles: o.triangles[0]..o.triangles[1],
         texture: o.texture,
-        material: Material {
-            specular: Rgb::from_array(o.specular),
-            shininess: o.shininess,
+        material: match o.layer {
+            Some([metallic, roughness]) => Material::metallic_roughness(metallic, roughness),
+            None => Material::phong(Rgb::from_array(o.specular), o.shininess),
         },
         role: o.role,
     }
@@ -418,6 +422,18 @@ fn check_contents(b: &SceneBundle) -> Result<(), String> {
             || o.texture.is_some_and(|i| i >= g.textures.len());
         if outside {
             return Err(format!("object {:?} reaches past the mesh", o.name));
+        }
+        let m = &o.material;
+        let layer = m.layer.map_or([0.0; 2], |l| [l.metallic, l.roughness]);
+        let sane = m
+            .specular
+            .to_array()
+            .iter()
+            .all(|c| (0.0..=1.0).contains(c))
+            && m.shininess.is_finite()
+            && layer.iter().all(|f| (0.0..=1.0).contains(f));
+        if !sane {
+            return Err(format!("object {:?} has a material out of range", o.name));
         }
     }
     let all = g

@@ -22,10 +22,8 @@ fn bundle() -> SceneBundle {
         Rgb::splat(0.6),
     );
     geometry.objects[1].role = ObjectRole::Proxy;
-    geometry.objects[0].material = Material {
-        specular: Rgb::splat(0.2),
-        shininess: 40.0,
-    };
+    geometry.objects[0].material = Material::phong(Rgb::splat(0.2), 40.0);
+    geometry.objects[1].material = Material::metallic_roughness(0.25, 0.75);
     let settings = BakeSettings {
         order: 3,
         samples: 64,
@@ -247,7 +245,7 @@ type HeaderEdit = dyn Fn(&mut serde_json::Value);
 fn hostile_headers_are_refused_before_use() {
     // The unedited header passes, so the refusals below are the edits'.
     assert!(SceneBundle::from_bytes("scene.bin", &with_header(|_| ())).is_ok());
-    let cases: [(&str, Box<HeaderEdit>); 6] = [
+    let cases: [(&str, Box<HeaderEdit>); 8] = [
         ("SH order", Box::new(|h| h["bake"]["order"] = 40.into())),
         (
             "no environment map",
@@ -265,6 +263,14 @@ fn hostile_headers_are_refused_before_use() {
         (
             "texture coordinates",
             Box::new(|h| h["objects"][0]["texture"] = 0.into()),
+        ),
+        (
+            "material out of range",
+            Box::new(|h| h["objects"][1]["layer"] = serde_json::json!([0.5, 7.0])),
+        ),
+        (
+            "material out of range",
+            Box::new(|h| h["objects"][0]["specular"] = serde_json::json!([-1.0, 0.0, 0.0])),
         ),
     ];
     for (expected, edit) in cases {

@@ -49,6 +49,13 @@ impl MaterialTable {
         let mut glossy: Vec<Material> = Vec::new();
         let mut shininess: Vec<f32> = Vec::new();
         let mut object_entries = Vec::with_capacity(materials.len());
+        if materials.iter().any(|m| m.layer.is_some()) {
+            foundation::infra::warn_once(
+                "the GPU renderer draws metallic-roughness surfaces as diffuse ones of their base \
+                 colour for now (their GGX layer is drawn by the path tracer, `hprt reference`)"
+                    .into(),
+            );
+        }
         for m in materials {
             if !m.is_glossy() {
                 object_entries.push(0);
@@ -200,18 +207,9 @@ mod tests {
 
     #[test]
     fn distinct_materials_share_entries_and_slots() {
-        let a = Material {
-            specular: Rgb::splat(0.2),
-            shininess: 60.0,
-        };
-        let b = Material {
-            specular: Rgb::splat(0.4),
-            shininess: 60.0,
-        };
-        let c = Material {
-            specular: Rgb::splat(0.2),
-            shininess: 10.0,
-        };
+        let a = Material::phong(Rgb::splat(0.2), 60.0);
+        let b = Material::phong(Rgb::splat(0.4), 60.0);
+        let c = Material::phong(Rgb::splat(0.2), 10.0);
         let table = MaterialTable::new(&[a, Material::DIFFUSE, b, a, c]).unwrap();
         assert_eq!(table.object_entries, [1, 0, 2, 1, 3]);
         assert_eq!(table.shininess, [60.0, 10.0]);
@@ -220,10 +218,7 @@ mod tests {
         assert_eq!(uniform[3].slot[0], 1);
         assert_eq!(uniform[0].specular, [0.0; 4]);
         let many: Vec<Material> = (0..MAX_MATERIALS)
-            .map(|i| Material {
-                specular: Rgb::splat(0.1),
-                shininess: 1.0 + i as f32,
-            })
+            .map(|i| Material::phong(Rgb::splat(0.1), 1.0 + i as f32))
             .collect();
         assert!(MaterialTable::new(&many).is_err());
     }
