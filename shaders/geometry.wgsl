@@ -5,6 +5,9 @@
 // and the vertex albedo (the texture's factor) are both multiplied by the texel here. Untextured
 // objects are drawn with a white texel: unchanged.
 //
+// Layered objects (glTF's metallic-roughness) take the same reflection at their equivalent
+// shininess, scaled by the split-sum E, over (1 − metallic)(1 − E) of their PRT radiance.
+//
 // Glossy objects add k_s times their specular occlusion times the prefiltered reflection map of
 // their shininess at the mirror direction (the environment beyond the lights; the lights' lobes
 // are the light pass's), and write their material index into the normal's w.
@@ -102,6 +105,23 @@ fn sh_irradiance_over_pi(n: vec3<f32>) -> vec3<f32> {
     return e;
 }
 
+fn split_sum_texel(i: u32, j: u32) -> vec2<f32> {
+    let k = j * SPLIT_SUM_SIZE + i;
+    let pair = materials.split_sum[k / 2u];
+    return select(pair.xy, pair.zw, (k & 1u) == 1u);
+}
+
+// The split-sum terms (A, B) at n·v and roughness, bilinear between texel centres.
+fn split_sum(cos_v: f32, roughness: f32) -> vec2<f32> {
+    let n = f32(SPLIT_SUM_SIZE);
+    let p = clamp(vec2<f32>(cos_v, roughness) * n - 0.5, vec2<f32>(0.0), vec2<f32>(n - 1.0));
+    let k = min(vec2<u32>(floor(p)), vec2<u32>(SPLIT_SUM_SIZE - 2u));
+    let t = p - vec2<f32>(k);
+    let top = mix(split_sum_texel(k.x, k.y), split_sum_texel(k.x + 1u, k.y), t.x);
+    let bottom = mix(split_sum_texel(k.x, k.y + 1u), split_sum_texel(k.x + 1u, k.y + 1u), t.x);
+    return mix(top, bottom, t.y);
+}
+
 @fragment
 fn fs_main(in: VertexOut) -> FragmentOut {
     return shade(in);
@@ -164,12 +184,33 @@ fn shade(in: VertexOut) -> FragmentOut {
         let sky_cone = asin(sqrt(unoccluded));
         let lobe_cone = 1.0 / sqrt(material.specular.w + 1.0);
         let offset = acos(clamp(dot(r, bent), -1.0, 1.0));
-        let seen = clamp((sky_cone - offset) / (2.0 * lobe_cone) + 0.5, 0.0, 1.0);
+        var seen = clamp((sky_cone - offset) / (2.0 * lobe_cone) + 0.5, 0.0, 1.0);
+        if material.layer.z > 0.5 {
+            // The split sum's E already leaves out the lobe's share below the horizon (GGX's
+            // masking): only what the occluders hide beyond it is theirs, the share seen over
+            // that seen by an unoccluded point (whose sky is the hemisphere around n).
+            let open = clamp((0.5 * GLOSSY_PI - acos(clamp(dot(r, normal), -1.0, 1.0))) / (2.0 * lobe_cone) + 0.5, 0.0, 1.0);
+            seen = select(seen, min(seen / open, 1.0), open > 1e-3);
+        }
         let seen_albedo = in.albedo;
         let occluded_light = select(vec3<f32>(0.0), in.indirect / max(seen_albedo, vec3<f32>(1e-4)), seen_albedo > vec3<f32>(1e-4));
         let occluders = max(occluded_light, vec3<f32>(0.0)) / max(1.0 - unoccluded, 0.05);
         let reflected = seen * environment + (1.0 - seen) * occluders;
-        out.color = out.color + vec4<f32>(material.specular.rgb * reflected, 0.0);
+        if material.layer.z > 0.5 {
+            // The layer reflects E = F₀ A + B of the environment (split sum) and lets the
+            // base below it keep (1 − E) of its PRT radiance, which the bake holds for the
+            // base colour: (1 − metallic) of it is the diffuse colour (CONVENTIONS.md,
+            // "Metallic-roughness materials").
+            let base = in.albedo * texel;
+            let metallic = material.layer.x;
+            let front = front_view(normalize(frame.camera_position.xyz - in.position), normal);
+            let terms = split_sum(dot(normal, front), material.layer.y);
+            let e = layer_f0(base, metallic) * terms.x + terms.y;
+            let diffuse = out.color.xyz * (1.0 - metallic) * (1.0 - e);
+            out.color = vec4<f32>(diffuse + e * reflected, 1.0);
+        } else {
+            out.color = out.color + vec4<f32>(material.specular.rgb * reflected, 0.0);
+        }
     }
     // w: the material index (exact in a half float) for the light pass.
     out.normal = vec4<f32>(normal, f32(in.material));

@@ -1,5 +1,6 @@
 // Second pass, added onto the first: each directional light's contribution
-// (ρ/π · max(0, n·d) + k_s D_s'(r·d)) · power · visibility, the Phong lobe of glossy surfaces
+// (ρ/π · max(0, n·d) + k_s D_s'(r·d)) · power · visibility, or a metallic-roughness surface's
+// f cos (its GGX lobe widened likewise), the Phong lobe of glossy surfaces
 // widened by the source's size (s' < s, still normalised: CONVENTIONS.md, "Glossy materials"), visibility by percentage-closer soft shadows on its
 // shadow map (blocker search, then PCF over the penumbra the source's size gives). Pixels that see no geometry show the environment map.
 
@@ -267,10 +268,14 @@ fn direct_light(pixel: vec2<f32>, depth: f32, proxies_alone: bool) -> Lit {
     let diffuse = albedo / PI;
     let material = materials.entries[u32(normal_and_material.w + 0.5)];
     let glossy = material.specular.r + material.specular.g + material.specular.b > 0.0;
+    let layered = material.layer.z > 0.5;
+    let view = normalize(frame.camera_position.xyz - position);
     var r = vec3<f32>(0.0);
     if glossy {
-        r = mirror_direction(normalize(frame.camera_position.xyz - position), normal);
+        r = mirror_direction(view, normal);
     }
+    let front = front_view(view, normal);
+    let roughness_alpha = max(material.layer.y * material.layer.y, 1e-3);
     let phase = pixel_phase(pixel);
     var sum = vec3<f32>(0.0);
     var without = vec3<f32>(0.0);
@@ -287,7 +292,19 @@ fn direct_light(pixel: vec2<f32>, depth: f32, proxies_alone: bool) -> Lit {
             if SHADOWED {
                 v = visibilities(i, position, normal, phase, proxies_alone);
             }
-            if glossy {
+            if layered {
+                // The layer's lobe widened by the source as the Phong lobe is: its peak
+                // matches Phong's at 1/s = 2α², so the source's variance adds half of itself
+                // to α² (CONVENTIONS.md, "Metallic-roughness materials").
+                let core = lights[i].params.z;
+                let halo = lights[i].source.x;
+                let share = lights[i].source.y;
+                let variance = (share * core * core + (1.0 - share) * halo * halo) / 4.0;
+                let alpha = sqrt(roughness_alpha * roughness_alpha + 0.5 * variance);
+                let f_cos = layer_f_cos(normal, front, direction, albedo, material.layer.x, alpha);
+                sum = sum + f_cos * lights[i].power.xyz * v.x;
+                without = without + f_cos * lights[i].power.xyz * v.y;
+            } else if glossy {
                 // The source's angular variance per axis: core and halo discs (tangents of
                 // their radii) weighted by their shares of the power.
                 let core = lights[i].params.z;

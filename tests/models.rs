@@ -53,7 +53,10 @@ fn document(nodes: Value, buffer_uri: Option<&str>) -> Value {
         }],
         "materials": [{
             "name": "paint",
-            "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.25, 0.8, 1.0] }
+            "pbrMetallicRoughness": {
+                "baseColorFactor": [0.5, 0.25, 0.8, 1.0],
+                "metallicFactor": 0.0
+            }
         }],
         "accessors": [
             { "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
@@ -218,6 +221,67 @@ fn base_colour_textures_decode_from_srgb() {
     let plain = Scene::load(&plain).unwrap();
     assert!(!plain.geometry.is_textured());
     assert_eq!(plain.geometry.objects[0].albedo.to_array(), [0.2, 0.3, 0.4]);
+}
+
+/// glTF's metallic-roughness layer: its factors times the means of their texture's blue
+/// (metallic) and green (roughness) channels, read linearly; glTF's defaults (a rough metal)
+/// where the material gives none; no layer for a rough dielectric (metallic 0, roughness 1);
+/// in a scene, the object's own material or albedo replaces the model's.
+#[test]
+fn metallic_roughness_factors_and_texture_means_give_the_layer() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("t.bin"), buffer()).unwrap();
+    let layer_of = |name: &str, pbr: Value, texture: bool| {
+        let mut doc = document(one_node(), Some("t.bin"));
+        doc["materials"][0]["pbrMetallicRoughness"] = pbr;
+        if texture {
+            doc["images"] = json!([{ "uri": "mr.png" }]);
+            doc["textures"] = json!([{ "source": 0 }]);
+            doc["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"] =
+                json!({ "index": 0 });
+        }
+        let path = dir.path().join(format!("{name}.gltf"));
+        std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
+        load(&path)[0].material.as_ref().unwrap().layer
+    };
+    let layer = layer_of(
+        "f",
+        json!({ "metallicFactor": 0.8, "roughnessFactor": 0.4 }),
+        false,
+    )
+    .unwrap();
+    assert_eq!((layer.metallic, layer.roughness), (0.8, 0.4));
+    let default = layer_of("d", json!({}), false).unwrap();
+    assert_eq!((default.metallic, default.roughness), (1.0, 1.0));
+    assert!(layer_of("r", json!({ "metallicFactor": 0.0 }), false).is_none());
+    // Texels (·, 128, 255) and (·, 64, 0): means 192/510 (green) and 0.5 (blue), not
+    // sRGB-decoded.
+    image::RgbImage::from_raw(2, 1, vec![9, 128, 255, 200, 64, 0])
+        .unwrap()
+        .save(dir.path().join("mr.png"))
+        .unwrap();
+    let textured = layer_of("t", json!({ "roughnessFactor": 0.5 }), true).unwrap();
+    assert!((textured.metallic - 0.5).abs() < 1e-6, "{textured:?}");
+    assert!(
+        (textured.roughness - 0.5 * 192.0 / 510.0).abs() < 1e-6,
+        "{textured:?}"
+    );
+
+    let scene = |name: &str, body: &str| {
+        let path = write_scene(dir.path(), name, &format!("mesh = \"f.gltf\"\n{body}"));
+        Scene::load(&path).unwrap().geometry.objects[0].material
+    };
+    let from_model = scene("m.toml", "");
+    assert_eq!(
+        from_model.layer.map(|l| (l.metallic, l.roughness)),
+        Some((0.8, 0.4))
+    );
+    let own = scene("o.toml", "roughness = 0.2\nmetallic = 0.0");
+    assert_eq!(
+        own.layer.map(|l| (l.metallic, l.roughness)),
+        Some((0.0, 0.2))
+    );
+    assert!(scene("a.toml", "albedo = [0.2, 0.3, 0.4]").layer.is_none());
 }
 
 #[test]

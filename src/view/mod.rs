@@ -406,7 +406,10 @@ impl App {
                 .settings
                 .materials
                 .iter()
-                .map(|m| [m.specular.x, m.specular.y, m.specular.z, m.shininess])
+                .map(|m| match m.layer {
+                    Some(l) => serde_json::json!({ "metallic": l.metallic, "roughness": l.roughness }),
+                    None => serde_json::json!([m.specular.x, m.specular.y, m.specular.z, m.shininess]),
+                })
                 .collect::<Vec<_>>(),
         })
     }

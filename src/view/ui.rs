@@ -268,6 +268,15 @@ impl Panel<'_> {
             });
         let albedo = objects[index].1;
         let material = &mut self.settings.materials[index];
+        if let Some(layer) = &mut material.layer {
+            ui.add(egui::Slider::new(&mut layer.metallic, 0.0..=1.0).text("metallic"));
+            ui.add(egui::Slider::new(&mut layer.roughness, 0.0..=1.0).text("roughness"));
+            ui.label(format!(
+                "base colour {:.2} {:.2} {:.2}",
+                albedo.x, albedo.y, albedo.z
+            ));
+            return;
+        }
         for (c, label) in ["specular R", "specular G", "specular B"]
             .iter()
             .enumerate()

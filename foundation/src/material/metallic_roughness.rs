@@ -229,6 +229,33 @@ pub fn split_sum_terms(cos_v: f32, roughness: f32, samples: u32) -> (f32, f32) {
     ((a / n) as f32, (b / n) as f32)
 }
 
+/// [`split_sum_terms`] averaged over views, cosine-weighted (`2 ∫ (A, B)(μ) μ dμ`): the
+/// layer's hemispherical albedo is `F₀ A + B`. What a layered surface reflects toward other
+/// surfaces in the bake, where its direction is not kept (CONVENTIONS.md, "Metallic-roughness
+/// materials").
+pub fn hemispherical_split_sum(roughness: f32, views: u32, samples: u32) -> (f32, f32) {
+    let views = views.max(1);
+    let (mut a, mut b) = (0.0f64, 0.0f64);
+    for i in 0..views {
+        let mu = (i as f32 + 0.5) / views as f32;
+        let (ai, bi) = split_sum_terms(mu, roughness, samples);
+        a += f64::from(ai * mu);
+        b += f64::from(bi * mu);
+    }
+    let scale = 2.0 / f64::from(views);
+    ((a * scale) as f32, (b * scale) as f32)
+}
+
+/// The Phong exponent whose normalised lobe around the mirror direction has the peak of the
+/// layer's reflected GGX lobe seen along the normal, `D(n)/4 = 1/(4πα²)` per solid angle
+/// against Phong's `(s + 1)/(2π)`: the two cores are then nearly the same Gaussian (GGX's
+/// tails are heavier). What the renderer prefilters the layer's reflection map with (at
+/// least 1: rougher layers are about as wide as a cosine).
+pub fn equivalent_shininess(roughness: f32) -> f32 {
+    let alpha = (roughness * roughness).max(MIN_ALPHA);
+    (0.5 / (alpha * alpha) - 1.0).clamp(1.0, super::MAX_SHININESS)
+}
+
 /// [`split_sum_terms`] tabulated over `n·v` (columns) and roughness (rows), both from 0 to
 /// 1 at the texel centres, read back bilinearly: the table a GPU pass samples.
 #[derive(Debug, Clone, PartialEq)]
@@ -250,6 +277,11 @@ impl SplitSumTable {
             })
             .collect();
         Self { size, terms }
+    }
+
+    /// `(A, B)` of texel `i` (n·v) in row `j` (roughness).
+    pub fn texel(&self, i: usize, j: usize) -> [f32; 2] {
+        self.terms[j.min(self.size - 1) * self.size + i.min(self.size - 1)]
     }
 
     /// `(A, B)` at `cos_v` and `roughness`, bilinear between texel centres (clamped at the

@@ -1,13 +1,16 @@
 //! glTF 2.0 models (`.gltf` with its buffers, or `.glb`) through the `gltf` crate: every
 //! triangle primitive of the default scene, placed by its node transforms, with its texture
-//! coordinates and the material's base colour (factor and texture). Everything else a material
+//! coordinates, the material's base colour (factor and texture) and its metallic-roughness
+//! layer (factors, times the mean of their texture's channels). Everything else a material
 //! says is ignored, with one note per material.
 
 use super::error::MeshError;
 use super::gltf_geometry::{assemble_triangles, check_type, with_flat_normals};
+use super::gltf_material::{decode_srgb, ignored_properties, part_layer};
 use super::gltf_sources::Sources;
 use super::triangle_mesh::RawMesh;
 use crate::color::Rgb;
+use crate::material::Layer;
 use crate::texture::{AlbedoTexture, decode_image};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
@@ -26,7 +29,7 @@ pub struct ModelPart {
     pub material: Option<PartMaterial>,
 }
 
-/// The part of a glTF material hprt uses: the base colour, linear.
+/// The part of a glTF material hprt uses: the base colour, linear, and the layer.
 #[derive(Debug, Clone)]
 pub struct PartMaterial {
     pub name: String,
@@ -34,6 +37,9 @@ pub struct PartMaterial {
     pub base_color: Rgb,
     /// `baseColorTexture`, decoded to linear RGB, if the material has one.
     pub texture: Option<std::sync::Arc<AlbedoTexture>>,
+    /// The metallic-roughness layer (factors times their texture's means); `None` for a rough dielectric
+    /// (metallic 0, roughness 1), drawn as Lambertian.
+    pub layer: Option<Layer>,
 }
 
 /// Extensions that change how geometry is stored: a file that requires one cannot be read.
@@ -339,7 +345,7 @@ impl Loader<'_> {
             let ignored = ignored_properties(material);
             if !ignored.is_empty() {
                 crate::infra::warn_once(format!(
-                    "{}: {name}: hprt renders the base colour only; ignored: {}",
+                    "{}: {name}: hprt does not draw all of this material; ignored: {}",
                     self.path.display(),
                     ignored.join(", ")
                 ));
@@ -358,11 +364,40 @@ impl Loader<'_> {
                 Some(self.texture(&info.texture().source())?)
             }
         };
+        let means = match pbr.metallic_roughness_texture() {
+            None => None,
+            Some(info) => Some(self.channel_means(&info.texture().source())?),
+        };
+        let layer = part_layer(
+            &format!("{}: {name}", self.path.display()),
+            [pbr.metallic_factor(), pbr.roughness_factor()],
+            means,
+        );
         Ok(PartMaterial {
             name,
             base_color: Rgb::new(r, g, b),
             texture,
+            layer,
         })
+    }
+
+    /// The mean of a metallic-roughness texture's blue (metallic) and green (roughness)
+    /// channels, linear (a grey image's one channel for both).
+    fn channel_means(&mut self, image: &gltf::Image) -> Result<[f32; 2], MeshError> {
+        let bytes = self.sources.image_bytes(image, self.buffers)?;
+        let decoded = decode_image(&bytes)
+            .map_err(|e| self.invalid(format!("image {}: {e}", image.index())))?;
+        let rgb = decoded.to_rgb32f();
+        let count = f64::from(rgb.width()) * f64::from(rgb.height());
+        if count == 0.0 {
+            return Err(self.invalid(format!("image {}: it has no pixels", image.index())));
+        }
+        let (mut metallic, mut roughness) = (0.0f64, 0.0f64);
+        for p in rgb.pixels() {
+            metallic += f64::from(p[2]);
+            roughness += f64::from(p[1]);
+        }
+        Ok([(metallic / count) as f32, (roughness / count) as f32])
     }
 
     fn texture(&mut self, image: &gltf::Image) -> Result<std::sync::Arc<AlbedoTexture>, MeshError> {
@@ -382,75 +417,4 @@ impl Loader<'_> {
         self.textures.insert(image.index(), texture.clone());
         Ok(texture)
     }
-}
-
-/// Material properties that would change a render but that hprt ignores.
-fn ignored_properties(material: &gltf::Material) -> Vec<&'static str> {
-    let pbr = material.pbr_metallic_roughness();
-    let mut ignored = Vec::new();
-    if pbr.metallic_factor() != 0.0 || pbr.metallic_roughness_texture().is_some() {
-        ignored.push("metallic");
-    }
-    if pbr.roughness_factor() != 1.0 {
-        ignored.push("roughness");
-    }
-    if material.normal_texture().is_some() {
-        ignored.push("normal texture");
-    }
-    if material.occlusion_texture().is_some() {
-        ignored.push("occlusion texture");
-    }
-    if material.emissive_texture().is_some() || material.emissive_factor() != [0.0; 3] {
-        ignored.push("emission");
-    }
-    if material.alpha_mode() != gltf::material::AlphaMode::Opaque {
-        ignored.push("transparency");
-    }
-    ignored
-}
-
-/// 8- or 16-bit RGB(A) or grey pixels, sRGB-encoded, to linear RGB; `None` for other formats.
-fn decode_srgb(image: &image::DynamicImage) -> Option<AlbedoTexture> {
-    use image::DynamicImage as D;
-    let (channels, bytes_per_channel) = match image {
-        D::ImageLuma8(_) => (1, 1),
-        D::ImageLumaA8(_) => (2, 1),
-        D::ImageRgb8(_) => (3, 1),
-        D::ImageRgba8(_) => (4, 1),
-        D::ImageLuma16(_) => (1, 2),
-        D::ImageLumaA16(_) => (2, 2),
-        D::ImageRgb16(_) => (3, 2),
-        D::ImageRgba16(_) => (4, 2),
-        _ => return None,
-    };
-    let pixels = image.as_bytes();
-    let texel_bytes = channels * bytes_per_channel;
-    let (width, height) = (image.width() as usize, image.height() as usize);
-    if width == 0 || height == 0 || pixels.len() < width * height * texel_bytes {
-        return None;
-    }
-    let channel = |texel: &[u8], c: usize| -> f32 {
-        match bytes_per_channel {
-            1 => f32::from(texel[c]) / 255.0,
-            _ => f32::from(u16::from_ne_bytes([texel[2 * c], texel[2 * c + 1]])) / 65535.0,
-        }
-    };
-    let texels = pixels
-        .chunks_exact(texel_bytes)
-        .take(width * height)
-        .map(|texel| {
-            // Grey (and grey + alpha) images repeat their one channel.
-            let rgb = if channels < 3 {
-                Vec3::splat(channel(texel, 0))
-            } else {
-                Vec3::new(channel(texel, 0), channel(texel, 1), channel(texel, 2))
-            };
-            rgb.map(crate::image_io::srgb_decode)
-        })
-        .collect();
-    Some(AlbedoTexture {
-        width,
-        height,
-        texels,
-    })
 }

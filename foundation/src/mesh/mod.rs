@@ -7,6 +7,7 @@ mod cleanup;
 mod error;
 mod gltf;
 mod gltf_geometry;
+mod gltf_material;
 mod gltf_sources;
 mod obj;
 mod ply;

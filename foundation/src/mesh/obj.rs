@@ -144,6 +144,7 @@ pub(super) fn parse_obj_parts(
                     name: mat.name.clone(),
                     base_color: Rgb::from_array(mat.diffuse.unwrap_or([1.0; 3])),
                     texture,
+                    layer: None,
                 })
             }
         };

@@ -8,7 +8,7 @@ use super::{Scene, SceneError};
 use crate::color::Rgb;
 use crate::infra::limits::{MAX_SCENE_TRIANGLES, ReadError, read_text_file};
 use crate::infra::names::check_file_name;
-use crate::material::{MAX_SHININESS, Material, check_energy};
+use crate::material::{Layer, MAX_SHININESS, Material, check_energy};
 use crate::mesh::{LoadOptions, MeshError, TriangleMesh, annulus_mesh, box_mesh};
 use crate::probe::ProbeSource;
 use glam::{Mat3, Mat4, Vec3};
@@ -247,7 +247,7 @@ fn add_object(
             check_energy(albedo, material.specular)
                 .map_err(|m| invalid(format!("{part_name}: {m}")))?;
         }
-        // An albedo in the scene file replaces the model's material, texture included.
+        let material = part_material(material, colour.is_some(), part.layer);
         match (colour, part.texture) {
             (None, Some(texture)) => {
                 geometry.push_textured_object(part_name, &world, albedo, texture)
@@ -260,6 +260,18 @@ fn add_object(
         }
     }
     Ok(())
+}
+
+/// A part's material: the object's, or the model's layer where the scene file gives no
+/// material (a material there replaces the model's layer, an albedo its whole material,
+/// texture included).
+fn part_material(object: Material, has_colour: bool, model: Option<Layer>) -> Material {
+    match model {
+        Some(layer) if !has_colour && object.is_lambertian() => {
+            Material::metallic_roughness(layer.metallic, layer.roughness)
+        }
+        _ => object,
+    }
 }
 
 /// The material an object asks for: a Phong lobe (its energy is checked against each part's
@@ -366,6 +378,7 @@ fn load_object_parts(
             mesh,
             albedo: None,
             texture: None,
+            layer: None,
         }]
     };
     match (&object.mesh, &object.box_shape, &object.annulus) {

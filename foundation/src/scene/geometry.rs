@@ -2,7 +2,8 @@
 //! albedo, the objects' ranges, textures and materials.
 
 use crate::color::Rgb;
-use crate::material::Material;
+use crate::material::metallic_roughness::{MetallicRoughness, hemispherical_split_sum};
+use crate::material::{Layer, Material};
 use crate::mesh::TriangleMesh;
 use crate::scene::ObjectRole;
 use crate::texture::AlbedoTexture;
@@ -235,9 +236,10 @@ impl SceneMesh {
         }
     }
 
-    /// Whether any object has a specular lobe.
+    /// Whether any object reflects view-dependently (a Phong lobe or a metallic-roughness
+    /// layer): the renderer then prefilters reflection maps, reports measure highlights.
     pub fn is_glossy(&self) -> bool {
-        self.objects.iter().any(|o| o.material.is_glossy())
+        !self.is_lambertian()
     }
 
     /// Per triangle, its object's material.
@@ -247,11 +249,6 @@ impl SceneMesh {
             out[o.triangles.start as usize..o.triangles.end as usize].fill(o.material);
         }
         out
-    }
-
-    /// Whether any object has a metallic-roughness layer.
-    pub fn has_layers(&self) -> bool {
-        self.objects.iter().any(|o| o.material.layer.is_some())
     }
 
     /// Whether every object is Lambertian (no lobe, no layer).
@@ -303,7 +300,8 @@ impl SceneMesh {
     /// its object's albedo, or for a textured object the factor times the texture averaged
     /// around the vertex ([`crate::texture::vertex_average`]); a glossy object adds its
     /// specular reflectance, reflected as if diffusely (its lobe's energy reaches the other
-    /// surfaces; its direction does not: CONVENTIONS.md, "Glossy materials").
+    /// surfaces; its direction does not: CONVENTIONS.md, "Glossy materials"); a layered one
+    /// reflects its layer's hemispherical albedo and the base under it ([`layered_albedo`]).
     pub fn reflected_albedo(&self) -> Vec<Rgb> {
         let mut albedo = self.albedo.clone();
         for o in &self.objects {
@@ -325,8 +323,32 @@ impl SceneMesh {
                 *a += o.material.specular;
             }
         }
+        for o in &self.objects {
+            let Some(layer) = o.material.layer else {
+                continue;
+            };
+            let (a, b) = hemispherical_split_sum(layer.roughness, 16, 256);
+            for base in &mut albedo[o.vertices.start as usize..o.vertices.end as usize] {
+                *base = layered_albedo(*base, layer, (a, b));
+            }
+        }
         albedo
     }
+}
+
+/// What a metallic-roughness surface of base colour `base` reflects in all, over every view
+/// (cosine-weighted): its layer's hemispherical albedo `E = F₀ A + B` and the base under it,
+/// `c_diff (1 − E)` (as the renderer splits them: CONVENTIONS.md, "Metallic-roughness
+/// materials"). `terms`: the layer's [`hemispherical_split_sum`].
+fn layered_albedo(base: Rgb, layer: Layer, terms: (f32, f32)) -> Rgb {
+    let material = MetallicRoughness {
+        base_color: base,
+        metallic: layer.metallic,
+        roughness: layer.roughness,
+    };
+    let (diffuse, f0) = material.diffuse_and_f0();
+    let specular = f0 * terms.0 + Rgb::splat(terms.1);
+    diffuse * (Rgb::ONE - specular) + specular
 }
 
 #[cfg(test)]
@@ -376,5 +398,30 @@ mod tests {
             geometry.mesh.positions[proxies.clone()],
             rest.mesh.positions[proxies]
         );
+    }
+
+    /// A layered object reflects to other surfaces what its layer and base do over every
+    /// view: a white dielectric everything (the layer takes from the base what it reflects),
+    /// a smooth metal the hemispherical mean of Schlick's Fresnel, `F₀ + (1 − F₀)/21`, a
+    /// black dielectric that of `F₀ = 0.04`.
+    #[test]
+    fn layered_objects_reflect_their_hemispherical_albedo() {
+        let cases = [
+            (Rgb::ONE, 0.0, 0.6, 1.0),
+            (Rgb::splat(0.9), 1.0, 0.1, 0.9 + 0.1 / 21.0),
+            (Rgb::ZERO, 0.0, 0.1, 0.04 + 0.96 / 21.0),
+        ];
+        for (base, metallic, roughness, want) in cases {
+            let mut geometry = SceneMesh::default();
+            let cube = box_mesh(Vec3::ZERO, Vec3::ONE, [1; 3], [false; 6]);
+            geometry.push_object("cube".into(), &cube, base);
+            geometry.objects[0].material = Material::metallic_roughness(metallic, roughness);
+            for a in geometry.reflected_albedo() {
+                assert!(
+                    (a - Rgb::splat(want)).abs().max_element() < 0.005 * want,
+                    "base {base}, metallic {metallic}, roughness {roughness}: {a} vs {want}"
+                );
+            }
+        }
     }
 }

@@ -2,6 +2,7 @@
 //! object that names it with the same options.
 
 use crate::color::Rgb;
+use crate::material::Layer;
 use crate::mesh::{self, LoadOptions, MeshCleanup, MeshError, TriangleMesh};
 use crate::texture::AlbedoTexture;
 use std::collections::HashMap;
@@ -16,6 +17,8 @@ pub(super) struct ObjectPart {
     /// The albedo the model file gives (glTF materials); the texture's factor if textured.
     pub(super) albedo: Option<Rgb>,
     pub(super) texture: Option<Arc<AlbedoTexture>>,
+    /// The metallic-roughness layer the model file gives (glTF materials).
+    pub(super) layer: Option<Layer>,
 }
 
 /// The model files a scene has read, by file and the options it was read with: a scene of many
@@ -65,6 +68,7 @@ fn read_model_parts(
             let (mesh, _report) = cleanup.run(path, part.mesh)?;
             Ok(ObjectPart {
                 albedo: part.material.as_ref().map(|m| material_albedo(path, m)),
+                layer: part.material.as_ref().and_then(|m| m.layer),
                 texture: part.material.and_then(|m| m.texture),
                 name: part.name,
                 mesh,

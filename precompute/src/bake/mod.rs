@@ -215,8 +215,8 @@ impl TracedScene {
         let reflected_albedo = geometry.reflected_albedo();
         let mut reflected_direct = traced.direct_transfer(&reflected_albedo, settings.order);
         fill_inside(&mut reflected_direct, &traced.inside, &neighbours);
-        // Textured and glossy scenes reflect toward other surfaces another albedo than the one
-        // their vertices' transfer is stored with.
+        // Textured, glossy and layered scenes reflect toward other surfaces another albedo than
+        // the one their vertices' transfer is stored with.
         let (direct, textured) = if geometry.is_textured() || geometry.is_glossy() {
             let albedo = geometry.albedo.clone();
             let mut direct = traced.direct_transfer(&albedo, settings.order);
@@ -247,13 +247,6 @@ pub fn bake(
     progress: &dyn Progress,
 ) -> Result<(Transfer, BakeStats), BakeError> {
     let start = Instant::now();
-    if geometry.has_layers() {
-        foundation::infra::warn_once(
-            "the bake treats metallic-roughness surfaces as diffuse ones of their base colour \
-             for now (the path tracer, `hprt reference`, draws their GGX layer)"
-                .into(),
-        );
-    }
     let traced = trace(geometry, bvh, settings, progress)?;
     let (transfer, mut stats) = sum_bounces(geometry, settings, traced, progress)?;
     foundation::infra::memory::release_freed_memory();

@@ -460,10 +460,11 @@ mod tests {
             ),
             (Shader::Lights, "Frame", size_of::<uniforms::FrameUniform>()),
             (Shader::Lights, "Light", size_of::<uniforms::LightUniform>()),
+            // The entries' stride and the split-sum table after them.
             (
                 Shader::Lights,
-                "Material",
-                size_of::<materials::MaterialUniform>(),
+                "Materials",
+                size_of::<materials::MaterialsUniform>(),
             ),
             (Shader::Prefilter, "Job", size_of::<reflection_maps::Job>()),
             (Shader::Prefilter, "Job", PREFILTER_JOB_SIZE as usize),

@@ -1,12 +1,15 @@
-//! Glossy materials on the GPU: a uniform table of the scene's distinct specular lobes (entry
-//! 0 the diffuse one), a per-vertex index into it with the vertex's specular occlusion, and the
-//! shininess slots the reflection maps are prefiltered for (`shaders/glossy.wgsl`).
+//! Glossy materials on the GPU: a uniform table of the scene's distinct specular lobes and
+//! metallic-roughness layers (entry 0 the diffuse one) with the layer's split-sum table, a
+//! per-vertex index into it with the vertex's specular occlusion, and the shininess slots the
+//! reflection maps are prefiltered for (`shaders/glossy.wgsl`; a layer's slot is its
+//! roughness's [`equivalent_shininess`]).
 
 use super::error::RenderError;
 use super::pass_helpers::writable_buffer;
-use super::shaders::MAX_MATERIALS;
+use super::shaders::{MAX_MATERIALS, SPLIT_SUM_SIZE};
 use bytemuck::{Pod, Zeroable};
 use foundation::material::Material;
+use foundation::material::metallic_roughness::{SplitSumTable, equivalent_shininess};
 use foundation::scene::SceneMesh;
 use foundation::settings::{InvalidSettings, SettingsProblem};
 use wgpu::util::DeviceExt;
@@ -17,6 +20,45 @@ use wgpu::util::DeviceExt;
 pub(super) struct MaterialUniform {
     specular: [f32; 4],
     slot: [u32; 4],
+    layer: [f32; 4],
+}
+
+/// Visible normals per texel of the table.
+const SPLIT_SUM_SAMPLES: u32 = 512;
+
+/// Matches `Materials` in `shaders/glossy.wgsl`: the entries, then the split-sum table, two
+/// texels `(A, B)` per vector.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(super) struct MaterialsUniform {
+    entries: [MaterialUniform; MAX_MATERIALS],
+    split_sum: [[f32; 4]; SPLIT_SUM_SIZE * SPLIT_SUM_SIZE / 2],
+}
+
+/// The split-sum table, made once per process (a few milliseconds).
+fn split_sum_texels() -> &'static [[f32; 4]; SPLIT_SUM_SIZE * SPLIT_SUM_SIZE / 2] {
+    static TABLE: std::sync::OnceLock<[[f32; 4]; SPLIT_SUM_SIZE * SPLIT_SUM_SIZE / 2]> =
+        std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let table = SplitSumTable::new(SPLIT_SUM_SIZE, SPLIT_SUM_SAMPLES);
+        let mut out = [[0.0; 4]; SPLIT_SUM_SIZE * SPLIT_SUM_SIZE / 2];
+        for (k, pair) in out.iter_mut().enumerate() {
+            for (half, texel) in [2 * k, 2 * k + 1].into_iter().enumerate() {
+                let [a, b] = table.texel(texel % SPLIT_SUM_SIZE, texel / SPLIT_SUM_SIZE);
+                pair[2 * half] = a;
+                pair[2 * half + 1] = b;
+            }
+        }
+        out
+    })
+}
+
+/// The reflection-map shininess of a material with a lobe or a layer.
+fn slot_shininess(m: &Material) -> f32 {
+    match m.layer {
+        Some(layer) => equivalent_shininess(layer.roughness),
+        None => m.shininess,
+    }
 }
 
 /// Per vertex: its material's index and its visibility cone.
@@ -36,7 +78,7 @@ pub(crate) const MATERIAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::Vert
 /// The distinct glossy materials of a set of objects, and each object's index (0: diffuse).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct MaterialTable {
-    /// Distinct glossy materials; table entry `i + 1`.
+    /// Distinct glossy and layered materials; table entry `i + 1`.
     pub glossy: Vec<Material>,
     /// Per object, its entry.
     pub object_entries: Vec<u32>,
@@ -49,15 +91,8 @@ impl MaterialTable {
         let mut glossy: Vec<Material> = Vec::new();
         let mut shininess: Vec<f32> = Vec::new();
         let mut object_entries = Vec::with_capacity(materials.len());
-        if materials.iter().any(|m| m.layer.is_some()) {
-            foundation::infra::warn_once(
-                "the GPU renderer draws metallic-roughness surfaces as diffuse ones of their base \
-                 colour for now (their GGX layer is drawn by the path tracer, `hprt reference`)"
-                    .into(),
-            );
-        }
         for m in materials {
-            if !m.is_glossy() {
+            if m.is_lambertian() {
                 object_entries.push(0);
                 continue;
             }
@@ -68,8 +103,9 @@ impl MaterialTable {
                     glossy.len() - 1
                 }
             };
-            if !shininess.contains(&m.shininess) {
-                shininess.push(m.shininess);
+            let s = slot_shininess(m);
+            if !shininess.contains(&s) {
+                shininess.push(s);
             }
             object_entries.push(i as u32 + 1);
         }
@@ -89,17 +125,27 @@ impl MaterialTable {
         })
     }
 
-    fn uniform(&self) -> Vec<MaterialUniform> {
-        let mut out = vec![MaterialUniform::zeroed(); MAX_MATERIALS];
-        for (entry, m) in out[1..].iter_mut().zip(&self.glossy) {
+    /// Each entry: `k_s` and the slot's shininess (its lobe's width in the specular
+    /// occlusion), the slot, and for a layer (metallic, roughness, 1).
+    fn uniform(&self) -> MaterialsUniform {
+        let mut out = MaterialsUniform {
+            entries: [MaterialUniform::zeroed(); MAX_MATERIALS],
+            split_sum: *split_sum_texels(),
+        };
+        for (entry, m) in out.entries[1..].iter_mut().zip(&self.glossy) {
+            let shininess = slot_shininess(m);
             let slot = self
                 .shininess
                 .iter()
-                .position(|s| *s == m.shininess)
+                .position(|s| *s == shininess)
                 .unwrap_or(0);
+            let layer = m
+                .layer
+                .map_or([0.0; 4], |l| [l.metallic, l.roughness, 1.0, 0.0]);
             *entry = MaterialUniform {
-                specular: m.specular.extend(m.shininess).to_array(),
+                specular: m.specular.extend(shininess).to_array(),
                 slot: [slot as u32, 0, 0, 0],
+                layer,
             };
         }
         out
@@ -133,7 +179,7 @@ impl GpuMaterials {
         let uniform = writable_buffer(
             device,
             "materials",
-            std::mem::size_of::<MaterialUniform>() * MAX_MATERIALS,
+            std::mem::size_of::<MaterialsUniform>(),
             wgpu::BufferUsages::UNIFORM,
         );
         let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -152,11 +198,7 @@ impl GpuMaterials {
 
     /// Uploads the table (call once after [`Self::new`] and after every change).
     pub(crate) fn write(&self, queue: &wgpu::Queue) {
-        queue.write_buffer(
-            &self.uniform,
-            0,
-            bytemuck::cast_slice(&self.table.uniform()),
-        );
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.table.uniform()));
     }
 
     /// Takes each vertex's new bent normal and unoccluded fraction (a turned object's).
@@ -213,13 +255,33 @@ mod tests {
         let table = MaterialTable::new(&[a, Material::DIFFUSE, b, a, c]).unwrap();
         assert_eq!(table.object_entries, [1, 0, 2, 1, 3]);
         assert_eq!(table.shininess, [60.0, 10.0]);
-        let uniform = table.uniform();
+        let uniform = table.uniform().entries;
         assert_eq!(uniform[2].specular, [0.4, 0.4, 0.4, 60.0]);
         assert_eq!(uniform[3].slot[0], 1);
         assert_eq!(uniform[0].specular, [0.0; 4]);
+        assert_eq!(uniform[1].layer, [0.0; 4]);
         let many: Vec<Material> = (0..MAX_MATERIALS)
             .map(|i| Material::phong(Rgb::splat(0.1), 1.0 + i as f32))
             .collect();
         assert!(MaterialTable::new(&many).is_err());
+    }
+
+    /// Layers take entries and slots as lobes do, their slot the roughness's equivalent
+    /// shininess; the table carries the split-sum terms, texel by texel.
+    #[test]
+    fn layers_have_entries_slots_and_the_split_sum_table() {
+        let copper = Material::metallic_roughness(1.0, 0.5);
+        let table = MaterialTable::new(&[Material::DIFFUSE, copper, copper]).unwrap();
+        assert_eq!(table.object_entries, [0, 1, 1]);
+        assert_eq!(table.shininess, [equivalent_shininess(0.5)]);
+        let uniform = table.uniform();
+        assert_eq!(uniform.entries[1].layer, [1.0, 0.5, 1.0, 0.0]);
+        assert_eq!(uniform.entries[1].specular[..3], [0.0; 3]);
+        let reference = SplitSumTable::new(SPLIT_SUM_SIZE, SPLIT_SUM_SAMPLES);
+        let (i, j) = (5, 17);
+        let texel = j * SPLIT_SUM_SIZE + i;
+        let pair = uniform.split_sum[texel / 2];
+        let got = [pair[2 * (texel % 2)], pair[2 * (texel % 2) + 1]];
+        assert_eq!(got, reference.texel(i, j));
     }
 }

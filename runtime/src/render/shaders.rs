@@ -14,6 +14,9 @@ pub(crate) const MAX_GPU_COEFFS: usize = MAX_GPU_ORDER * MAX_GPU_ORDER;
 /// Distinct glossy materials a scene may have (the materials' uniform array; entry 0 is the
 /// diffuse one).
 pub(crate) const MAX_MATERIALS: usize = 32;
+/// Texels per side of the metallic-roughness layer's split-sum table (n·v across, roughness
+/// down).
+pub(crate) const SPLIT_SUM_SIZE: usize = 32;
 /// Invocations per workgroup of the per-vertex transfer pass.
 pub(crate) const TRANSFER_WORKGROUP: u32 = 64;
 /// Workgroups (bands of rows) summing the live composite's ratio floor.
@@ -128,12 +131,15 @@ fn constants() -> String {
          const MAX_LIGHTS: u32 = {MAX_LIGHTS}u;\n\
          const MAX_SH_COEFFS: u32 = {}u;\n\
          const MAX_MATERIALS: u32 = {MAX_MATERIALS}u;\n\
+         const SPLIT_SUM_SIZE: u32 = {SPLIT_SUM_SIZE}u;\n\
+         const SPLIT_SUM_PAIRS: u32 = {}u;\n\
          const TRANSFER_WORKGROUP: u32 = {TRANSFER_WORKGROUP}u;\n\
          const FLOOR_GROUPS: u32 = {FLOOR_GROUPS}u;\n\
          const FLOOR_SUMS: u32 = {FLOOR_SUMS}u;\n\
          const MAX_RATIO: f32 = {};\n\
          const RATIO_FLOOR: f32 = {};\n",
         num_coeffs(MAX_GPU_ORDER),
+        SPLIT_SUM_SIZE * SPLIT_SUM_SIZE / 2,
         wgsl_float(composite::MAX_RATIO),
         wgsl_float(composite::RATIO_FLOOR),
     )

@@ -36,6 +36,8 @@ pub enum SettingError {
     SpecularOutOfRange { name: String, value: String },
     #[error("{name}: shininess {value} outside (0, {MAX_SHININESS}]")]
     ShininessOutOfRange { name: String, value: f32 },
+    #[error("{name}: {value} outside [0, 1]")]
+    FactorOutOfRange { name: String, value: f32 },
 }
 
 /// `value` as a finite number.
@@ -185,8 +187,9 @@ impl ViewSettings {
         Ok(())
     }
 
-    /// `specular:N r,g,b` (or one value for all three) and `shininess:N s`, for object N
-    /// (from 0).
+    /// `specular:N r,g,b` (or one value for all three) and `shininess:N s`, or the
+    /// metallic-roughness layer's `metallic:N m` and `roughness:N r` (a layer replaces a
+    /// Phong lobe, from glTF's defaults, 1 and 1), for object N (from 0).
     fn set_material(&mut self, name: &str, value: &str) -> Result<(), SettingError> {
         let unknown = || SettingError::Unknown(name.to_owned());
         let (what, index) = name.split_once(':').ok_or_else(unknown)?;
@@ -210,6 +213,23 @@ impl ViewSettings {
                     });
                 }
                 material.shininess = s;
+            }
+            "metallic" | "roughness" => {
+                let f = finite(name, value)?;
+                if !(0.0..=1.0).contains(&f) {
+                    return Err(SettingError::FactorOutOfRange {
+                        name: name.to_owned(),
+                        value: f,
+                    });
+                }
+                let layer = material.layer.unwrap_or(foundation::material::Layer {
+                    metallic: 1.0,
+                    roughness: 1.0,
+                });
+                *material = match what {
+                    "metallic" => Material::metallic_roughness(f, layer.roughness),
+                    _ => Material::metallic_roughness(layer.metallic, f),
+                };
             }
             _ => return Err(unknown()),
         }
@@ -334,6 +354,10 @@ mod tests {
         assert_eq!(s.materials[1].specular, Rgb::new(0.1, 0.2, 0.3));
         assert_eq!(s.materials[1].shininess, 60.0);
         assert_eq!(s.materials[0].specular, Rgb::splat(0.25));
+        s.set("roughness:0", "0.3").unwrap();
+        assert_eq!(s.materials[0], Material::metallic_roughness(1.0, 0.3));
+        s.set("metallic:0", "0").unwrap();
+        assert_eq!(s.materials[0], Material::metallic_roughness(0.0, 0.3));
         for (name, value) in [
             ("specular:2", "0.1"),
             ("specular:x", "0.1"),
@@ -341,6 +365,8 @@ mod tests {
             ("specular:0", "0.1,0.2"),
             ("shininess:0", "0"),
             ("gloss:0", "1"),
+            ("metallic:0", "1.5"),
+            ("roughness:0", "nan"),
         ] {
             assert!(s.set(name, value).is_err(), "{name} {value}");
         }

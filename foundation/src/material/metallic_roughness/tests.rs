@@ -219,3 +219,62 @@ fn split_sum_terms_give_the_specular_albedo() {
         "({a}, {b}) vs ({ea}, {eb})"
     );
 }
+
+/// The cosine-weighted mean over views of the split-sum terms is the layer's hemispherical
+/// albedo: against the midpoint rule over views of the quadrature of `f cos` of a metal.
+#[test]
+fn hemispherical_terms_give_the_layer_albedo() {
+    for roughness in [0.3, 0.8] {
+        let (a, b) = hemispherical_split_sum(roughness, 32, 1024);
+        let f0 = 0.7;
+        let metal = MetallicRoughness {
+            base_color: Rgb::splat(f0),
+            metallic: 1.0,
+            roughness,
+        };
+        let views = 12;
+        let mut albedo = 0.0;
+        for i in 0..views {
+            let mu = (i as f32 + 0.5) / views as f32;
+            let v = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+            let bsdf = MetallicRoughnessBsdf::new(Vec3::Z, &metal, v);
+            albedo += 2.0 * f64::from(mu) * hemisphere(|w| f64::from(bsdf.eval(w).specular.x));
+        }
+        albedo /= f64::from(views);
+        let split = f64::from(f0 * a + b);
+        assert!(
+            (split / albedo - 1.0).abs() < 0.01,
+            "roughness {roughness}: {split} vs {albedo}"
+        );
+    }
+}
+
+/// The equivalent Phong exponent gives the reflected GGX lobe's peak where the layer is
+/// smooth (seen along the normal: the lobe is `D` carried to the reflected direction), and is
+/// clamped to a cosine where it is rough.
+#[test]
+fn equivalent_shininess_matches_the_peak_of_smooth_layers() {
+    for roughness in [0.15, 0.3, 0.5] {
+        let alpha = roughness * roughness;
+        // The reflected direction's density at normal view: D(h) (n·h) / (4 v·h) per solid
+        // angle of l, with h halfway between l and the normal.
+        let density = |l: Vec3| {
+            let h = (l + Vec3::Z).normalize();
+            f64::from(ggx_distribution(h.z, alpha) * h.z / (4.0 * h.z))
+        };
+        // Normalised (a rougher lobe loses some of it below the horizon).
+        if roughness <= 0.3 {
+            let mass = hemisphere(density);
+            assert!((mass - 1.0).abs() < 0.01, "roughness {roughness}: {mass}");
+        }
+        let s = equivalent_shininess(roughness);
+        let phong = (f64::from(s) + 1.0) / std::f64::consts::TAU;
+        let peak = density(Vec3::Z);
+        assert!(
+            (phong / peak - 1.0).abs() < 0.01,
+            "roughness {roughness}: s {s} peaks at {phong}, the lobe at {peak}"
+        );
+    }
+    assert_eq!(equivalent_shininess(1.0), 1.0);
+    assert!(equivalent_shininess(0.0) <= crate::material::MAX_SHININESS);
+}
