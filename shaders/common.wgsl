@@ -8,7 +8,8 @@ struct Frame {
     // image centre's neighbouring pixels, then unused.
     env_rotation: vec4<f32>,
     light_count: u32,
-    // Bit 1: show the environment behind the scene.
+    // Bit 1: show the environment behind the scene; bit 3: reflections not occluded by the
+    // bake (the "ibl" peer).
     flags: u32,
     // PCF kernel: taps per side (odd).
     pcf_taps: u32,

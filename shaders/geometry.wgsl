@@ -195,6 +195,10 @@ fn shade(in: VertexOut) -> FragmentOut {
         let seen_albedo = in.albedo;
         let occluded_light = select(vec3<f32>(0.0), in.indirect / max(seen_albedo, vec3<f32>(1e-4)), seen_albedo > vec3<f32>(1e-4));
         let occluders = max(occluded_light, vec3<f32>(0.0)) / max(1.0 - unoccluded, 0.05);
+        // The "ibl" peer: no occlusion from the bake.
+        if (frame.flags & 8u) != 0u {
+            seen = 1.0;
+        }
         let reflected = seen * environment + (1.0 - seen) * occluders;
         if material.layer.z > 0.5 {
             // The layer reflects E = F₀ A + B of the environment (split sum) and lets the

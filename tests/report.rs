@@ -192,7 +192,8 @@ fn report_measures_shadows_and_survives_bad_maps() {
             "hybrid/consistent",
             "median-cut/8",
             "median-cut/32",
-            "sh-sun"
+            "sh-sun",
+            "ibl"
         ]
     );
     let mut shadow_errors = Vec::new();

@@ -82,7 +82,7 @@ impl Renderer {
     /// float32` array), decomposed here, or a `Decomposition` (one of `hprt.decompose`'s, or
     /// SH and lights of your own, drawn over `background`, a map, black when not given).
     /// `mode`: "hybrid" (SH part plus shadow-mapped lights), "prt" (the whole map through
-    /// the transfer), "unshadowed", "lights", or a peer ("median-cut", "sh-sun"; a map only).
+    /// the transfer), "unshadowed", "lights", or a peer ("median-cut", "sh-sun", "ibl"; a map only).
     /// Returns the linear radiance image, `(height, width, 3) float32`.
     #[pyo3(signature = (lighting, mode = "hybrid", rotation_deg = None, decompose_mode = "consistent", camera = None, background = None))]
     #[allow(clippy::too_many_arguments)]

@@ -19,6 +19,8 @@ pub enum Technique {
     MedianCut(usize),
     /// One shadowed light plus unshadowed order-3 SH irradiance.
     ShSun,
+    /// Order-3 SH irradiance by the normal and the prefiltered map, nothing shadowed.
+    Ibl,
 }
 
 impl Technique {
@@ -29,6 +31,7 @@ impl Technique {
             Technique::Hybrid { .. } => RenderMode::Hybrid,
             Technique::MedianCut(_) => RenderMode::MedianCut,
             Technique::ShSun => RenderMode::ShSun,
+            Technique::Ibl => RenderMode::Ibl,
         }
     }
 
@@ -61,7 +64,7 @@ impl Technique {
         match self {
             Technique::MedianCut(count) => lighting.set_median_cut_lights(count)?,
             Technique::ShSun => lighting.set_median_cut_lights(1)?,
-            Technique::Prt | Technique::Hybrid { .. } => {
+            Technique::Prt | Technique::Ibl | Technique::Hybrid { .. } => {
                 lighting.set_settings(self.decompose_settings(order, threshold))?
             }
         }
@@ -158,7 +161,7 @@ pub struct Peer {
 }
 
 /// The peers, in the tables' order.
-pub const PEERS: [Peer; 3] = [
+pub const PEERS: [Peer; 4] = [
     Peer {
         method: Method::new("median-cut/8", "median-cut-8", Technique::MedianCut(8)),
         families: PeerFamilies {
@@ -176,6 +179,14 @@ pub const PEERS: [Peer; 3] = [
     },
     Peer {
         method: Method::new("sh-sun", "sh-sun", Technique::ShSun),
+        families: PeerFamilies {
+            sequence: false,
+            path: None,
+        },
+    },
+    // What Filament, three.js and Bevy draw.
+    Peer {
+        method: Method::new("ibl", "ibl", Technique::Ibl),
         families: PeerFamilies {
             sequence: false,
             path: None,

@@ -170,7 +170,7 @@ impl Viewer {
         }
     }
 
-    /// "hybrid", "prt", "median-cut", "sh-sun" (or any `hprt render --mode`).
+    /// "hybrid", "prt", "median-cut", "sh-sun", "ibl" (or any `hprt render --mode`).
     pub fn set_mode(&mut self, mode: &str) -> Result<(), JsError> {
         self.mode = mode.parse().map_err(js_error)?;
         self.lighting_stale = true;

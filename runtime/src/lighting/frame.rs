@@ -33,13 +33,17 @@ foundation::named_enum! {
         /// Peer: one shadowed light plus unshadowed order-3 SH irradiance
         /// ([`crate::peers::sh_sun`]).
         ShSun = "sh-sun",
+        /// Peer: image-based lighting as engines without a bake draw it (Filament, three.js,
+        /// Bevy): order-3 SH irradiance by the normal and the whole map prefiltered for
+        /// glossy and layered surfaces (split sum), nothing shadowed or occluded.
+        Ibl = "ibl",
     }
 }
 
 impl RenderMode {
     /// Whether the mode needs the decomposition (else only the plain projection).
     pub fn uses_lights(self) -> bool {
-        self != RenderMode::Prt
+        !matches!(self, RenderMode::Prt | RenderMode::Ibl)
     }
 }
 
@@ -52,6 +56,16 @@ pub enum ShTransfer {
     /// None: bands 0–2 applied per pixel by the normal, unshadowed (irradiance by the
     /// normal, as engines apply SH without a bake).
     Unshadowed,
+    /// None at all: as [`Self::Unshadowed`], and reflections not occluded by the bake's
+    /// visibility cones either (the "ibl" peer).
+    Unbaked,
+}
+
+impl ShTransfer {
+    /// Whether bands 0–2 are applied per pixel by the normal instead of the bake.
+    pub fn per_pixel(self) -> bool {
+        self != ShTransfer::Baked
+    }
 }
 
 /// Whether a mode's lights send their bounce light through the bake's indirect transfer unless
@@ -100,6 +114,19 @@ impl FrameLighting {
         }
     }
 
+    /// The "ibl" peer: `projection` cut to order 3 per pixel by the normal, `reflections`
+    /// (the whole map) unoccluded, no lights.
+    pub fn ibl(projection: &ShCoeffs<Rgb>, reflections: ReflectedEnvironment) -> Self {
+        Self {
+            sh: projection.with_order(3),
+            lights: Vec::new(),
+            lights_indirect: false,
+            shadows: false,
+            sh_transfer: ShTransfer::Unbaked,
+            reflections,
+        }
+    }
+
     /// Lights alone, shadowed, without bounce light (median cut).
     pub fn lights_only(order: usize, lights: Vec<DirectionalLight>) -> Self {
         Self {
@@ -145,6 +172,12 @@ impl FrameLighting {
                 Self::lights_only(decomposition.sh.order(), decomposition.lights.clone())
             }
             RenderMode::ShSun => Self::sh_sun(decomposition),
+            // Without a map at hand, the projection stands for it in the reflections too;
+            // [`EnvironmentLighting::frame`] gives the prefiltered map.
+            RenderMode::Ibl => Self::ibl(
+                projection,
+                ReflectedEnvironment::Sh(projection.with_order(3)),
+            ),
         }
     }
 

@@ -65,6 +65,8 @@ struct ReflectionSource {
     geometry: CubeGeometry,
     cube: CubeMap,
     remainder: Option<(Vec<DirectionalLight>, ShCoeffs<Rgb>, SharedCube)>,
+    /// The whole map, shared (the "ibl" peer's reflections).
+    whole: Option<SharedCube>,
 }
 
 /// Everything made from the current map in its own frame (and, for `tracked`, at the current
@@ -384,6 +386,32 @@ impl EnvironmentLighting {
         rotate_decomposition(base, self.orientation)
     }
 
+    /// The whole map, in its own frame, for reflections (`None` without reflection maps).
+    fn whole_map(&mut self) -> Option<ReflectedEnvironment> {
+        let size = self.reflection_size?;
+        let source = self.reflection_source(size);
+        let cube = source
+            .whole
+            .get_or_insert_with(|| SharedCube(Arc::new(source.cube.clone())))
+            .clone();
+        Some(ReflectedEnvironment::Remainder {
+            cube,
+            orientation: self.orientation,
+        })
+    }
+
+    /// The map as a cube of `size` texels a face, made on first use.
+    fn reflection_source(&mut self, size: usize) -> &mut ReflectionSource {
+        self.derived
+            .reflection
+            .get_or_insert_with(|| ReflectionSource {
+                geometry: CubeGeometry::new(size),
+                cube: CubeSource::new(&self.map, size).cube(0.0),
+                remainder: None,
+                whole: None,
+            })
+    }
+
     /// The map's remainder beyond the lights of `world` (a decomposition at the current
     /// orientation), in the map's own frame; remade only when the lights or SH part change
     /// in the map's frame, so a turning map reuses it.
@@ -400,14 +428,7 @@ impl EnvironmentLighting {
                 (back.lights, back.sh)
             }
         };
-        let source = self
-            .derived
-            .reflection
-            .get_or_insert_with(|| ReflectionSource {
-                geometry: CubeGeometry::new(size),
-                cube: CubeSource::new(&self.map, size).cube(0.0),
-                remainder: None,
-            });
+        let source = self.reflection_source(size);
         let cube = match &source.remainder {
             Some((l, s, cube)) if *l == lights && *s == sh => cube.clone(),
             _ => {
@@ -434,8 +455,17 @@ impl EnvironmentLighting {
         let start = Instant::now();
         if !mode.uses_lights() {
             let projection = self.project();
+            let lighting = match mode {
+                RenderMode::Ibl => {
+                    let reflections = self
+                        .whole_map()
+                        .unwrap_or_else(|| ReflectedEnvironment::Sh(projection.with_order(3)));
+                    FrameLighting::ibl(&projection, reflections)
+                }
+                _ => FrameLighting::prt(projection),
+            };
             return LitFrame {
-                lighting: FrameLighting::prt(projection),
+                lighting,
                 decomposition: None,
                 ms: start.elapsed().as_secs_f64() * 1e3,
             };

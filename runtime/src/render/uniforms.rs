@@ -113,6 +113,8 @@ pub(crate) struct FrameParameters<'a> {
     /// SH lighting (bands 0–2 used) applied per pixel by the normal, unshadowed, instead of
     /// the per-vertex transfer ([`crate::lighting::ShTransfer::Unshadowed`]).
     pub sh_per_pixel: Option<&'a ShCoeffs<Rgb>>,
+    /// Reflections not occluded by the bake's visibility cones (the "ibl" peer).
+    pub unoccluded_reflections: bool,
     /// World → the reflection maps' frame.
     pub reflection_to_map: Mat4,
 }
@@ -143,7 +145,9 @@ impl FrameUniform {
             viewport: [w, h, 1.0 / w, 1.0 / h],
             env_rotation: [cos, sin, centre_pixel_angle(p.camera), 0.0],
             light_count: p.light_count as u32,
-            flags: (u32::from(p.background) << 1) | (u32::from(p.sh_per_pixel.is_some()) << 2),
+            flags: (u32::from(p.background) << 1)
+                | (u32::from(p.sh_per_pixel.is_some()) << 2)
+                | (u32::from(p.unoccluded_reflections) << 3),
             pcf_taps: p.pcf_taps,
             proxy_layers: p.proxy_layers,
             sh_irradiance: p.sh_per_pixel.map_or([[0.0; 4]; 9], irradiance_over_pi),
