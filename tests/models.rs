@@ -341,6 +341,22 @@ fn malformed_and_unsupported_files_fail_clearly_without_output() {
         vec!["missing.gltf", "buffer 0", "nowhere.bin"],
     ));
 
+    // A metallic-roughness texture whose image is missing, or not an image.
+    for (file, uri, needle) in [
+        ("no_mr.gltf", "absent.png", "absent.png"),
+        ("bad_mr.gltf", "missing.gltf", "image 0"),
+    ] {
+        let mut doc = document(one_node(), Some("t.bin"));
+        std::fs::write(d.join("t.bin"), buffer()).unwrap();
+        doc["images"] = json!([{ "uri": uri }]);
+        doc["textures"] = json!([{ "source": 0 }]);
+        doc["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"] =
+            json!({ "index": 0 });
+        let path = d.join(file);
+        std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
+        cases.push((path, vec![file, needle]));
+    }
+
     for (path, needles) in cases {
         // The library says what is wrong, naming the file.
         let message = read_model(&path, &LoadOptions::default())

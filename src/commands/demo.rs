@@ -79,6 +79,10 @@ const GLOSSY_TEAPOT: &str = "scenes/teapot_glossy.toml";
 const GLOSSY_DRAGON: &str = "scenes/dragon_glossy.toml";
 const GLOSSY_DRAGON_MAP: &str = "scenes/env/sunrise.exr";
 const GLOSSY_DRAGON_SPP: u32 = 512;
+/// glTF's metallic-roughness material: a copper teapot under one map, a quick reference.
+const PBR_TEAPOT: &str = "scenes/teapot_pbr.toml";
+const PBR_TEAPOT_MAP: &str = "scenes/env/sunrise.exr";
+const PBR_TEAPOT_SPP: u32 = 512;
 /// Capture: photographs of the interior map (synthetic, through a known response; exposure
 /// times in their EXIF) captured back into a map, decomposed against the map photographed,
 /// and the teapot's report under it.
@@ -198,7 +202,8 @@ fn run_logged(script: &Path, log: &Path) -> anyhow::Result<()> {
 }
 
 /// Glossy materials: shadowed highlights from the lights, prefiltered reflections of the
-/// rest, against the path tracer's Phong lobe; the teapot under `envs`, the dragon under one.
+/// rest, against the path tracer's Phong lobe; the teapot under `envs`, the dragon under one;
+/// then the copper teapot (glTF's metallic-roughness material) under one.
 fn demo_glossy(output: &Path, envs: &[PathBuf], options: &ReportOptions) -> anyhow::Result<()> {
     println!("\nthe glossy teapot {GLOSSY_TEAPOT}:");
     let teapot = load_scene(&bundled(GLOSSY_TEAPOT))?;
@@ -217,6 +222,18 @@ fn demo_glossy(output: &Path, envs: &[PathBuf], options: &ReportOptions) -> anyh
         &[bundled(GLOSSY_DRAGON_MAP)],
         &dragon_options,
         &output.join("dragon-glossy"),
+    )?;
+    println!("\nthe PBR teapot {PBR_TEAPOT}:");
+    let pbr = load_scene(&bundled(PBR_TEAPOT))?;
+    let pbr_options = ReportOptions {
+        spp: PBR_TEAPOT_SPP,
+        ..dragon_options
+    };
+    write_report(
+        &pbr,
+        &[bundled(PBR_TEAPOT_MAP)],
+        &pbr_options,
+        &output.join("teapot-pbr"),
     )?;
     Ok(())
 }

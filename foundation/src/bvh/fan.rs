@@ -38,7 +38,10 @@
 //! Embree 4.4's single-ray closest hit traced 3.91 M rays/s. Tracing a packet's lanes alone
 //! once two or three remain, rather than one, was no faster on the bundled dragon at 64
 //! samples, where packets part most (2.05–2.34 against 2.20–2.46 M rays/s, measured beside
-//! another job).
+//! another job). Ordering a fan's rays coherently (by the Morton code of each ray's point on
+//! the projected disk, its hits scattered back so the bake's bits stay the same) helped the
+//! bundled dragon at 64 samples a little (3.62 to 3.66 and 3.38 to 3.58 M rays/s) and hurt
+//! at 1024 samples (5.34 to 4.91) and on the 871k dragon at 64 (3.58 to 3.24): not kept.
 //!
 //! Earlier attempts, answers unchanged each time (2026-12-03, Zen 1): an eight-wide tree for
 //! the fans, 5–10% slower than these packets, which test each child box for their eight

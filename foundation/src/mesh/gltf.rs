@@ -387,17 +387,18 @@ impl Loader<'_> {
         let bytes = self.sources.image_bytes(image, self.buffers)?;
         let decoded = decode_image(&bytes)
             .map_err(|e| self.invalid(format!("image {}: {e}", image.index())))?;
-        let rgb = decoded.to_rgb32f();
-        let count = f64::from(rgb.width()) * f64::from(rgb.height());
+        let count = f64::from(decoded.width()) * f64::from(decoded.height());
         if count == 0.0 {
             return Err(self.invalid(format!("image {}: it has no pixels", image.index())));
         }
-        let (mut metallic, mut roughness) = (0.0f64, 0.0f64);
-        for p in rgb.pixels() {
-            metallic += f64::from(p[2]);
-            roughness += f64::from(p[1]);
+        // Pixel by pixel as 8-bit RGBA (grey repeated): no copy of a large image.
+        let (mut metallic, mut roughness) = (0u64, 0u64);
+        for (_, _, p) in image::GenericImageView::pixels(&decoded) {
+            metallic += u64::from(p[2]);
+            roughness += u64::from(p[1]);
         }
-        Ok([(metallic / count) as f32, (roughness / count) as f32])
+        let mean = |sum: u64| (sum as f64 / count / 255.0) as f32;
+        Ok([mean(metallic), mean(roughness)])
     }
 
     fn texture(&mut self, image: &gltf::Image) -> Result<std::sync::Arc<AlbedoTexture>, MeshError> {
