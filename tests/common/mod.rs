@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod composite;
+pub mod spheres;
 pub mod viewer;
 
 use std::path::{Path, PathBuf};
