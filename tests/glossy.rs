@@ -4,10 +4,10 @@ mod common;
 
 use common::spheres::*;
 use common::*;
+use foundation::Rgb;
 use foundation::envmap::EnvMap;
 use foundation::material::{Material, phong_zonal};
 use foundation::sh::ShCoeffs;
-use foundation::Rgb;
 use glam::{Quat, Vec3};
 use runtime::render::{FrameLighting, RenderMode};
 use runtime::{CubeGeometry, CubeMap, DecomposeSettings, EnvironmentLighting};
