@@ -107,6 +107,13 @@ class SceneObject:
     @property
     def shininess(self) -> float: ...
     @property
+    def metallic(self) -> float | None:
+        """glTF's metallic factor of the object's metallic-roughness layer (None without one;
+        the albedo is then its base colour)."""
+    @property
+    def roughness(self) -> float | None:
+        """The layer's perceptual roughness (None without a layer)."""
+    @property
     def vertex_count(self) -> int: ...
     @property
     def triangle_count(self) -> int: ...

@@ -91,8 +91,8 @@ impl Scene {
     }
 }
 
-/// One object of a scene: its part of the mesh, its role and its material (the Phong
-/// material: a diffuse albedo, or texture factor, plus a specular lobe).
+/// One object of a scene: its part of the mesh, its role and its material (a diffuse albedo,
+/// or texture factor, plus a Phong lobe or glTF's metallic-roughness layer).
 #[pyclass(module = "hprt", frozen, get_all)]
 #[derive(Clone)]
 pub(crate) struct SceneObject {
@@ -105,6 +105,10 @@ pub(crate) struct SceneObject {
     /// Phong `k_s` per channel (zero: diffuse) and exponent.
     specular: [f32; 3],
     shininess: f32,
+    /// The metallic-roughness layer's factors (`None` without one; the albedo is then the
+    /// base colour).
+    metallic: Option<f32>,
+    roughness: Option<f32>,
     vertex_count: u32,
     triangle_count: u32,
 }
@@ -121,6 +125,8 @@ impl From<&foundation::scene::SceneObject> for SceneObject {
             textured: o.texture.is_some(),
             specular: o.material.specular.to_array(),
             shininess: o.material.shininess,
+            metallic: o.material.layer.map(|l| l.metallic),
+            roughness: o.material.layer.map(|l| l.roughness),
             vertex_count: o.vertices.end - o.vertices.start,
             triangle_count: o.triangles.end - o.triangles.start,
         }

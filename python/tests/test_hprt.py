@@ -277,6 +277,14 @@ class BakeAndRender(unittest.TestCase):
         glossy = hprt.load_scene(SCENES / "teapot_glossy.toml")
         shiny = [o for o in glossy.objects if max(o.specular) > 0.0]
         self.assertTrue(shiny and all(o.shininess > 1.0 for o in shiny))
+        self.assertTrue(all(o.metallic is None for o in glossy.objects))
+        pbr = hprt.load_scene(SCENES / "teapot_pbr.toml")
+        teapot = next(o for o in pbr.objects if o.name == "teapot")
+        self.assertEqual(teapot.metallic, 1.0)
+        self.assertAlmostEqual(teapot.roughness or 0.0, 0.35, places=6)
+        table = next(o for o in pbr.objects if o.name == "table top")
+        self.assertIsNone(table.metallic)
+        self.assertIsNone(table.roughness)
 
     def test_a_missing_file_is_a_file_not_found_error(self) -> None:
         with self.assertRaisesRegex(hprt.HprtError, "no_such_scene.toml"):
