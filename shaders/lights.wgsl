@@ -256,6 +256,15 @@ fn visibilities(index: u32, position: vec3<f32>, normal: vec3<f32>, phase: f32, 
     return v;
 }
 
+// A light's angular variance per axis: its core and halo discs (tangents of their radii)
+// weighted by their shares of the power. What widens a glossy lobe toward it.
+fn source_variance(light: Light) -> f32 {
+    let core = light.params.z;
+    let halo = light.source.x;
+    let share = light.source.y;
+    return (share * core * core + (1.0 - share) * halo * halo) / 4.0;
+}
+
 // Every light's direct contribution at the surface the G-buffer holds at `pixel`, and with
 // `proxies_alone` also as the proxies alone receive it.
 fn direct_light(pixel: vec2<f32>, depth: f32, proxies_alone: bool) -> Lit {
@@ -296,22 +305,12 @@ fn direct_light(pixel: vec2<f32>, depth: f32, proxies_alone: bool) -> Lit {
                 // The layer's lobe widened by the source as the Phong lobe is: its peak
                 // matches Phong's at 1/s = 2α², so the source's variance adds half of itself
                 // to α² (CONVENTIONS.md, "Metallic-roughness materials").
-                let core = lights[i].params.z;
-                let halo = lights[i].source.x;
-                let share = lights[i].source.y;
-                let variance = (share * core * core + (1.0 - share) * halo * halo) / 4.0;
-                let alpha = sqrt(roughness_alpha * roughness_alpha + 0.5 * variance);
+                let alpha = sqrt(roughness_alpha * roughness_alpha + 0.5 * source_variance(lights[i]));
                 let f_cos = layer_f_cos(normal, front, direction, albedo, material.layer.x, alpha);
                 sum = sum + f_cos * lights[i].power.xyz * v.x;
                 without = without + f_cos * lights[i].power.xyz * v.y;
             } else if glossy {
-                // The source's angular variance per axis: core and halo discs (tangents of
-                // their radii) weighted by their shares of the power.
-                let core = lights[i].params.z;
-                let halo = lights[i].source.x;
-                let share = lights[i].source.y;
-                let variance = (share * core * core + (1.0 - share) * halo * halo) / 4.0;
-                let shininess = 1.0 / (1.0 / material.specular.w + variance);
+                let shininess = 1.0 / (1.0 / material.specular.w + source_variance(lights[i]));
                 let specular = material.specular.rgb * phong_lobe(dot(r, direction), shininess);
                 sum = sum + (diffuse * cosine + specular) * lights[i].power.xyz * v.x;
                 without = without + (diffuse * cosine + specular) * lights[i].power.xyz * v.y;

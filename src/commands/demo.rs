@@ -208,34 +208,44 @@ fn demo_glossy(output: &Path, envs: &[PathBuf], options: &ReportOptions) -> anyh
     println!("\nthe glossy teapot {GLOSSY_TEAPOT}:");
     let teapot = load_scene(&bundled(GLOSSY_TEAPOT))?;
     write_report(&teapot, envs, options, &output.join("teapot-glossy"))?;
-    println!("\nthe glossy dragon {GLOSSY_DRAGON}:");
-    let dragon = load_scene(&bundled(GLOSSY_DRAGON))?;
-    let dragon_options = ReportOptions {
-        spp: GLOSSY_DRAGON_SPP,
+    quick_report(
+        "glossy dragon",
+        GLOSSY_DRAGON,
+        GLOSSY_DRAGON_MAP,
+        GLOSSY_DRAGON_SPP,
+        options,
+        &output.join("dragon-glossy"),
+    )?;
+    quick_report(
+        "PBR teapot",
+        PBR_TEAPOT,
+        PBR_TEAPOT_MAP,
+        PBR_TEAPOT_SPP,
+        options,
+        &output.join("teapot-pbr"),
+    )
+}
+
+/// The bundled scene `scene`'s report under the bundled map `map` alone, with a quick
+/// reference of `spp` paths per pixel (its noise floor stated in the report).
+fn quick_report(
+    what: &str,
+    scene: &str,
+    map: &str,
+    spp: u32,
+    options: &ReportOptions,
+    dir: &Path,
+) -> anyhow::Result<()> {
+    println!("\nthe {what} {scene}:");
+    let loaded = load_scene(&bundled(scene))?;
+    let quick = ReportOptions {
+        spp,
         target_noise: None,
         thresholds: vec![0.0, 0.05],
         frames: 1,
         ..options.clone()
     };
-    write_report(
-        &dragon,
-        &[bundled(GLOSSY_DRAGON_MAP)],
-        &dragon_options,
-        &output.join("dragon-glossy"),
-    )?;
-    println!("\nthe PBR teapot {PBR_TEAPOT}:");
-    let pbr = load_scene(&bundled(PBR_TEAPOT))?;
-    let pbr_options = ReportOptions {
-        spp: PBR_TEAPOT_SPP,
-        ..dragon_options
-    };
-    write_report(
-        &pbr,
-        &[bundled(PBR_TEAPOT_MAP)],
-        &pbr_options,
-        &output.join("teapot-pbr"),
-    )?;
-    Ok(())
+    write_report(&loaded, &[bundled(map)], &quick, dir)
 }
 
 /// The teapot composited into three maps, and into a photograph taken through its camera.
