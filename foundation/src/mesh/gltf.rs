@@ -106,6 +106,7 @@ fn read_gltf(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, MeshError> {
         sources,
         buffers: &buffers,
         textures: HashMap::new(),
+        channel_means: HashMap::new(),
         noted: Vec::new(),
         parts: Vec::new(),
     };
@@ -143,6 +144,8 @@ struct Loader<'a> {
     buffers: &'a [gltf::buffer::Data],
     /// Decoded base colour textures by image index.
     textures: HashMap<usize, std::sync::Arc<AlbedoTexture>>,
+    /// Metallic-roughness textures' channel means, by image (decoded once).
+    channel_means: HashMap<usize, [f32; 2]>,
     /// Materials already noted for the properties hprt ignores.
     noted: Vec<Option<usize>>,
     parts: Vec<ModelPart>,
@@ -384,6 +387,9 @@ impl Loader<'_> {
     /// The mean of a metallic-roughness texture's blue (metallic) and green (roughness)
     /// channels, linear (a grey image's one channel for both).
     fn channel_means(&mut self, image: &gltf::Image) -> Result<[f32; 2], MeshError> {
+        if let Some(means) = self.channel_means.get(&image.index()) {
+            return Ok(*means);
+        }
         let bytes = self.sources.image_bytes(image, self.buffers)?;
         let decoded = decode_image(&bytes)
             .map_err(|e| self.invalid(format!("image {}: {e}", image.index())))?;
@@ -398,7 +404,9 @@ impl Loader<'_> {
             roughness += u64::from(p[1]);
         }
         let mean = |sum: u64| (sum as f64 / count / 255.0) as f32;
-        Ok([mean(metallic), mean(roughness)])
+        let means = [mean(metallic), mean(roughness)];
+        self.channel_means.insert(image.index(), means);
+        Ok(means)
     }
 
     fn texture(&mut self, image: &gltf::Image) -> Result<std::sync::Arc<AlbedoTexture>, MeshError> {

@@ -14,15 +14,17 @@ pub(super) fn part_layer(
     factors: [f32; 2],
     texture_means: Option<[f32; 2]>,
 ) -> Option<Layer> {
-    let [metallic, roughness] = factors.map(|f| {
-        let clamped = if f.is_nan() { 1.0 } else { f.clamp(0.0, 1.0) };
-        if clamped != f {
-            log::warn!(
-                "{what}: metallic or roughness factor {f} clamped to {clamped}, as glTF does"
-            );
-        }
-        clamped
-    });
+    let [metallic, roughness] =
+        [("metallic", factors[0]), ("roughness", factors[1])].map(|(name, f)| {
+            let clamped = if f.is_nan() { 1.0 } else { f.clamp(0.0, 1.0) };
+            if clamped != f {
+                // Once per material, however many primitives use it.
+                crate::infra::warn_once(format!(
+                    "{what}: {name} factor {f} clamped to {clamped}, as glTF does"
+                ));
+            }
+            clamped
+        });
     let [m, r] = texture_means.unwrap_or([1.0, 1.0]);
     let (metallic, roughness) = (metallic * m.clamp(0.0, 1.0), roughness * r.clamp(0.0, 1.0));
     (metallic > 0.0 || roughness < 1.0).then_some(Layer {
