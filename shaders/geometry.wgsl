@@ -8,6 +8,11 @@
 // Layered objects (glTF's metallic-roughness) take the same reflection at their equivalent
 // shininess, scaled by the split-sum E, over (1 − metallic)(1 − E) of their PRT radiance.
 //
+// Normal-mapped objects shade with the normal their map gives (glTF's tangent space): the
+// G-buffer holds it for the lights, reflections leave by it, and the PRT radiance, baked for the
+// vertex normal, is scaled by the SH irradiance at the mapped normal over that at the vertex
+// normal (CONVENTIONS.md, "Normal maps").
+//
 // Glossy objects add k_s times their specular occlusion times the prefiltered reflection map of
 // their shininess at the mirror direction (the environment beyond the lights; the lights' lobes
 // are the light pass's), and write their material index into the normal's w.
@@ -15,6 +20,9 @@
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(1) @binding(0) var albedo_texture: texture_2d<f32>;
 @group(1) @binding(1) var albedo_sampler: sampler;
+@group(1) @binding(2) var normal_texture: texture_2d<f32>;
+// x: the normal map's scale; y: 1 where the object has a normal map.
+@group(1) @binding(3) var<uniform> surface: vec4<f32>;
 @group(0) @binding(1) var<uniform> materials: Materials;
 // Six layers (one cube) per shininess slot.
 @group(0) @binding(2) var reflection_maps: texture_2d_array<f32>;
@@ -32,6 +40,8 @@ struct VertexIn {
     @location(6) visibility: vec4<f32>,
     // The interreflected part of `radiance`.
     @location(7) indirect: vec4<f32>,
+    // glTF's tangent: xyz along +u, w the bitangent's sign (zero without a normal map).
+    @location(10) tangent: vec4<f32>,
 };
 
 // The live composite's (`vs_composite`): the radiance of the proxies alone (their transfer
@@ -53,6 +63,7 @@ struct VertexOut {
     @location(7) indirect: vec3<f32>,
     @location(8) without_objects: vec3<f32>,
     @location(9) @interpolate(flat) proxy: f32,
+    @location(10) tangent: vec4<f32>,
 };
 
 @vertex
@@ -71,6 +82,7 @@ fn vertex(in: VertexIn) -> VertexOut {
     out.visibility = in.visibility;
     out.position = in.position;
     out.indirect = in.indirect.xyz;
+    out.tangent = in.tangent;
     return out;
 }
 
@@ -159,12 +171,46 @@ fn fs_composite(in: VertexOut) -> CompositeOut {
     return out;
 }
 
+// The shading normal of a tangent-space normal map's texel (`perturbed_normal` in
+// foundation/src/mesh/tangents.rs): the tangent made orthogonal to n, the bitangent
+// cross(n, t) times the sign, x and y scaled; n itself where the frame is degenerate.
+fn perturbed_normal(n: vec3<f32>, tangent: vec4<f32>, texel: vec3<f32>, scale: f32) -> vec3<f32> {
+    let along = tangent.xyz - n * dot(n, tangent.xyz);
+    if dot(along, along) < 1e-12 {
+        return n;
+    }
+    let t = normalize(along);
+    let b = cross(n, t) * select(1.0, -1.0, tangent.w < 0.0);
+    let m = (texel * 2.0 - 1.0) * vec3<f32>(scale, scale, 1.0);
+    let mapped = t * m.x + b * m.y + n * m.z;
+    if dot(mapped, mapped) < 1e-12 {
+        return n;
+    }
+    return normalize(mapped);
+}
+
+// What the PRT radiance, baked for the vertex normal, is scaled by at a mapped normal: the
+// unshadowed SH irradiance's luminance there over at the vertex normal, kept within [0, 4]
+// (1 where the vertex normal sees almost no light).
+fn normal_map_ratio(vertex_normal: vec3<f32>, mapped: vec3<f32>) -> f32 {
+    let weights = vec3<f32>(0.2126, 0.7152, 0.0722);
+    let at_vertex = dot(max(sh_irradiance_over_pi(vertex_normal), vec3<f32>(0.0)), weights);
+    let at_mapped = dot(max(sh_irradiance_over_pi(mapped), vec3<f32>(0.0)), weights);
+    return select(1.0, clamp(at_mapped / at_vertex, 0.0, 4.0), at_vertex > 1e-6);
+}
+
 // The PRT radiance and the G-buffer of one fragment.
 fn shade(in: VertexOut) -> FragmentOut {
     var out: FragmentOut;
-    let normal = normalize(in.normal);
+    let vertex_normal = normalize(in.normal);
     let texel = textureSample(albedo_texture, albedo_sampler, in.uv).rgb;
+    let normal_texel = textureSample(normal_texture, albedo_sampler, in.uv).rgb;
+    var normal = vertex_normal;
     out.color = vec4<f32>(in.radiance * texel, 1.0);
+    if surface.y > 0.5 {
+        normal = perturbed_normal(vertex_normal, in.tangent, normal_texel, surface.x);
+        out.color = vec4<f32>(out.color.xyz * normal_map_ratio(vertex_normal, normal), 1.0);
+    }
     if (frame.flags & 4u) != 0u {
         out.color = vec4<f32>(in.albedo * texel * max(sh_irradiance_over_pi(normal), vec3<f32>(0.0)), 1.0);
     }

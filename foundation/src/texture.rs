@@ -51,8 +51,9 @@ pub fn decode_image_within(
     Ok(reader.decode()?)
 }
 
-/// A base colour texture, decoded from sRGB to linear RGB; rows from the top, so texture
-/// coordinate (0, 0) is the top-left corner of the image (glTF's convention).
+/// An RGB texture: a base colour decoded from sRGB to linear RGB, or a normal map's texels as
+/// they are ([0, 1], 0.5 meaning 0); rows from the top, so texture coordinate (0, 0) is the
+/// top-left corner of the image (glTF's convention).
 #[derive(Debug, Clone, PartialEq)]
 pub struct AlbedoTexture {
     pub width: usize,
@@ -132,6 +133,22 @@ pub(crate) fn vertex_average(
         .zip(&weights)
         .map(|(s, &w)| if w > 0.0 { (*s / w).as_vec3() } else { mean })
         .collect()
+}
+
+/// A tangent-space normal map (glTF's `normalTexture`): its texels, read linearly, and the
+/// scale of their x and y (CONVENTIONS.md, "Normal maps").
+#[derive(Debug, Clone, PartialEq)]
+pub struct NormalMap {
+    pub texture: std::sync::Arc<AlbedoTexture>,
+    pub scale: f32,
+}
+
+impl NormalMap {
+    /// The shading normal at a point with interpolated normal `n`, tangent `tangent` and
+    /// texture coordinates `uv` (the texel looked up as [`AlbedoTexture::bilinear`] does).
+    pub fn shading_normal(&self, n: glam::Vec3, tangent: glam::Vec4, uv: Vec2) -> glam::Vec3 {
+        crate::mesh::perturbed_normal(n, tangent, self.texture.bilinear(uv), self.scale)
+    }
 }
 
 #[cfg(test)]

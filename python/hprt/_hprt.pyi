@@ -114,6 +114,9 @@ class SceneObject:
     def roughness(self) -> float | None:
         """The layer's perceptual roughness (None without a layer)."""
     @property
+    def normal_map_scale(self) -> float | None:
+        """The scale of the object's tangent-space normal map (None without one)."""
+    @property
     def vertex_count(self) -> int: ...
     @property
     def triangle_count(self) -> int: ...

@@ -5,7 +5,7 @@ use crate::errors::hprt_error;
 use crate::progress::with_progress;
 use foundation::bake_settings::BakeSettings;
 use foundation::bvh::SceneBvh;
-use foundation::scene::{ObjectRole, Scene as SceneData};
+use foundation::scene::{ObjectRole, Scene as SceneData, SceneMesh};
 use numpy::ndarray::{Array3, ArrayView3};
 use numpy::{IntoPyArray, PyArray3};
 use precompute::bake::{Transfer, TransferVectors};
@@ -42,7 +42,7 @@ impl Scene {
             .geometry
             .objects
             .iter()
-            .map(SceneObject::from)
+            .map(|o| SceneObject::of(o, &self.data.geometry))
             .collect()
     }
 
@@ -109,12 +109,14 @@ pub(crate) struct SceneObject {
     /// base colour).
     metallic: Option<f32>,
     roughness: Option<f32>,
+    /// The scale of its tangent-space normal map (`None` without one).
+    normal_map_scale: Option<f32>,
     vertex_count: u32,
     triangle_count: u32,
 }
 
-impl From<&foundation::scene::SceneObject> for SceneObject {
-    fn from(o: &foundation::scene::SceneObject) -> Self {
+impl SceneObject {
+    fn of(o: &foundation::scene::SceneObject, geometry: &SceneMesh) -> Self {
         Self {
             name: o.name.clone(),
             role: match o.role {
@@ -127,6 +129,7 @@ impl From<&foundation::scene::SceneObject> for SceneObject {
             shininess: o.material.shininess,
             metallic: o.material.layer.map(|l| l.metallic),
             roughness: o.material.layer.map(|l| l.roughness),
+            normal_map_scale: o.normal_map.map(|m| geometry.normal_maps[m].scale),
             vertex_count: o.vertices.end - o.vertices.start,
             triangle_count: o.triangles.end - o.triangles.start,
         }

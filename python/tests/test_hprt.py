@@ -285,6 +285,11 @@ class BakeAndRender(unittest.TestCase):
         table = next(o for o in pbr.objects if o.name == "table top")
         self.assertIsNone(table.metallic)
         self.assertIsNone(table.roughness)
+        self.assertIsNone(table.normal_map_scale)
+        mirror = hprt.load_scene(SCENES / "models" / "NormalTangentMirrorTest.glb")
+        scales = [o.normal_map_scale for o in mirror.objects]
+        self.assertIn(1.0, scales)  # the panel's map
+        self.assertIn(None, scales)  # the ground slab it stands on
 
     def test_a_missing_file_is_a_file_not_found_error(self) -> None:
         with self.assertRaisesRegex(hprt.HprtError, "no_such_scene.toml"):

@@ -82,6 +82,9 @@ pub struct Integrator<'a> {
     /// Per triangle, its texture in `geometry.textures` or [`NO_TEXTURE`]; empty for an
     /// untextured scene, whose hits then read nothing more than before.
     triangle_textures: Vec<u32>,
+    /// Per triangle, its normal map in `geometry.normal_maps` or [`NO_TEXTURE`]; empty for a
+    /// scene without normal maps.
+    triangle_normal_maps: Vec<u32>,
     /// Per triangle, its material; empty for a diffuse scene.
     triangle_materials: HugePageTable<Material>,
 }
@@ -115,6 +118,10 @@ impl<'a> Integrator<'a> {
                 geometry.triangle_textures()
             } else {
                 Vec::new()
+            },
+            triangle_normal_maps: match geometry.normal_maps.is_empty() {
+                true => Vec::new(),
+                false => geometry.triangle_normal_maps(),
             },
             triangle_materials: if !geometry.is_lambertian() {
                 geometry.triangle_materials()
@@ -151,9 +158,15 @@ impl<'a> Integrator<'a> {
             albedo *= self.geometry.textures[texture as usize].bilinear(uv);
         }
         let front = triangle.front_normal;
+        let mut shading_normal = normal.try_normalize().unwrap_or(front);
+        if let Some(&map) = self.triangle_normal_maps.get(hit.triangle as usize)
+            && map != NO_TEXTURE
+        {
+            shading_normal = self.mapped_normal(hit, shading_normal, map as usize);
+        }
         SurfacePoint {
             position,
-            shading_normal: normal.try_normalize().unwrap_or(front),
+            shading_normal,
             front_normal: front,
             albedo,
             material: self
@@ -163,6 +176,21 @@ impl<'a> Integrator<'a> {
                 .unwrap_or_default(),
             leaving: Skip::Triangle(hit.triangle),
         }
+    }
+
+    /// The shading normal a normal map gives at a hit whose interpolated normal is `n`.
+    fn mapped_normal(&self, hit: &Hit, n: Vec3, map: usize) -> Vec3 {
+        let mesh = &self.geometry.mesh;
+        let corners = mesh.triangles[hit.triangle as usize];
+        let weights = hit.barycentrics();
+        let (mut uv, mut tangent) = (glam::Vec2::ZERO, glam::Vec4::ZERO);
+        for (i, w) in corners.iter().zip(weights) {
+            uv += mesh.uvs[*i as usize] * w;
+            tangent += mesh.tangents[*i as usize] * w;
+        }
+        // The sign is the corners' (one per triangle in a well-made mesh).
+        tangent.w = mesh.tangents[corners[0] as usize].w;
+        self.geometry.normal_maps[map].shading_normal(n, tangent, uv)
     }
 
     /// The point at vertex `v`, with rays leaving as in the bake.

@@ -83,6 +83,10 @@ const GLOSSY_DRAGON_SPP: u32 = 512;
 const PBR_TEAPOT: &str = "scenes/teapot_pbr.toml";
 const PBR_TEAPOT_MAP: &str = "scenes/env/sunrise.exr";
 const PBR_TEAPOT_SPP: u32 = 512;
+/// A public glTF sample with textures and a normal map (mirrored texture coordinates), under
+/// the same map, a quick reference.
+const NORMAL_MAPPED_SAMPLE: &str = "scenes/models/NormalTangentMirrorTest.glb";
+const NORMAL_MAPPED_SAMPLE_SPP: u32 = 256;
 /// Capture: photographs of the interior map (synthetic, through a known response; exposure
 /// times in their EXIF) captured back into a map, decomposed against the map photographed,
 /// and the teapot's report under it.
@@ -203,7 +207,8 @@ fn run_logged(script: &Path, log: &Path) -> anyhow::Result<()> {
 
 /// Glossy materials: shadowed highlights from the lights, prefiltered reflections of the
 /// rest, against the path tracer's Phong lobe; the teapot under `envs`, the dragon under one;
-/// then the copper teapot (glTF's metallic-roughness material) under one.
+/// then the copper teapot (glTF's metallic-roughness material) and a normal-mapped glTF sample
+/// under one.
 fn demo_glossy(output: &Path, envs: &[PathBuf], options: &ReportOptions) -> anyhow::Result<()> {
     println!("\nthe glossy teapot {GLOSSY_TEAPOT}:");
     let teapot = load_scene(&bundled(GLOSSY_TEAPOT))?;
@@ -223,6 +228,14 @@ fn demo_glossy(output: &Path, envs: &[PathBuf], options: &ReportOptions) -> anyh
         PBR_TEAPOT_SPP,
         options,
         &output.join("teapot-pbr"),
+    )?;
+    quick_report(
+        "normal-mapped glTF sample",
+        NORMAL_MAPPED_SAMPLE,
+        PBR_TEAPOT_MAP,
+        NORMAL_MAPPED_SAMPLE_SPP,
+        options,
+        &output.join("normal-mapped-sample"),
     )
 }
 

@@ -266,6 +266,7 @@ pub fn plane_facing(centre: Vec3, normal: Vec3) -> foundation::mesh::TriangleMes
         normals: vec![normal; 4],
         triangles: vec![[0, 1, 2], [0, 2, 3]],
         uvs: Vec::new(),
+        tangents: Vec::new(),
     }
 }
 

@@ -2,7 +2,7 @@
 
 use super::error::MeshError;
 use super::triangle_mesh::{RawMesh, TriangleMesh};
-use glam::{IVec3, Vec3};
+use glam::{IVec3, Vec3, Vec4};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -51,30 +51,25 @@ impl MeshCleanup {
                 detail: String::new(),
             });
         }
-        let RawMesh {
-            mut positions,
-            normals,
-            triangles,
-            uvs,
-        } = raw;
-        let diagonal = bounds_diagonal(&positions);
+        let diagonal = bounds_diagonal(&raw.positions);
         let mut report = CleanupReport::default();
-        let input_triangles = triangles.len();
-
+        let input_triangles = raw.triangles.len();
         // Texture seams are split vertices on purpose: a textured mesh is not welded unless
         // asked (and then each welded vertex keeps the first one's coordinates).
-        let weld = self.weld.unwrap_or(normals.is_none() && uvs.is_none());
-        let (mut triangles, mut normals, mut uvs) = (triangles, normals, uvs);
-        if weld {
-            let (remap, kept) = weld_positions(&positions, self.weld_tolerance * diagonal);
-            report.welded_vertices = positions.len() - kept.len();
-            positions = kept.iter().map(|&i| positions[i as usize]).collect();
-            normals = normals.map(|n| kept.iter().map(|&i| n[i as usize]).collect());
-            uvs = uvs.map(|t| kept.iter().map(|&i| t[i as usize]).collect());
-            for t in &mut triangles {
-                *t = t.map(|i| remap[i as usize]);
-            }
-        }
+        let weld = self
+            .weld
+            .unwrap_or(raw.normals.is_none() && raw.uvs.is_none());
+        let raw = match weld {
+            true => welded(raw, self.weld_tolerance * diagonal, &mut report),
+            false => raw,
+        };
+        let RawMesh {
+            positions,
+            normals,
+            mut triangles,
+            uvs,
+            tangents,
+        } = raw;
 
         let min_double_area = (1e-7 * diagonal).powi(2);
         triangles.retain(|&[a, b, c]| {
@@ -111,6 +106,7 @@ impl MeshCleanup {
             normals,
             triangles,
             uvs: uvs.unwrap_or_default(),
+            tangents: tangents.map(unit_tangents).unwrap_or_default(),
         });
         Ok((mesh, report))
     }
@@ -160,6 +156,15 @@ fn validate(raw: &RawMesh) -> Result<(), String> {
         if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
             return Err(format!("vertex {i} has non-finite texture coordinates"));
         }
+    }
+    if let Some(tangents) = &raw.tangents
+        && tangents.len() != raw.positions.len()
+    {
+        return Err(format!(
+            "{} tangents for {} vertices",
+            tangents.len(),
+            raw.positions.len()
+        ));
     }
     let n = raw.positions.len() as u32;
     if let Some((t, i)) = raw
@@ -277,6 +282,46 @@ pub(super) fn smooth_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<
     normals.into_iter().map(|n| n.unwrap_or(Vec3::Y)).collect()
 }
 
+/// `raw` with the vertices within `tolerance` of each other merged (each keeps the first
+/// one's attributes), counted in `report`.
+fn welded(raw: RawMesh, tolerance: f32, report: &mut CleanupReport) -> RawMesh {
+    let (remap, kept) = weld_positions(&raw.positions, tolerance);
+    report.welded_vertices = raw.positions.len() - kept.len();
+    RawMesh {
+        positions: kept.iter().map(|&i| raw.positions[i as usize]).collect(),
+        normals: raw
+            .normals
+            .as_deref()
+            .map(|n| kept.iter().map(|&i| n[i as usize]).collect()),
+        uvs: raw
+            .uvs
+            .as_deref()
+            .map(|t| kept.iter().map(|&i| t[i as usize]).collect()),
+        tangents: raw
+            .tangents
+            .as_deref()
+            .map(|t| kept.iter().map(|&i| t[i as usize]).collect()),
+        triangles: raw
+            .triangles
+            .iter()
+            .map(|t| t.map(|i| remap[i as usize]))
+            .collect(),
+    }
+}
+
+/// Tangents as the renderers read them: unit xyz and a w of exactly ±1. A tangent of zero
+/// length or with a non-finite component becomes zero, which draws its vertex without the
+/// normal map (documented in CONVENTIONS.md, "Normal maps"), rather than a NaN.
+fn unit_tangents(tangents: Vec<Vec4>) -> Vec<Vec4> {
+    tangents
+        .into_iter()
+        .map(|t| match (t.truncate().try_normalize(), t.w.is_finite()) {
+            (Some(xyz), true) => xyz.extend(if t.w < 0.0 { -1.0 } else { 1.0 }),
+            _ => Vec4::ZERO,
+        })
+        .collect()
+}
+
 /// Drops vertices no triangle uses (left over from degenerate or welded triangles).
 fn remove_unreferenced(mesh: TriangleMesh) -> TriangleMesh {
     let mut new_index = vec![u32::MAX; mesh.positions.len()];
@@ -290,6 +335,9 @@ fn remove_unreferenced(mesh: TriangleMesh) -> TriangleMesh {
                 out.normals.push(mesh.normals[i as usize]);
                 if let Some(uv) = mesh.uvs.get(i as usize) {
                     out.uvs.push(*uv);
+                }
+                if let Some(t) = mesh.tangents.get(i as usize) {
+                    out.tangents.push(*t);
                 }
             }
             *slot
@@ -320,6 +368,7 @@ mod tests {
             normals: None,
             triangles: vec![[0, 1, 2], [3, 4, 5], [0, 1, 0], [0, 2, 6]],
             uvs: None,
+            tangents: None,
         }
     }
 
@@ -364,6 +413,7 @@ mod tests {
             normals: None,
             triangles: vec![[0, 1, 2]],
             uvs: None,
+            tangents: None,
         };
         let err = MeshCleanup::default()
             .run(&PathBuf::from("flat.obj"), raw)

@@ -1,18 +1,20 @@
 //! glTF 2.0 models (`.gltf` with its buffers, or `.glb`) through the `gltf` crate: every
 //! triangle primitive of the default scene, placed by its node transforms, with its texture
-//! coordinates, the material's base colour (factor and texture) and its metallic-roughness
-//! layer (factors, times the mean of their texture's channels). Everything else a material
-//! says is ignored, with one note per material.
+//! coordinates and tangents, the material's base colour (factor and texture), its normal map
+//! (tangents generated with MikkTSpace where the primitive has none) and its
+//! metallic-roughness layer (factors, times the mean of their texture's channels). Everything
+//! else a material says is ignored, with one note per material.
 
 use super::error::MeshError;
 use super::gltf_geometry::{assemble_triangles, check_type, with_flat_normals};
-use super::gltf_material::{decode_srgb, ignored_properties, part_layer};
+use super::gltf_material::{decode_normals, decode_srgb, ignored_properties, part_layer};
 use super::gltf_sources::Sources;
+use super::tangents::TangentInput;
 use super::triangle_mesh::RawMesh;
 use crate::color::Rgb;
 use crate::material::Layer;
-use crate::texture::{AlbedoTexture, decode_image};
-use glam::{Mat3, Mat4, Vec2, Vec3};
+use crate::texture::{AlbedoTexture, NormalMap, decode_image};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use std::collections::HashMap;
@@ -40,6 +42,8 @@ pub struct PartMaterial {
     /// The metallic-roughness layer (factors times their texture's means); `None` for a rough dielectric
     /// (metallic 0, roughness 1), drawn as Lambertian.
     pub layer: Option<Layer>,
+    /// `normalTexture`, decoded linearly, with its scale.
+    pub normal_map: Option<NormalMap>,
 }
 
 /// Extensions that change how geometry is stored: a file that requires one cannot be read.
@@ -142,8 +146,8 @@ struct Loader<'a> {
     path: &'a Path,
     sources: Sources<'a>,
     buffers: &'a [gltf::buffer::Data],
-    /// Decoded base colour textures by image index.
-    textures: HashMap<usize, std::sync::Arc<AlbedoTexture>>,
+    /// Decoded base colour textures and normal maps by image index (and whether a normal map).
+    textures: HashMap<(usize, bool), std::sync::Arc<AlbedoTexture>>,
     /// Metallic-roughness textures' channel means, by image (decoded once).
     channel_means: HashMap<usize, [f32; 2]>,
     /// Materials already noted for the properties hprt ignores.
@@ -185,13 +189,30 @@ impl Loader<'_> {
                 continue;
             }
             self.check_primitive(&name, &primitive)?;
-            let raw = self.primitive_mesh(&name, &primitive, world)?;
+            let mut raw = self.primitive_mesh(&name, &primitive, world)?;
             let material = self.material(&primitive.material())?;
-            if material.texture.is_some() && raw.uvs.is_none() {
+            let textured = [
+                ("a base colour texture", material.texture.is_some()),
+                ("a normal map", material.normal_map.is_some()),
+            ];
+            if let Some((what, _)) = textured.iter().find(|(_, has)| *has)
+                && raw.uvs.is_none()
+            {
                 return Err(self.invalid(format!(
-                    "{name}: its material has a base colour texture but the primitive has no \
-                     TEXCOORD_0"
+                    "{name}: its material has {what} but the primitive has no TEXCOORD_0"
                 )));
+            }
+            if material.normal_map.is_none() {
+                raw.tangents = None;
+            } else if raw.tangents.is_none()
+                && let (Some(normals), Some(uvs)) = (&raw.normals, &raw.uvs)
+            {
+                raw.tangents = Some(super::tangents::generate_tangents(TangentInput {
+                    positions: &raw.positions,
+                    normals,
+                    uvs,
+                    triangles: &raw.triangles,
+                }));
             }
             self.parts.push(ModelPart {
                 name,
@@ -220,6 +241,11 @@ impl Loader<'_> {
         let uvs: Option<Vec<Vec2>> = reader
             .read_tex_coords(0)
             .map(|t| t.into_f32().map(Vec2::from).collect());
+        // glTF gives tangents only beside normals (3.7.2.1); flat normals get generated ones.
+        let tangents: Option<Vec<Vec4>> = reader
+            .read_tangents()
+            .filter(|_| normals.is_some())
+            .map(|t| t.map(Vec4::from).collect());
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
             None => (0..positions.len() as u32).collect(),
@@ -242,6 +268,7 @@ impl Loader<'_> {
             return Err(self.invalid(format!("{name}: its node transform is singular")));
         }
         let normal_matrix = linear.inverse().transpose();
+        let det = linear.determinant();
         let mut raw = RawMesh {
             positions: positions
                 .iter()
@@ -254,6 +281,11 @@ impl Loader<'_> {
             }),
             triangles,
             uvs,
+            tangents: tangents.map(|ts| {
+                ts.iter()
+                    .map(|t| super::tangents::transform_tangent(&linear, det, *t))
+                    .collect()
+            }),
         };
         if raw.normals.is_none() {
             raw = with_flat_normals(raw);
@@ -364,7 +396,7 @@ impl Loader<'_> {
                         info.tex_coord()
                     )));
                 }
-                Some(self.texture(&info.texture().source())?)
+                Some(self.image(&info.texture().source(), false)?)
             }
         };
         let means = match pbr.metallic_roughness_texture() {
@@ -376,11 +408,38 @@ impl Loader<'_> {
             [pbr.metallic_factor(), pbr.roughness_factor()],
             means,
         );
+        let normal_map = match material.normal_texture() {
+            None => None,
+            Some(normal) => Some(self.normal_map(&name, &normal)?),
+        };
         Ok(PartMaterial {
             name,
             base_color: Rgb::new(r, g, b),
             texture,
             layer,
+            normal_map,
+        })
+    }
+
+    /// A material's normal map; a non-finite scale is refused (glTF's default is 1).
+    fn normal_map(
+        &mut self,
+        material: &str,
+        normal: &gltf::material::NormalTexture,
+    ) -> Result<NormalMap, MeshError> {
+        if normal.tex_coord() != 0 {
+            return Err(self.invalid(format!(
+                "{material}: the normal texture uses TEXCOORD_{}; hprt reads TEXCOORD_0 only",
+                normal.tex_coord()
+            )));
+        }
+        let scale = normal.scale();
+        if !scale.is_finite() {
+            return Err(self.invalid(format!("{material}: the normal texture's scale is {scale}")));
+        }
+        Ok(NormalMap {
+            texture: self.image(&normal.texture().source(), true)?,
+            scale,
         })
     }
 
@@ -409,21 +468,31 @@ impl Loader<'_> {
         Ok(means)
     }
 
-    fn texture(&mut self, image: &gltf::Image) -> Result<std::sync::Arc<AlbedoTexture>, MeshError> {
-        if let Some(t) = self.textures.get(&image.index()) {
+    /// A base colour texture (sRGB) or, with `normals`, a normal map (linear), decoded once.
+    fn image(
+        &mut self,
+        image: &gltf::Image,
+        normals: bool,
+    ) -> Result<std::sync::Arc<AlbedoTexture>, MeshError> {
+        if let Some(t) = self.textures.get(&(image.index(), normals)) {
             return Ok(t.clone());
         }
         let bytes = self.sources.image_bytes(image, self.buffers)?;
         let decoded = decode_image(&bytes)
             .map_err(|e| self.invalid(format!("image {}: {e}", image.index())))?;
-        let texture = std::sync::Arc::new(decode_srgb(&decoded).ok_or_else(|| {
+        let (texels, what) = match normals {
+            false => (decode_srgb(&decoded), "a base colour"),
+            true => (decode_normals(&decoded), "a normal map (RGB)"),
+        };
+        let texture = std::sync::Arc::new(texels.ok_or_else(|| {
             self.invalid(format!(
-                "image {}: unsupported pixel format {:?} for a base colour",
+                "image {}: unsupported pixel format {:?} for {what}",
                 image.index(),
                 decoded.color()
             ))
         })?);
-        self.textures.insert(image.index(), texture.clone());
+        self.textures
+            .insert((image.index(), normals), texture.clone());
         Ok(texture)
     }
 }

@@ -12,6 +12,8 @@ pub(super) fn with_flat_normals(mesh: RawMesh) -> RawMesh {
     let mut out = RawMesh {
         normals: Some(Vec::with_capacity(3 * mesh.triangles.len())),
         uvs: mesh.uvs.as_ref().map(|_| Vec::new()),
+        // Tangents come with normals; flat-shaded primitives get generated ones.
+        tangents: None,
         ..Default::default()
     };
     for tri in &mesh.triangles {
@@ -33,8 +35,8 @@ pub(super) fn with_flat_normals(mesh: RawMesh) -> RawMesh {
 }
 
 /// Refuses an attribute hprt reads whose type is not the one glTF gives it (the `gltf` crate's
-/// reader assumes it): positions and normals are float VEC3, texture coordinates VEC2 of float
-/// or normalised unsigned bytes or shorts.
+/// reader assumes it): positions and normals are float VEC3, tangents float VEC4, texture
+/// coordinates VEC2 of float or normalised unsigned bytes or shorts.
 pub(super) fn check_type(
     semantic: &gltf::Semantic,
     accessor: &gltf::Accessor,
@@ -44,6 +46,7 @@ pub(super) fn check_type(
         gltf::Semantic::Positions | gltf::Semantic::Normals => {
             data == DataType::F32 && dims == Dimensions::Vec3
         }
+        gltf::Semantic::Tangents => data == DataType::F32 && dims == Dimensions::Vec4,
         gltf::Semantic::TexCoords(0) => {
             dims == Dimensions::Vec2 && matches!(data, DataType::F32 | DataType::U8 | DataType::U16)
         }
@@ -97,6 +100,7 @@ mod tests {
             normals: None,
             triangles: vec![[0, 1, 2], [0, 1, 3]],
             uvs: Some(vec![Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE]),
+            tangents: None,
         };
         let flat = with_flat_normals(roof);
         assert_eq!(flat.positions.len(), 6);

@@ -1,5 +1,6 @@
 //! What hprt reads of a glTF material beyond the geometry: the base colour texture decoded
-//! from sRGB, the metallic-roughness layer, and the properties it does not draw.
+//! from sRGB, the normal map decoded linearly, the metallic-roughness layer, and the
+//! properties it does not draw.
 
 use crate::material::Layer;
 use crate::texture::AlbedoTexture;
@@ -41,9 +42,6 @@ pub(super) fn ignored_properties(material: &gltf::Material) -> Vec<&'static str>
     if pbr.metallic_roughness_texture().is_some() {
         ignored.push("metallic-roughness texture (its mean is used)");
     }
-    if material.normal_texture().is_some() {
-        ignored.push("normal texture");
-    }
     if material.occlusion_texture().is_some() {
         ignored.push("occlusion texture");
     }
@@ -58,6 +56,23 @@ pub(super) fn ignored_properties(material: &gltf::Material) -> Vec<&'static str>
 
 /// 8- or 16-bit RGB(A) or grey pixels, sRGB-encoded, to linear RGB; `None` for other formats.
 pub(super) fn decode_srgb(image: &image::DynamicImage) -> Option<AlbedoTexture> {
+    decode_texels(image, crate::image_io::srgb_decode)
+}
+
+/// 8- or 16-bit RGB(A) pixels of a normal map, read as they are (glTF's normal textures are
+/// linear); `None` for other formats, grey ones included (a grey image holds no directions).
+pub(super) fn decode_normals(image: &image::DynamicImage) -> Option<AlbedoTexture> {
+    use image::DynamicImage as D;
+    match image {
+        D::ImageRgb8(_) | D::ImageRgba8(_) | D::ImageRgb16(_) | D::ImageRgba16(_) => {
+            decode_texels(image, |c| c)
+        }
+        _ => None,
+    }
+}
+
+/// 8- or 16-bit RGB(A) or grey pixels to RGB, each channel in [0, 1] through `decode`.
+fn decode_texels(image: &image::DynamicImage, decode: fn(f32) -> f32) -> Option<AlbedoTexture> {
     use image::DynamicImage as D;
     let (channels, bytes_per_channel) = match image {
         D::ImageLuma8(_) => (1, 1),
@@ -92,7 +107,7 @@ pub(super) fn decode_srgb(image: &image::DynamicImage) -> Option<AlbedoTexture> 
             } else {
                 Vec3::new(channel(texel, 0), channel(texel, 1), channel(texel, 2))
             };
-            rgb.map(crate::image_io::srgb_decode)
+            rgb.map(decode)
         })
         .collect();
     Some(AlbedoTexture {

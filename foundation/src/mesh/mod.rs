@@ -1,6 +1,7 @@
 //! Triangle meshes and their loaders (OBJ, PLY, Bézier patches), with the clean-up every
 //! mesh gets before it is baked: validation, removal of zero-area triangles, optional welding
-//! of coincident vertices and smooth vertex normals.
+//! of coincident vertices and smooth vertex normals. glTF models bring their materials and
+//! tangent frames.
 
 mod bpt;
 mod cleanup;
@@ -12,6 +13,7 @@ mod gltf_sources;
 mod obj;
 mod ply;
 mod shapes;
+mod tangents;
 mod triangle_mesh;
 
 pub use bpt::BezierPatch;
@@ -21,6 +23,7 @@ pub use gltf::{ModelPart, PartMaterial};
 pub use gltf_sources::set_allow_outside_uris;
 pub(crate) use shapes::annulus_mesh;
 pub use shapes::{box_mesh, icosahedron, sphere_mesh, subdivide};
+pub use tangents::{perturbed_normal, transform_tangent};
 pub use triangle_mesh::{RawMesh, TriangleMesh};
 
 use crate::infra::limits::{MAX_MESH_BYTES, ReadError, gunzip_limited, read_regular_file};

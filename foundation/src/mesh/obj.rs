@@ -76,6 +76,7 @@ fn model_mesh(m: &tobj::Mesh) -> RawMesh {
         positions,
         normals,
         uvs,
+        tangents: None,
     }
 }
 
@@ -145,6 +146,7 @@ pub(super) fn parse_obj_parts(
                     base_color: Rgb::from_array(mat.diffuse.unwrap_or([1.0; 3])),
                     texture,
                     layer: None,
+                    normal_map: None,
                 })
             }
         };

@@ -105,6 +105,7 @@ pub(super) fn parse_ply(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError>
         normals,
         triangles,
         uvs: None,
+        tangents: None,
     })
 }
 

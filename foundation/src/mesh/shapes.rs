@@ -145,6 +145,7 @@ pub fn sphere_mesh(center: Vec3, radius: f32, subdivisions: u32) -> TriangleMesh
         normals: directions,
         triangles,
         uvs: Vec::new(),
+        tangents: Vec::new(),
     }
 }
 

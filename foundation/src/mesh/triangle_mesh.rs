@@ -1,10 +1,11 @@
 //! The mesh types: a file's mesh as read ([`RawMesh`]) and the cleaned, indexed mesh everything
 //! else uses ([`TriangleMesh`]).
 
-use glam::{Vec2, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 /// An indexed triangle mesh with one unit normal per vertex and, for a textured mesh, one
-/// texture coordinate per vertex (glTF's convention: origin at the image's top left).
+/// texture coordinate per vertex (glTF's convention: origin at the image's top left) and, for
+/// a normal-mapped one, one tangent per vertex.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriangleMesh {
     pub positions: Vec<Vec3>,
@@ -12,6 +13,9 @@ pub struct TriangleMesh {
     pub triangles: Vec<[u32; 3]>,
     /// Empty, or one per vertex.
     pub uvs: Vec<Vec2>,
+    /// Empty, or one per vertex: glTF's tangent, a unit vector along +u in xyz and in w the
+    /// sign (±1) of the bitangent `cross(normal, tangent) * w` (along +v in texture space).
+    pub tangents: Vec<Vec4>,
 }
 
 impl TriangleMesh {
@@ -57,10 +61,57 @@ impl TriangleMesh {
         )
     }
 
-    /// Appends `other`, offsetting its indices. Texture coordinates stay one per vertex where
-    /// either mesh has them (zero for the other's vertices).
+    /// The mesh under an affine transform: positions, (inverse-transpose) normals and
+    /// tangents ([`transform_tangent`]). `None` if the transform is singular.
+    pub fn transformed(&self, m: &Mat4) -> Option<TriangleMesh> {
+        let mesh = self;
+        let linear = Mat3::from_mat4(*m);
+        let det = linear.determinant();
+        if !det.is_finite() || det.abs() < 1e-12 {
+            return None;
+        }
+        let normal_matrix = linear.inverse().transpose();
+        let mut triangles = mesh.triangles.clone();
+        if det < 0.0 {
+            // A mirroring transform flips the winding; restore outward-facing triangles.
+            for t in &mut triangles {
+                t.swap(1, 2);
+            }
+        }
+        Some(TriangleMesh {
+            positions: mesh
+                .positions
+                .iter()
+                .map(|p| m.transform_point3(*p))
+                .collect(),
+            normals: mesh
+                .normals
+                .iter()
+                .map(|n| (normal_matrix * *n).normalize_or(Vec3::Y))
+                .collect(),
+            triangles,
+            uvs: mesh.uvs.clone(),
+            tangents: mesh
+                .tangents
+                .iter()
+                .map(|t| super::tangents::transform_tangent(&linear, det, *t))
+                .collect(),
+        })
+    }
+
+    /// Appends `other`, offsetting its indices. Texture coordinates and tangents stay one per
+    /// vertex where either mesh has them (zero for the other's vertices).
     pub(crate) fn append(&mut self, other: &TriangleMesh) {
         let base = self.positions.len() as u32;
+        if !self.tangents.is_empty() || !other.tangents.is_empty() {
+            self.tangents.resize(self.positions.len(), Vec4::ZERO);
+            match other.tangents.is_empty() {
+                true => self
+                    .tangents
+                    .extend(std::iter::repeat_n(Vec4::ZERO, other.positions.len())),
+                false => self.tangents.extend_from_slice(&other.tangents),
+            }
+        }
         if !self.uvs.is_empty() || !other.uvs.is_empty() {
             self.uvs.resize(self.positions.len(), Vec2::ZERO);
             match other.uvs.is_empty() {
@@ -77,14 +128,15 @@ impl TriangleMesh {
     }
 }
 
-/// A mesh as read from a file: positions, triangles and, if the file has them, normals and
-/// texture coordinates.
+/// A mesh as read from a file: positions, triangles and, if the file has them, normals,
+/// texture coordinates and tangents.
 #[derive(Debug, Clone, Default)]
 pub struct RawMesh {
     pub positions: Vec<Vec3>,
     pub normals: Option<Vec<Vec3>>,
     pub triangles: Vec<[u32; 3]>,
     pub uvs: Option<Vec<Vec2>>,
+    pub tangents: Option<Vec<Vec4>>,
 }
 
 /// One mesh of all `meshes`; normals only if every one has them (and there are vertices).
@@ -124,6 +176,7 @@ mod tests {
             normals: vec![Vec3::Z; 3],
             triangles: vec![[0, 1, 2]],
             uvs: Vec::new(),
+            tangents: Vec::new(),
         };
         let mut m = tri.clone();
         m.append(&tri);

@@ -11,8 +11,10 @@ use crate::infra::names::check_file_name;
 use crate::material::{Layer, MAX_SHININESS, Material, check_energy};
 use crate::mesh::{LoadOptions, MeshError, TriangleMesh, annulus_mesh, box_mesh};
 use crate::probe::ProbeSource;
-use glam::{Mat3, Mat4, Vec3};
+use crate::texture::{AlbedoTexture, NormalMap};
+use glam::Vec3;
 use std::path::Path;
+use std::sync::Arc;
 
 impl Scene {
     /// Loads a scene file and every mesh it names.
@@ -234,7 +236,9 @@ fn add_object(
             true => name.clone(),
             false => format!("{name}/{}", part.name),
         };
-        let world = transform_mesh(&part.mesh, &object.transform.matrix())
+        let world = part
+            .mesh
+            .transformed(&object.transform.matrix())
             .ok_or_else(|| invalid(format!("{name}: the transform is singular")))?;
         let total = geometry.mesh.triangle_count() + world.triangle_count();
         if total > MAX_SCENE_TRIANGLES {
@@ -248,18 +252,33 @@ fn add_object(
                 .map_err(|m| invalid(format!("{part_name}: {m}")))?;
         }
         let material = part_material(material, colour.is_some(), part.layer);
-        match (colour, part.texture) {
-            (None, Some(texture)) => {
-                geometry.push_textured_object(part_name, &world, albedo, texture)
-            }
-            _ => geometry.push_object(part_name, &world, albedo),
-        }
+        // A scene file's colour replaces the model's whole material, textures included.
+        let textures = colour.is_none().then_some((part.texture, part.normal_map));
+        push_part(geometry, part_name, &world, albedo, textures);
         if let Some(o) = geometry.objects.last_mut() {
             o.material = material;
             o.role = object.role;
         }
     }
     Ok(())
+}
+
+/// Adds one part of an object, with its model's base colour texture and normal map, if any.
+fn push_part(
+    geometry: &mut SceneMesh,
+    name: String,
+    world: &TriangleMesh,
+    albedo: Rgb,
+    textures: Option<(Option<Arc<AlbedoTexture>>, Option<NormalMap>)>,
+) {
+    let (texture, normal_map) = textures.unwrap_or_default();
+    match texture {
+        Some(texture) => geometry.push_textured_object(name, world, albedo, texture),
+        None => geometry.push_object(name, world, albedo),
+    }
+    if let Some(map) = normal_map {
+        geometry.set_normal_map(map);
+    }
 }
 
 /// A part's material: the object's, or the model's layer where the scene file gives no
@@ -379,6 +398,7 @@ fn load_object_parts(
             albedo: None,
             texture: None,
             layer: None,
+            normal_map: None,
         }]
     };
     match (&object.mesh, &object.box_shape, &object.annulus) {
@@ -450,36 +470,4 @@ fn annulus_object(a: &AnnulusSpec) -> Result<TriangleMesh, ObjectError> {
         a.outer_radius,
         a.segments,
     ))
-}
-
-/// Applies an affine transform to positions and (inverse-transpose) normals. `None` if the
-/// transform is singular.
-pub(crate) fn transform_mesh(mesh: &TriangleMesh, m: &Mat4) -> Option<TriangleMesh> {
-    let linear = Mat3::from_mat4(*m);
-    let det = linear.determinant();
-    if !det.is_finite() || det.abs() < 1e-12 {
-        return None;
-    }
-    let normal_matrix = linear.inverse().transpose();
-    let mut triangles = mesh.triangles.clone();
-    if det < 0.0 {
-        // A mirroring transform flips the winding; restore outward-facing triangles.
-        for t in &mut triangles {
-            t.swap(1, 2);
-        }
-    }
-    Some(TriangleMesh {
-        positions: mesh
-            .positions
-            .iter()
-            .map(|p| m.transform_point3(*p))
-            .collect(),
-        normals: mesh
-            .normals
-            .iter()
-            .map(|n| (normal_matrix * *n).normalize_or(Vec3::Y))
-            .collect(),
-        triangles,
-        uvs: mesh.uvs.clone(),
-    })
 }

@@ -6,7 +6,7 @@ use crate::material::metallic_roughness::{MetallicRoughness, hemispherical_split
 use crate::material::{Layer, Material};
 use crate::mesh::TriangleMesh;
 use crate::scene::ObjectRole;
-use crate::texture::AlbedoTexture;
+use crate::texture::{AlbedoTexture, NormalMap};
 use std::sync::Arc;
 
 /// A named part of the scene mesh.
@@ -19,6 +19,8 @@ pub struct SceneObject {
     pub triangles: std::ops::Range<u32>,
     /// Index into [`SceneMesh::textures`] of its base colour texture.
     pub texture: Option<usize>,
+    /// Index into [`SceneMesh::normal_maps`] of its normal map (the mesh then has tangents).
+    pub normal_map: Option<usize>,
     /// Its specular lobe, if glossy (the albedo above is its diffuse `k_d`).
     pub material: Material,
     /// A virtual object, or a proxy of a real surface.
@@ -40,6 +42,9 @@ pub struct SceneMesh {
     pub objects: Vec<SceneObject>,
     /// Base colour textures of the textured objects.
     pub textures: Vec<Arc<AlbedoTexture>>,
+    /// Normal maps of the normal-mapped objects. The bake does not read them (CONVENTIONS.md,
+    /// "Normal maps"), so they are not in [`Self::content_hash`].
+    pub normal_maps: Vec<NormalMap>,
 }
 
 impl SceneMesh {
@@ -116,9 +121,27 @@ impl SceneMesh {
             vertices: v0..self.mesh.vertex_count() as u32,
             triangles: t0..self.mesh.triangle_count() as u32,
             texture: None,
+            normal_map: None,
             material: Material::DIFFUSE,
             role: ObjectRole::Object,
         });
+    }
+
+    /// Gives the last object pushed `map` (its mesh must have had tangents).
+    pub fn set_normal_map(&mut self, map: NormalMap) {
+        debug_assert!(self.mesh.tangents.len() == self.mesh.vertex_count());
+        let index = match self.normal_maps.iter().position(|m| {
+            Arc::ptr_eq(&m.texture, &map.texture) && m.scale.to_bits() == map.scale.to_bits()
+        }) {
+            Some(i) => i,
+            None => {
+                self.normal_maps.push(map);
+                self.normal_maps.len() - 1
+            }
+        };
+        if let Some(object) = self.objects.last_mut() {
+            object.normal_map = Some(index);
+        }
     }
 
     /// Adds `mesh` (world space, with texture coordinates) whose albedo is `factor` times
@@ -182,6 +205,10 @@ impl SceneMesh {
                     true => Vec::new(),
                     false => self.mesh.uvs[v0..v1].to_vec(),
                 },
+                tangents: match o.normal_map {
+                    None => Vec::new(),
+                    Some(_) => self.mesh.tangents[v0..v1].to_vec(),
+                },
             };
             match o.texture {
                 Some(t) => out.push_textured_object(
@@ -191,6 +218,9 @@ impl SceneMesh {
                     self.textures[t].clone(),
                 ),
                 None => out.push_object(o.name.clone(), &part, o.albedo),
+            }
+            if let Some(map) = o.normal_map {
+                out.set_normal_map(self.normal_maps[map].clone());
             }
             if let Some(last) = out.objects.last_mut() {
                 last.material = o.material;
@@ -287,9 +317,18 @@ impl SceneMesh {
 
     /// Per triangle, the index of its texture, or [`NO_TEXTURE`].
     pub fn triangle_textures(&self) -> Vec<u32> {
+        self.per_triangle(|o| o.texture)
+    }
+
+    /// Per triangle, the index of its normal map in [`Self::normal_maps`], or [`NO_TEXTURE`].
+    pub fn triangle_normal_maps(&self) -> Vec<u32> {
+        self.per_triangle(|o| o.normal_map)
+    }
+
+    fn per_triangle(&self, index: impl Fn(&SceneObject) -> Option<usize>) -> Vec<u32> {
         let mut out = vec![NO_TEXTURE; self.mesh.triangle_count()];
         for o in &self.objects {
-            if let Some(t) = o.texture {
+            if let Some(t) = index(o) {
                 out[o.triangles.start as usize..o.triangles.end as usize].fill(t as u32);
             }
         }

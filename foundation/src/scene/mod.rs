@@ -120,7 +120,6 @@ impl Scene {
 
 #[cfg(test)]
 mod tests {
-    use super::build::transform_mesh;
     use super::*;
     use crate::color::Rgb;
     use crate::material::Material;
@@ -313,7 +312,9 @@ mod tests {
     #[test]
     fn mirroring_transforms_keep_triangles_outward() {
         let cube = box_mesh(Vec3::splat(-1.0), Vec3::ONE, [1, 1, 1], [false; 6]);
-        let mirrored = transform_mesh(&cube, &Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0))).unwrap();
+        let mirrored = cube
+            .transformed(&Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)))
+            .unwrap();
         for t in 0..mirrored.triangle_count() {
             let [a, b, c] = mirrored.corners(t);
             let n = (b - a).cross(c - a);
@@ -324,7 +325,10 @@ mod tests {
                     > 0.99
             );
         }
-        assert!(transform_mesh(&cube, &Mat4::from_scale(Vec3::new(0.0, 1.0, 1.0))).is_none());
+        assert!(
+            cube.transformed(&Mat4::from_scale(Vec3::new(0.0, 1.0, 1.0)))
+                .is_none()
+        );
     }
 
     #[test]

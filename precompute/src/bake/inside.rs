@@ -111,6 +111,7 @@ mod tests {
             normals: vec![Vec3::Z; 5],
             triangles: vec![[0, 1, 4], [1, 2, 4], [2, 3, 4]],
             uvs: Vec::new(),
+            tangents: Vec::new(),
         };
         let neighbours = VertexNeighbours::new(&mesh);
         assert_eq!(neighbours.of(1), &[0, 2, 4]);

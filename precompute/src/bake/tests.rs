@@ -237,6 +237,7 @@ fn plane_facing(normal: Vec3) -> TriangleMesh {
         normals: vec![normal; 4],
         triangles: vec![[0, 1, 2], [0, 2, 3]],
         uvs: Vec::new(),
+        tangents: Vec::new(),
     }
 }
 

@@ -2,6 +2,7 @@
 //! reference renderer against an independent one. See the README's "Cross-checking with
 //! Mitsuba 3" for the mapping.
 
+use foundation::Rgb;
 use foundation::camera::Camera;
 use foundation::envmap::EnvMap;
 use foundation::image_io::{RgbImageF32, write_exr};
@@ -37,21 +38,24 @@ pub fn mitsuba_max_depth(bounces: u32) -> u32 {
 
 /// A binary little-endian PLY with positions, normals and, for a textured mesh, texture
 /// coordinates (`u`, `v`: hprt's and Mitsuba's bitmap convention agree, origin at the image's
-/// top left).
+/// top left) and, for a normal-mapped one, tangents (`tangent_x`, `_y`, `_z`) and their
+/// bitangent signs (`handed_x`): Mitsuba reads them as the attributes `vertex_tangent` and
+/// `vertex_handed`.
 pub(crate) fn ply_bytes(mesh: &TriangleMesh) -> Vec<u8> {
-    let textured = !mesh.uvs.is_empty();
-    let names: &[&str] = if textured {
-        &["x", "y", "z", "nx", "ny", "nz", "u", "v"]
-    } else {
-        &["x", "y", "z", "nx", "ny", "nz"]
-    };
+    let mut names = vec!["x", "y", "z", "nx", "ny", "nz"];
+    if !mesh.uvs.is_empty() {
+        names.extend(["u", "v"]);
+    }
+    if !mesh.tangents.is_empty() {
+        names.extend(["tangent_x", "tangent_y", "tangent_z", "handed_x"]);
+    }
     let mut ply = Ply::<DefaultElement>::new();
     ply.header.encoding = Encoding::BinaryLittleEndian;
     ply.header
         .comments
         .push("exported by hprt (world space)".into());
     let mut vertex = ElementDef::new("vertex".into());
-    for name in names {
+    for name in &names {
         vertex.properties.add(PropertyDef::new(
             (*name).into(),
             PropertyType::Scalar(ScalarType::Float),
@@ -67,12 +71,13 @@ pub(crate) fn ply_bytes(mesh: &TriangleMesh) -> Vec<u8> {
     let vertices = (0..mesh.vertex_count())
         .map(|v| {
             let mut e = DefaultElement::new();
-            let uv = mesh.uvs.get(v).map(|t| t.to_array()).unwrap_or_default();
+            // Absent attributes add nothing (their names are absent too).
             let values = mesh.positions[v]
                 .to_array()
                 .into_iter()
                 .chain(mesh.normals[v].to_array())
-                .chain(uv);
+                .chain(mesh.uvs.get(v).into_iter().flat_map(|t| t.to_array()))
+                .chain(mesh.tangents.get(v).into_iter().flat_map(|t| t.to_array()));
             for (name, value) in names.iter().zip(values) {
                 e.insert((*name).into(), Property::Float(value));
             }
@@ -110,12 +115,21 @@ fn object_mesh(geometry: &SceneMesh, object: usize) -> TriangleMesh {
             .map(|t| t.map(|i| i - v0 as u32))
             .collect(),
         uvs: mesh.uvs.get(v0..v1).map(<[_]>::to_vec).unwrap_or_default(),
+        tangents: match o.normal_map {
+            Some(_) => mesh.tangents[v0..v1].to_vec(),
+            None => Vec::new(),
+        },
     }
 }
 
 /// The texture file of textured object `index`.
 fn texture_file_for(name: &str, index: usize) -> String {
     file_name_for(name, index).replace(".ply", ".exr")
+}
+
+/// The normal map file of normal-mapped object `index`.
+fn normal_map_file_for(name: &str, index: usize) -> String {
+    file_name_for(name, index).replace(".ply", "_normals.exr")
 }
 
 fn file_name_for(name: &str, index: usize) -> String {
@@ -214,7 +228,7 @@ fn shape_xml(o: &SceneObject, i: usize) -> String {
         ),
     };
     let m = &o.material;
-    let inner = if let Some(layer) = m.layer {
+    let surface = if let Some(layer) = m.layer {
         format!(
             r#"<bsdf type="hprtmetallicroughness">
                 {reflectance}
@@ -238,6 +252,21 @@ fn shape_xml(o: &SceneObject, i: usize) -> String {
                 {reflectance}
             </bsdf>"#
         )
+    };
+    // A normal map (its scale folded into the texels) perturbs the shading frame of the
+    // BSDF it wraps, with hprt's tangents (CONVENTIONS.md, "Normal maps").
+    let inner = match o.normal_map {
+        Some(_) => format!(
+            r#"<bsdf type="hprtnormalmap">
+                <texture type="bitmap" name="normalmap">
+                    <string name="filename" value="textures/{}"/>
+                    <boolean name="raw" value="true"/>
+                </texture>
+                {surface}
+            </bsdf>"#,
+            normal_map_file_for(&o.name, i)
+        ),
+        None => surface,
     };
     format!(
         r#"    <shape type="ply" id="{id}">
@@ -272,6 +301,10 @@ pub(crate) const PHONG_PLUGIN: &str = include_str!("phong.py");
 /// `hprtmetallicroughness` when imported.
 pub(crate) const METALLIC_ROUGHNESS_PLUGIN: &str = include_str!("metallic_roughness.py");
 
+/// glTF's tangent-space normal map as a Mitsuba 3 BSDF wrapper with hprt's tangents,
+/// registered as `hprtnormalmap` when imported.
+pub(crate) const NORMAL_MAP_PLUGIN: &str = include_str!("normal_map.py");
+
 /// Every file [`export_mitsuba`] writes into `dir` for `geometry`.
 pub fn export_files(dir: &Path, geometry: &SceneMesh) -> Vec<PathBuf> {
     let objects = geometry.objects.iter().enumerate();
@@ -279,17 +312,26 @@ pub fn export_files(dir: &Path, geometry: &SceneMesh) -> Vec<PathBuf> {
         .clone()
         .map(|(i, o)| dir.join("meshes").join(file_name_for(&o.name, i)));
     let textures = objects
+        .clone()
         .filter(|(_, o)| o.texture.is_some())
         .map(|(i, o)| dir.join("textures").join(texture_file_for(&o.name, i)));
+    let normal_maps = objects
+        .filter(|(_, o)| o.normal_map.is_some())
+        .map(|(i, o)| dir.join("textures").join(normal_map_file_for(&o.name, i)));
     let fixed = [
         "envmap.exr",
         "thinsheet.py",
         "phong.py",
         "metallic_roughness.py",
+        "normal_map.py",
         "scene.xml",
     ]
     .map(|f| dir.join(f));
-    meshes.chain(textures).chain(fixed).collect()
+    meshes
+        .chain(textures)
+        .chain(normal_maps)
+        .chain(fixed)
+        .collect()
 }
 
 /// Writes `dir/scene.xml`, the plugins (`dir/*.py`), `dir/envmap.exr`, `dir/meshes/*.ply` and, for
@@ -321,6 +363,20 @@ pub fn export_mitsuba(
         let image = RgbImageF32::new(texture.width, texture.height, texels);
         write_exr(&path, &image).map_err(|e| error(&path, e.to_string()))?;
     }
+    for (i, o) in geometry.objects.iter().enumerate() {
+        let Some(m) = o.normal_map else { continue };
+        let map = &geometry.normal_maps[m];
+        let folder = dir.join("textures");
+        std::fs::create_dir_all(&folder).map_err(|e| error(&folder, e.to_string()))?;
+        let path = folder.join(normal_map_file_for(&o.name, i));
+        // (2 t − 1)(s, s, 1) is what the plugin reads as 2 t' − 1: the scale folded in.
+        let scaled = |t: Rgb| {
+            (((t * 2.0 - Rgb::ONE) * Rgb::new(map.scale, map.scale, 1.0)) + Rgb::ONE) * 0.5
+        };
+        let texels = map.texture.texels.iter().map(|t| scaled(*t)).collect();
+        let image = RgbImageF32::new(map.texture.width, map.texture.height, texels);
+        write_exr(&path, &image).map_err(|e| error(&path, e.to_string()))?;
+    }
     let env_path = dir.join("envmap.exr");
     let image = RgbImageF32::new(map.width(), map.height(), map.texels().to_vec());
     write_exr(&env_path, &image).map_err(|e| error(&env_path, e.to_string()))?;
@@ -328,6 +384,7 @@ pub fn export_mitsuba(
         ("thinsheet.py", THIN_SHEET_PLUGIN),
         ("phong.py", PHONG_PLUGIN),
         ("metallic_roughness.py", METALLIC_ROUGHNESS_PLUGIN),
+        ("normal_map.py", NORMAL_MAP_PLUGIN),
     ] {
         let plugin_path = dir.join(name);
         write_atomic(&plugin_path, plugin.as_bytes())

@@ -109,6 +109,7 @@ fn open_box() -> TriangleMesh {
         normals: outer.normals.iter().map(|n| -*n).collect(),
         triangles: outer.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect(),
         uvs: Vec::new(),
+        tangents: Vec::new(),
     }
 }
 

@@ -1,10 +1,17 @@
 use super::*;
+use foundation::bake_settings::BakeSettings;
 use foundation::mesh::{box_mesh, sphere_mesh};
+use foundation::scene::ObjectRole;
 use glam::Vec3;
 
-/// A sphere on a slab, its transfer made up (every coefficient a different size, some
-/// negative), under a map with a float32-only value and one in half floats.
 fn bundle() -> SceneBundle {
+    bundle_of(false)
+}
+
+/// A sphere on a slab (and with `tile` a normal-mapped tile beside them), its transfer made up
+/// (every coefficient a different size, some negative), under a map with a float32-only value
+/// and one in half floats.
+fn bundle_of(tile: bool) -> SceneBundle {
     let mut geometry = SceneMesh::default();
     geometry.push_object(
         "ball".into(),
@@ -21,6 +28,33 @@ fn bundle() -> SceneBundle {
         ),
         Rgb::splat(0.6),
     );
+    // A normal-mapped tile: texture coordinates, tangents of both signs, a 2 × 1 map.
+    let tile_mesh = TriangleMesh {
+        positions: vec![
+            Vec3::new(3.0, 0.0, 0.0),
+            Vec3::new(4.0, 0.0, 0.0),
+            Vec3::new(3.0, 0.0, 1.0),
+        ],
+        normals: vec![Vec3::Y; 3],
+        triangles: vec![[0, 2, 1]],
+        uvs: vec![glam::Vec2::ZERO, glam::Vec2::X, glam::Vec2::Y],
+        tangents: vec![
+            glam::Vec4::new(1.0, 0.0, 0.0, -1.0),
+            glam::Vec4::X,
+            glam::Vec4::X,
+        ],
+    };
+    if tile {
+        geometry.push_object("tile".into(), &tile_mesh, Rgb::splat(0.5));
+        geometry.set_normal_map(NormalMap {
+            texture: Arc::new(AlbedoTexture {
+                width: 2,
+                height: 1,
+                texels: vec![Rgb::new(0.5, 0.5, 1.0), Rgb::new(0.7, 0.4, 0.9)],
+            }),
+            scale: 0.8,
+        });
+    }
     geometry.objects[1].role = ObjectRole::Proxy;
     geometry.objects[0].material = Material::phong(Rgb::splat(0.2), 40.0);
     geometry.objects[1].material = Material::metallic_roughness(0.25, 0.75);
@@ -85,7 +119,15 @@ fn bundle() -> SceneBundle {
 
 #[test]
 fn round_trip_keeps_all_but_the_transfer_bit_for_bit() {
-    let original = bundle();
+    round_trip(bundle());
+    // Normal maps: the tangents (in the mesh), the objects' maps and the maps themselves.
+    let (original, back) = round_trip(bundle_of(true));
+    let h = &back.geometry;
+    assert_eq!(original.geometry.normal_maps, h.normal_maps);
+    assert!(!h.mesh.tangents.is_empty() && h.objects[2].normal_map == Some(0));
+}
+
+fn round_trip(original: SceneBundle) -> (SceneBundle, SceneBundle) {
     let back = SceneBundle::from_bytes("t.bin", &original.to_bytes().unwrap()).unwrap();
     let (g, h) = (&original.geometry, &back.geometry);
     assert_eq!(g.mesh, h.mesh);
@@ -111,6 +153,7 @@ fn round_trip_keeps_all_but_the_transfer_bit_for_bit() {
             );
         }
     }
+    (original, back)
 }
 
 /// What the 12 bits take away is noise already: two bakes of the test scene that differ in
@@ -183,9 +226,9 @@ fn a_map_is_stored_in_half_floats_only_where_they_hold_it_exactly() {
     assert_eq!(back.maps[0].map.texels(), b.maps[0].map.texels());
 }
 
-/// The uncompressed container of the test bundle.
-fn container() -> Vec<u8> {
-    gunzip_limited(&bundle().to_bytes().unwrap(), MAX_BUNDLE_BYTES).unwrap()
+/// The uncompressed container of the test bundle (with `tile`, its normal-mapped tile).
+fn container(tile: bool) -> Vec<u8> {
+    gunzip_limited(&bundle_of(tile).to_bytes().unwrap(), MAX_BUNDLE_BYTES).unwrap()
 }
 
 fn gzip(bytes: &[u8]) -> Vec<u8> {
@@ -206,7 +249,7 @@ fn truncated_or_damaged_files_are_refused_by_name() {
     let bytes = bundle().to_bytes().unwrap();
     let e = error_of(&bytes[..bytes.len() / 2]);
     assert!(e.starts_with("scene.bin"), "{e}");
-    let mut inner = container();
+    let mut inner = container(false);
     let e = error_of(&gzip(&inner[..inner.len() - 9]));
     assert!(e.contains("scene.bin") && e.contains("web scene"), "{e}");
     let middle = inner.len() / 2;
@@ -220,7 +263,10 @@ fn truncated_or_damaged_files_are_refused_by_name() {
 /// The container with its header edited and its checksum made good again: what a hostile
 /// file can claim.
 fn with_header(edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
-    let inner = container();
+    edited(container(false), edit)
+}
+
+fn edited(inner: Vec<u8>, edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
     let len = u32::from_le_bytes(inner[12..16].try_into().unwrap()) as usize;
     let mut header: serde_json::Value = serde_json::from_slice(&inner[16..16 + len]).unwrap();
     edit(&mut header);
@@ -275,6 +321,22 @@ fn hostile_headers_are_refused_before_use() {
     ];
     for (expected, edit) in cases {
         let e = error_of(&with_header(edit));
+        assert!(e.contains(expected), "expected {expected:?} in: {e}");
+    }
+    // A normal map that is not there, or has no texels.
+    assert!(SceneBundle::from_bytes("scene.bin", &edited(container(true), |_| ())).is_ok());
+    let tile_cases: [(&str, Box<HeaderEdit>); 2] = [
+        (
+            "past the",
+            Box::new(|h| h["objects"][2]["normal_map"] = 3.into()),
+        ),
+        (
+            "empty normal map",
+            Box::new(|h| h["normal_maps"][0]["width"] = 0.into()),
+        ),
+    ];
+    for (expected, edit) in tile_cases {
+        let e = error_of(&edited(container(true), edit));
         assert!(e.contains(expected), "expected {expected:?} in: {e}");
     }
 }

@@ -84,7 +84,8 @@ impl Renderer {
                 true => lights.len() as u32,
                 false => 0,
             },
-            sh_per_pixel: lighting.sh_transfer.per_pixel().then_some(&lighting.sh),
+            sh: &lighting.sh,
+            sh_per_pixel: lighting.sh_transfer.per_pixel(),
             unoccluded_reflections: lighting.sh_transfer == ShTransfer::Unbaked,
             reflection_to_map: match &lighting.reflections {
                 crate::reflection::ReflectedEnvironment::Remainder { orientation, .. } => {

@@ -1,7 +1,7 @@
 //! The static scene on the GPU: vertices, indices, baked transfer, and the per-vertex PRT
 //! radiance computed from them every time the lighting changes (`shaders/transfer.wgsl`).
 
-use super::bindings::ALBEDO_TEXTURE;
+use super::bindings::SURFACE_TEXTURES;
 use super::environment_texture::{mip_chain_of, upload_mip_chain};
 use super::error::{BakeMismatch, RenderError};
 use super::materials::GpuMaterials;
@@ -12,10 +12,9 @@ use crate::lighting::{FrameLighting, ShTransfer};
 use bytemuck::{Pod, Zeroable};
 use foundation::color::Rgb;
 use foundation::scene::SceneMesh;
-use foundation::texture::AlbedoTexture;
+use foundation::texture::{AlbedoTexture, NormalMap};
 use glam::Vec3;
 use precompute::bake::Transfer;
-use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 #[repr(C)]
@@ -26,6 +25,8 @@ struct Vertex {
     /// The albedo, or a textured object's factor (the texel multiplies it per pixel).
     albedo: [f32; 3],
     uv: [f32; 2],
+    /// glTF's tangent (xyz along +u, w the bitangent's sign); zero without a normal map.
+    tangent: [f32; 4],
 }
 
 pub(crate) struct GpuScene {
@@ -41,9 +42,10 @@ pub(crate) struct GpuScene {
     /// Scene bounds (min, max).
     pub bounds: (Vec3, Vec3),
     transfer_pass: TransferPass,
-    /// Layout of group 1 of the PRT pass: an albedo texture and its sampler.
+    /// Layout of group 1 of the PRT pass: an object's textures ([`SURFACE_TEXTURES`]).
     pub texture_layout: wgpu::BindGroupLayout,
-    /// One per texture; the first is a white texel for untextured objects.
+    /// One per pair of albedo texture and normal map ([`surface_keys`]); the first, a white
+    /// texel and no normal map, is the untextured objects'.
     texture_groups: Vec<wgpu::BindGroup>,
     /// Index ranges drawn with one texture group each, in scene order.
     draws: Vec<(std::ops::Range<u32>, usize)>,
@@ -57,7 +59,7 @@ pub(crate) const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::Vertex
     array_stride: std::mem::size_of::<Vertex>() as u64,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &wgpu::vertex_attr_array![
-        0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 4 => Float32x2
+        0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 4 => Float32x2, 10 => Float32x4
     ],
 };
 
@@ -97,6 +99,7 @@ fn vertices(geometry: &SceneMesh) -> Vec<Vertex> {
             normal: mesh.normals[v].to_array(),
             albedo: geometry.albedo[v].to_array(),
             uv: mesh.uvs.get(v).map_or([0.0; 2], |uv| uv.to_array()),
+            tangent: mesh.tangents.get(v).map_or([0.0; 4], |t| t.to_array()),
         })
         .collect()
 }
@@ -149,15 +152,19 @@ impl GpuScene {
             &indirect_radiance_buffer,
         );
         let materials = materials(device, queue, geometry, transfer)?;
-        let texture_layout = ALBEDO_TEXTURE.layout(device);
-        let white = Arc::new(AlbedoTexture {
+        let texture_layout = SURFACE_TEXTURES.layout(device);
+        let white = AlbedoTexture {
             width: 1,
             height: 1,
             texels: vec![Rgb::ONE],
-        });
-        let texture_groups = std::iter::once(&white)
-            .chain(&geometry.textures)
-            .map(|t| texture_group(device, queue, &texture_layout, t))
+        };
+        let texture_groups = surface_keys(geometry)
+            .into_iter()
+            .map(|(albedo, normals)| {
+                let albedo = albedo.map_or(&white, |t| &*geometry.textures[t]);
+                let normals = normals.map(|m| &geometry.normal_maps[m]);
+                texture_group(device, queue, &texture_layout, albedo, normals)
+            })
             .collect();
         Ok(Self {
             materials,
@@ -251,7 +258,7 @@ impl GpuScene {
         pass.set_vertex_buffer(3, self.indirect_buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
         for (range, group) in &self.draws {
-            pass.set_bind_group(ALBEDO_TEXTURE.group, &self.texture_groups[*group], &[]);
+            pass.set_bind_group(SURFACE_TEXTURES.group, &self.texture_groups[*group], &[]);
             pass.draw_indexed(range.clone(), 0, 0..1);
         }
     }
@@ -347,10 +354,22 @@ fn visibility(geometry: &SceneMesh, transfer: &Transfer) -> Vec<[f32; 4]> {
         .collect()
 }
 
-/// Index ranges of consecutive objects sharing a texture group (0: untextured, `i + 1`:
-/// `geometry.textures[i]`): an untextured scene is one draw.
+/// Index ranges of consecutive objects sharing a texture group (their place in
+/// [`surface_keys`]): an untextured scene is one draw.
 fn draws(geometry: &SceneMesh) -> Vec<(std::ops::Range<u32>, usize)> {
     draws_of(geometry, |_| true)
+}
+
+/// The objects' distinct pairs of albedo texture and normal map, in scene order after the
+/// untextured objects' `(None, None)`.
+fn surface_keys(geometry: &SceneMesh) -> Vec<(Option<usize>, Option<usize>)> {
+    let mut keys = vec![(None, None)];
+    for o in &geometry.objects {
+        if !keys.contains(&(o.texture, o.normal_map)) {
+            keys.push((o.texture, o.normal_map));
+        }
+    }
+    keys
 }
 
 /// [`draws`] of the objects `keep` keeps.
@@ -358,9 +377,13 @@ pub(crate) fn draws_of(
     geometry: &SceneMesh,
     keep: impl Fn(&foundation::scene::SceneObject) -> bool,
 ) -> Vec<(std::ops::Range<u32>, usize)> {
+    let keys = surface_keys(geometry);
     let mut draws: Vec<(std::ops::Range<u32>, usize)> = Vec::new();
     for o in geometry.objects.iter().filter(|o| keep(o)) {
-        let group = o.texture.map_or(0, |t| t + 1);
+        let group = keys
+            .iter()
+            .position(|k| *k == (o.texture, o.normal_map))
+            .unwrap_or(0);
         let range = 3 * o.triangles.start..3 * o.triangles.end;
         match draws.last_mut() {
             Some((last, g)) if *g == group && last.end == range.start => last.end = range.end,
@@ -370,16 +393,33 @@ pub(crate) fn draws_of(
     draws
 }
 
-/// An albedo texture with its mipmaps, sampled trilinearly with repeat wrapping (the reference
-/// looks the base level up bilinearly: `AlbedoTexture::bilinear`).
+/// An albedo texture and a normal map with their mipmaps, sampled trilinearly with repeat
+/// wrapping (the reference looks the base level up bilinearly: `AlbedoTexture::bilinear`),
+/// and the normal map's scale (x) and presence (y) in a uniform. Without a normal map, the
+/// albedo texture stands in for it, unread.
 fn texture_group(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     layout: &wgpu::BindGroupLayout,
     texture: &AlbedoTexture,
+    normal_map: Option<&NormalMap>,
 ) -> wgpu::BindGroup {
-    let levels = mip_chain_of(&texture.texels, texture.width, texture.height);
-    let gpu_texture = upload_mip_chain(device, queue, "albedo texture", &levels);
+    let upload = |texture: &AlbedoTexture, label| {
+        let levels = mip_chain_of(&texture.texels, texture.width, texture.height);
+        upload_mip_chain(device, queue, label, &levels)
+    };
+    let gpu_texture = upload(texture, "albedo texture");
+    let normal_texture = normal_map.map(|m| upload(&m.texture, "normal map"));
+    let surface = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("surface"),
+        contents: bytemuck::cast_slice(&[
+            normal_map.map_or(0.0, |m| m.scale),
+            f32::from(u8::from(normal_map.is_some())),
+            0.0,
+            0.0,
+        ]),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
     let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some("albedo texture"),
         address_mode_u: wgpu::AddressMode::Repeat,
@@ -390,12 +430,20 @@ fn texture_group(
         ..Default::default()
     });
     let view = gpu_texture.create_view(&Default::default());
-    ALBEDO_TEXTURE.bind_group(
+    let normal_view = normal_texture
+        .as_ref()
+        .map_or_else(|| view.clone(), |t| t.create_view(&Default::default()));
+    SURFACE_TEXTURES.bind_group(
         device,
         layout,
         &[
             ("albedo_texture", wgpu::BindingResource::TextureView(&view)),
             ("albedo_sampler", wgpu::BindingResource::Sampler(&sampler)),
+            (
+                "normal_texture",
+                wgpu::BindingResource::TextureView(&normal_view),
+            ),
+            ("surface", surface.as_entire_binding()),
         ],
     )
 }

@@ -56,7 +56,8 @@ pub(crate) struct FrameUniform {
     pcf_taps: u32,
     /// Layer offset of the proxies' own shadow maps (the live composite; 0 otherwise).
     proxy_layers: u32,
-    /// Per-pixel irradiance of bands 0–2 over π, `A_l L_k / π` (RGB in xyz), when flag bit 2.
+    /// Irradiance of bands 0–2 over π, `A_l L_k / π` (RGB in xyz): per pixel with flag bit 2,
+    /// and for normal maps.
     sh_irradiance: [[f32; 4]; 9],
     camera_position: [f32; 4],
     reflection_to_map: [[f32; 4]; 4],
@@ -110,9 +111,12 @@ pub(crate) struct FrameParameters<'a> {
     pub background: bool,
     pub pcf_taps: u32,
     pub proxy_layers: u32,
-    /// SH lighting (bands 0–2 used) applied per pixel by the normal, unshadowed, instead of
-    /// the per-vertex transfer ([`crate::lighting::ShTransfer::Unshadowed`]).
-    pub sh_per_pixel: Option<&'a ShCoeffs<Rgb>>,
+    /// The SH lighting (bands 0–2 used): what normal maps compare their normal's irradiance
+    /// with the vertex normal's by, and with `sh_per_pixel` the whole diffuse lighting.
+    pub sh: &'a ShCoeffs<Rgb>,
+    /// SH lighting applied per pixel by the normal, unshadowed, instead of the per-vertex
+    /// transfer ([`crate::lighting::ShTransfer::Unshadowed`]).
+    pub sh_per_pixel: bool,
     /// Reflections not occluded by the bake's visibility cones (the "ibl" peer).
     pub unoccluded_reflections: bool,
     /// World → the reflection maps' frame.
@@ -146,11 +150,11 @@ impl FrameUniform {
             env_rotation: [cos, sin, centre_pixel_angle(p.camera), 0.0],
             light_count: p.light_count as u32,
             flags: (u32::from(p.background) << 1)
-                | (u32::from(p.sh_per_pixel.is_some()) << 2)
+                | (u32::from(p.sh_per_pixel) << 2)
                 | (u32::from(p.unoccluded_reflections) << 3),
             pcf_taps: p.pcf_taps,
             proxy_layers: p.proxy_layers,
-            sh_irradiance: p.sh_per_pixel.map_or([[0.0; 4]; 9], irradiance_over_pi),
+            sh_irradiance: irradiance_over_pi(p.sh),
             camera_position: p.camera.position.extend(1.0).to_array(),
             reflection_to_map: p.reflection_to_map.to_cols_array_2d(),
         }

@@ -17,6 +17,7 @@ fn square(y: f32) -> TriangleMesh {
         normals: vec![Vec3::Y; 4],
         triangles: vec![[0, 1, 2], [0, 2, 3]],
         uvs: Vec::new(),
+        tangents: Vec::new(),
     }
 }
 
