@@ -6,6 +6,7 @@
 
 mod common;
 
+use common::quad::{Quad, quad};
 use common::*;
 use foundation::bvh::SceneBvh;
 use foundation::camera::Camera;
@@ -268,63 +269,6 @@ fn the_mirrored_tangent_model_follows_the_reference() {
     }
 }
 
-/// A one-quad model (two triangles facing +z, u along `u_sign` x, v along +y) with normals,
-/// its material's normal map `normal.png`; with `tangents` the file's tangents too, and with
-/// `uvs` its texture coordinates.
-fn quad_model(
-    dir: &std::path::Path,
-    name: &str,
-    u_sign: f32,
-    tangents: Option<[f32; 4]>,
-    uvs: bool,
-) -> std::path::PathBuf {
-    use serde_json::json;
-    let corners = [[0.0f32, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-    let mut bin = Vec::new();
-    let mut push = |values: &[f32]| values.iter().for_each(|v| bin.extend(v.to_le_bytes()));
-    corners.iter().for_each(|[x, y]| push(&[*x, *y, 0.0]));
-    corners.iter().for_each(|_| push(&[0.0, 0.0, 1.0]));
-    corners.iter().for_each(|[x, y]| push(&[u_sign * x, *y]));
-    corners
-        .iter()
-        .for_each(|_| push(&tangents.unwrap_or([1.0, 0.0, 0.0, 1.0])));
-    for i in [0u16, 1, 2, 0, 2, 3] {
-        bin.extend(i.to_le_bytes());
-    }
-    let view = |offset: usize, length: usize| json!({ "buffer": 0, "byteOffset": offset, "byteLength": length });
-    let mut attributes = json!({ "POSITION": 0, "NORMAL": 1 });
-    if uvs {
-        attributes["TEXCOORD_0"] = json!(2);
-    }
-    if tangents.is_some() {
-        attributes["TANGENT"] = json!(3);
-    }
-    let doc = json!({
-        "asset": { "version": "2.0" },
-        "scene": 0,
-        "scenes": [{ "nodes": [0] }],
-        "nodes": [{ "mesh": 0 }],
-        "meshes": [{ "primitives": [{ "attributes": attributes, "indices": 4, "material": 0 }] }],
-        "materials": [{ "normalTexture": { "index": 0, "scale": 0.5 } }],
-        "images": [{ "uri": "normal.png" }],
-        "textures": [{ "source": 0 }],
-        "accessors": [
-            { "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
-              "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0] },
-            { "bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3" },
-            { "bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2" },
-            { "bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC4" },
-            { "bufferView": 4, "componentType": 5123, "count": 6, "type": "SCALAR" }
-        ],
-        "bufferViews": [view(0, 48), view(48, 48), view(96, 32), view(128, 64), view(192, 12)],
-        "buffers": [{ "byteLength": 204, "uri": format!("{name}.bin") }]
-    });
-    std::fs::write(dir.join(format!("{name}.bin")), &bin).unwrap();
-    let path = dir.join(format!("{name}.gltf"));
-    std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
-    path
-}
-
 /// What the loader makes of normal maps: the file's tangents kept (zero ones stay zero, drawn
 /// without the map), MikkTSpace's where the file has none (along +u, w the sign of
 /// +v against cross(n, t): −1 where u runs along −x), the map's scale, and clear errors for a
@@ -350,13 +294,11 @@ fn the_loader_keeps_or_generates_tangents_and_refuses_what_it_cannot_draw() {
         assert_eq!(map.scale, 0.5);
         parts[0].mesh.tangents.clone().unwrap()
     };
-    let given = tangents_of(&quad_model(
-        d,
-        "given",
-        1.0,
-        Some([0.0, 1.0, 0.0, -1.0]),
-        true,
-    ));
+    let given = Quad {
+        tangents: Some([0.0, 1.0, 0.0, -1.0]),
+        ..Quad::normal_mapped()
+    };
+    let given = tangents_of(&quad(d, "given", &given));
     assert!(
         given.iter().all(|t| *t == Vec4::new(0.0, 1.0, 0.0, -1.0)),
         "{given:?}"
@@ -365,7 +307,14 @@ fn the_loader_keeps_or_generates_tangents_and_refuses_what_it_cannot_draw() {
         (1.0, Vec4::new(1.0, 0.0, 0.0, 1.0)),
         (-1.0, Vec4::new(-1.0, 0.0, 0.0, -1.0)),
     ] {
-        let made = tangents_of(&quad_model(d, "made", u_sign, None, true));
+        let made = tangents_of(&quad(
+            d,
+            "made",
+            &Quad {
+                u_sign,
+                ..Quad::normal_mapped()
+            },
+        ));
         assert!(
             made.iter().all(|t| (*t - want).length() < 1e-5),
             "u along {u_sign} x: {made:?}"
@@ -373,7 +322,14 @@ fn the_loader_keeps_or_generates_tangents_and_refuses_what_it_cannot_draw() {
     }
     // Zero tangents in the file: kept as zero by the clean-up, which draws those points plain.
     let scene = write_scene(d, "zero.toml", "mesh = \"zero.gltf\"");
-    quad_model(d, "zero", 1.0, Some([0.0; 4]), true);
+    quad(
+        d,
+        "zero",
+        &Quad {
+            tangents: Some([0.0; 4]),
+            ..Quad::normal_mapped()
+        },
+    );
     let zero = Scene::load(&scene).unwrap();
     assert!(zero.geometry.mesh.tangents.iter().all(|t| *t == Vec4::ZERO));
     assert_eq!(zero.geometry.objects[0].normal_map, Some(0));
@@ -383,7 +339,14 @@ fn the_loader_keeps_or_generates_tangents_and_refuses_what_it_cannot_draw() {
             .unwrap_err()
             .to_string()
     };
-    let e = error(&quad_model(d, "bare", 1.0, None, false));
+    let e = error(&quad(
+        d,
+        "bare",
+        &Quad {
+            uv_sets: 0,
+            ..Quad::normal_mapped()
+        },
+    ));
     assert!(
         e.contains("bare.gltf") && e.contains("normal map") && e.contains("TEXCOORD_0"),
         "{e}"
@@ -392,6 +355,6 @@ fn the_loader_keeps_or_generates_tangents_and_refuses_what_it_cannot_draw() {
         .unwrap()
         .save(d.join("normal.png"))
         .unwrap();
-    let e = error(&quad_model(d, "grey", 1.0, None, true));
+    let e = error(&quad(d, "grey", &Quad::normal_mapped()));
     assert!(e.contains("grey.gltf") && e.contains("normal map"), "{e}");
 }

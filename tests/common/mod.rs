@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod composite;
+pub mod quad;
 pub mod spheres;
 pub mod viewer;
 

@@ -1,7 +1,8 @@
 //! glTF 2.0 models (`.gltf` with its buffers, or `.glb`) through the `gltf` crate: every
 //! triangle primitive of the default scene, placed by its node transforms, with its texture
-//! coordinates and tangents, the material's base colour (factor and texture), its normal map
-//! (tangents generated with MikkTSpace where the primitive has none) and its
+//! coordinates (the set its textures read, transformed as they say) and tangents, the
+//! material's base colour (factor and texture), its normal map (tangents generated with
+//! MikkTSpace where the primitive has none) and its
 //! metallic-roughness layer (factors, times the mean of their texture's channels). Everything
 //! else a material says is ignored, with one note per material.
 
@@ -9,7 +10,7 @@ use super::error::MeshError;
 use super::gltf_geometry::{assemble_triangles, check_type, with_flat_normals};
 use super::gltf_material::{decode_normals, decode_srgb, ignored_properties, part_layer};
 use super::gltf_sources::Sources;
-use super::tangents::TangentInput;
+use super::gltf_texcoords::{Textured, finish_textured, material_tex_coords};
 use super::triangle_mesh::RawMesh;
 use crate::color::Rgb;
 use crate::material::Layer;
@@ -189,31 +190,16 @@ impl Loader<'_> {
                 continue;
             }
             self.check_primitive(&name, &primitive)?;
-            let mut raw = self.primitive_mesh(&name, &primitive, world)?;
+            let coords = material_tex_coords(&primitive.material())
+                .map_err(|m| self.invalid(format!("{name}: {m}")))?;
+            let mut raw = self.primitive_mesh(&name, &primitive, world, coords.set)?;
             let material = self.material(&primitive.material())?;
-            let textured = [
-                ("a base colour texture", material.texture.is_some()),
-                ("a normal map", material.normal_map.is_some()),
-            ];
-            if let Some((what, _)) = textured.iter().find(|(_, has)| *has)
-                && raw.uvs.is_none()
-            {
-                return Err(self.invalid(format!(
-                    "{name}: its material has {what} but the primitive has no TEXCOORD_0"
-                )));
-            }
-            if material.normal_map.is_none() {
-                raw.tangents = None;
-            } else if raw.tangents.is_none()
-                && let (Some(normals), Some(uvs)) = (&raw.normals, &raw.uvs)
-            {
-                raw.tangents = Some(super::tangents::generate_tangents(TangentInput {
-                    positions: &raw.positions,
-                    normals,
-                    uvs,
-                    triangles: &raw.triangles,
-                }));
-            }
+            let textured = Textured {
+                base_colour: material.texture.is_some(),
+                normal_map: material.normal_map.is_some(),
+            };
+            finish_textured(&mut raw, textured, coords)
+                .map_err(|m| self.invalid(format!("{name}: {m}")))?;
             self.parts.push(ModelPart {
                 name,
                 mesh: raw,
@@ -230,6 +216,7 @@ impl Loader<'_> {
         name: &str,
         primitive: &gltf::Primitive,
         world: &Mat4,
+        uv_set: u32,
     ) -> Result<RawMesh, MeshError> {
         let reader = primitive.reader(|b| self.buffers.get(b.index()).map(|d| &d[..]));
         let positions: Vec<Vec3> = reader
@@ -239,7 +226,7 @@ impl Loader<'_> {
             .collect();
         let normals: Option<Vec<Vec3>> = reader.read_normals().map(|n| n.map(Vec3::from).collect());
         let uvs: Option<Vec<Vec2>> = reader
-            .read_tex_coords(0)
+            .read_tex_coords(uv_set)
             .map(|t| t.into_f32().map(Vec2::from).collect());
         // glTF gives tangents only beside normals (3.7.2.1); flat normals get generated ones.
         let tangents: Option<Vec<Vec4>> = reader
@@ -388,16 +375,7 @@ impl Loader<'_> {
         }
         let texture = match pbr.base_color_texture() {
             None => None,
-            Some(info) => {
-                if info.tex_coord() != 0 {
-                    return Err(self.invalid(format!(
-                        "{name}: the base colour texture uses TEXCOORD_{}; hprt reads \
-                         TEXCOORD_0 only",
-                        info.tex_coord()
-                    )));
-                }
-                Some(self.image(&info.texture().source(), false)?)
-            }
+            Some(info) => Some(self.image(&info.texture().source(), false)?),
         };
         let means = match pbr.metallic_roughness_texture() {
             None => None,
@@ -427,12 +405,6 @@ impl Loader<'_> {
         material: &str,
         normal: &gltf::material::NormalTexture,
     ) -> Result<NormalMap, MeshError> {
-        if normal.tex_coord() != 0 {
-            return Err(self.invalid(format!(
-                "{material}: the normal texture uses TEXCOORD_{}; hprt reads TEXCOORD_0 only",
-                normal.tex_coord()
-            )));
-        }
         let scale = normal.scale();
         if !scale.is_finite() {
             return Err(self.invalid(format!("{material}: the normal texture's scale is {scale}")));

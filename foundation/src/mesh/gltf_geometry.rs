@@ -47,7 +47,7 @@ pub(super) fn check_type(
             data == DataType::F32 && dims == Dimensions::Vec3
         }
         gltf::Semantic::Tangents => data == DataType::F32 && dims == Dimensions::Vec4,
-        gltf::Semantic::TexCoords(0) => {
+        gltf::Semantic::TexCoords(_) => {
             dims == Dimensions::Vec2 && matches!(data, DataType::F32 | DataType::U8 | DataType::U16)
         }
         _ => true,

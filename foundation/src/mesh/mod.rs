@@ -10,6 +10,7 @@ mod gltf;
 mod gltf_geometry;
 mod gltf_material;
 mod gltf_sources;
+mod gltf_texcoords;
 mod obj;
 mod ply;
 mod shapes;
