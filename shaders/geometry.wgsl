@@ -13,6 +13,9 @@
 // vertex normal, is scaled by the SH irradiance at the mapped normal over that at the vertex
 // normal (CONVENTIONS.md, "Normal maps").
 //
+// Emitting objects add the radiance they emit (glTF's emission), which the bake does not
+// carry to other surfaces (CONVENTIONS.md, "Emission").
+//
 // Glossy objects add k_s times their specular occlusion times the prefiltered reflection map of
 // their shininess at the mirror direction (the environment beyond the lights; the lights' lobes
 // are the light pass's), and write their material index into the normal's w.
@@ -21,8 +24,16 @@
 @group(1) @binding(0) var albedo_texture: texture_2d<f32>;
 @group(1) @binding(1) var albedo_sampler: sampler;
 @group(1) @binding(2) var normal_texture: texture_2d<f32>;
-// x: the normal map's scale; y: 1 where the object has a normal map.
-@group(1) @binding(3) var<uniform> surface: vec4<f32>;
+@group(1) @binding(3) var emissive_texture: texture_2d<f32>;
+@group(1) @binding(4) var<uniform> surface: Surface;
+
+struct Surface {
+    // x: the normal map's scale; y: 1 where the object has a normal map.
+    normal_map: vec4<f32>,
+    // rgb: the radiance it emits (glTF's emissive factor times strength); w: 1 where the
+    // emissive texture multiplies it.
+    emission: vec4<f32>,
+};
 @group(0) @binding(1) var<uniform> materials: Materials;
 // Six layers (one cube) per shininess slot.
 @group(0) @binding(2) var reflection_maps: texture_2d_array<f32>;
@@ -205,10 +216,11 @@ fn shade(in: VertexOut) -> FragmentOut {
     let vertex_normal = normalize(in.normal);
     let texel = textureSample(albedo_texture, albedo_sampler, in.uv).rgb;
     let normal_texel = textureSample(normal_texture, albedo_sampler, in.uv).rgb;
+    let emissive_texel = textureSample(emissive_texture, albedo_sampler, in.uv).rgb;
     var normal = vertex_normal;
     out.color = vec4<f32>(in.radiance * texel, 1.0);
-    if surface.y > 0.5 {
-        normal = perturbed_normal(vertex_normal, in.tangent, normal_texel, surface.x);
+    if surface.normal_map.y > 0.5 {
+        normal = perturbed_normal(vertex_normal, in.tangent, normal_texel, surface.normal_map.x);
         out.color = vec4<f32>(out.color.xyz * normal_map_ratio(vertex_normal, normal), 1.0);
     }
     if (frame.flags & 4u) != 0u {
@@ -262,6 +274,9 @@ fn shade(in: VertexOut) -> FragmentOut {
             out.color = out.color + vec4<f32>(material.specular.rgb * reflected, 0.0);
         }
     }
+    // Emission: added as it is, from both sides (the light pass adds the lights' on top).
+    let emitted_texel = select(vec3<f32>(1.0), emissive_texel, surface.emission.w > 0.5);
+    out.color = out.color + vec4<f32>(surface.emission.rgb * emitted_texel, 0.0);
     // w: the material index (exact in a half float) for the light pass.
     out.normal = vec4<f32>(normal, f32(in.material));
     out.albedo = vec4<f32>(in.albedo * texel, 1.0);

@@ -151,6 +151,26 @@ impl NormalMap {
     }
 }
 
+/// Light a surface emits (glTF's `emissiveFactor` times `KHR_materials_emissive_strength`,
+/// times its sRGB `emissiveTexture` if any): radiance, linear, the same toward every direction
+/// and from both sides (CONVENTIONS.md, "Emission").
+#[derive(Debug, Clone, PartialEq)]
+pub struct Emission {
+    pub factor: crate::color::Rgb,
+    pub texture: Option<std::sync::Arc<AlbedoTexture>>,
+}
+
+impl Emission {
+    /// The radiance emitted at texture coordinates `uv` (the texel looked up as
+    /// [`AlbedoTexture::bilinear`] does).
+    pub fn radiance(&self, uv: Vec2) -> crate::color::Rgb {
+        match &self.texture {
+            Some(t) => self.factor * t.bilinear(uv),
+            None => self.factor,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -117,6 +117,10 @@ class SceneObject:
     def normal_map_scale(self) -> float | None:
         """The scale of the object's tangent-space normal map (None without one)."""
     @property
+    def emission(self) -> tuple[float, float, float] | None:
+        """The radiance the object emits: glTF's emissive factor times its strength, before
+        its emissive texture (None where it emits nothing)."""
+    @property
     def vertex_count(self) -> int: ...
     @property
     def triangle_count(self) -> int: ...

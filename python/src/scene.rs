@@ -111,6 +111,8 @@ pub(crate) struct SceneObject {
     roughness: Option<f32>,
     /// The scale of its tangent-space normal map (`None` without one).
     normal_map_scale: Option<f32>,
+    /// The radiance it emits (glTF's emissive factor times strength; `None` for none).
+    emission: Option<[f32; 3]>,
     vertex_count: u32,
     triangle_count: u32,
 }
@@ -130,6 +132,7 @@ impl SceneObject {
             metallic: o.material.layer.map(|l| l.metallic),
             roughness: o.material.layer.map(|l| l.roughness),
             normal_map_scale: o.normal_map.map(|m| geometry.normal_maps[m].scale),
+            emission: o.emission.map(|e| geometry.emissions[e].factor.to_array()),
             vertex_count: o.vertices.end - o.vertices.start,
             triangle_count: o.triangles.end - o.triangles.start,
         }

@@ -286,6 +286,7 @@ class BakeAndRender(unittest.TestCase):
         self.assertIsNone(table.metallic)
         self.assertIsNone(table.roughness)
         self.assertIsNone(table.normal_map_scale)
+        self.assertIsNone(table.emission)
         mirror = hprt.load_scene(SCENES / "models" / "NormalTangentMirrorTest.glb")
         scales = [o.normal_map_scale for o in mirror.objects]
         self.assertIn(1.0, scales)  # the panel's map

@@ -27,6 +27,8 @@ pub struct SurfacePoint {
     pub albedo: Rgb,
     /// The specular lobe (diffuse surfaces: [`Material::DIFFUSE`]).
     pub material: Material,
+    /// The radiance it emits toward every direction (zero for most surfaces).
+    pub emitted: Rgb,
     /// Which triangles a ray leaving the point must not hit: the one it leaves, or, for a ray
     /// leaving a vertex, every triangle sharing the vertex (as in the bake).
     pub leaving: Skip,
@@ -85,6 +87,9 @@ pub struct Integrator<'a> {
     /// Per triangle, its normal map in `geometry.normal_maps` or [`NO_TEXTURE`]; empty for a
     /// scene without normal maps.
     triangle_normal_maps: Vec<u32>,
+    /// Per triangle, its emission in `geometry.emissions` or [`NO_TEXTURE`]; empty for a scene
+    /// that emits nothing, whose paths then end on their last bounce as before.
+    triangle_emissions: Vec<u32>,
     /// Per triangle, its material; empty for a diffuse scene.
     triangle_materials: HugePageTable<Material>,
 }
@@ -122,6 +127,10 @@ impl<'a> Integrator<'a> {
             triangle_normal_maps: match geometry.normal_maps.is_empty() {
                 true => Vec::new(),
                 false => geometry.triangle_normal_maps(),
+            },
+            triangle_emissions: match geometry.emissions.is_empty() {
+                true => Vec::new(),
+                false => geometry.triangle_emissions(),
             },
             triangle_materials: if !geometry.is_lambertian() {
                 geometry.triangle_materials()
@@ -165,6 +174,7 @@ impl<'a> Integrator<'a> {
             shading_normal = self.mapped_normal(hit, shading_normal, map as usize);
         }
         SurfacePoint {
+            emitted: self.emitted(hit),
             position,
             shading_normal,
             front_normal: front,
@@ -176,6 +186,30 @@ impl<'a> Integrator<'a> {
                 .unwrap_or_default(),
             leaving: Skip::Triangle(hit.triangle),
         }
+    }
+
+    /// The radiance the surface emits at a hit (both sides alike: CONVENTIONS.md, "Emission").
+    fn emitted(&self, hit: &Hit) -> Rgb {
+        match self.triangle_emissions.get(hit.triangle as usize) {
+            Some(&e) if e != NO_TEXTURE => {
+                let emission = &self.geometry.emissions[e as usize];
+                match emission.texture {
+                    None => emission.factor,
+                    Some(_) => emission.radiance(self.hit_uv(hit)),
+                }
+            }
+            _ => Rgb::ZERO,
+        }
+    }
+
+    /// The interpolated texture coordinates at a hit.
+    fn hit_uv(&self, hit: &Hit) -> glam::Vec2 {
+        let mesh = &self.geometry.mesh;
+        mesh.triangles[hit.triangle as usize]
+            .iter()
+            .zip(hit.barycentrics())
+            .map(|(i, w)| mesh.uvs[*i as usize] * w)
+            .sum()
     }
 
     /// The shading normal a normal map gives at a hit whose interpolated normal is `n`.
@@ -201,6 +235,8 @@ impl<'a> Integrator<'a> {
             position: mesh.positions[v as usize],
             shading_normal: normal,
             front_normal: normal,
+            // The bake's points: light from the environment alone.
+            emitted: Rgb::ZERO,
             // On a textured object, the texture's factor: as the bake, per unit texel value.
             albedo: self.geometry.albedo[v as usize],
             material: self
@@ -252,6 +288,9 @@ impl<'a> Integrator<'a> {
         let mut light_sample = self.light.sample_texel(sampler.next_2d());
         for depth in 0..=self.bounces {
             let point = path.point;
+            // Light the point emits itself, seen along the path (an emitter is found by the
+            // path alone, not sampled: weight 1).
+            out.radiance += path.before * point.emitted;
             let bsdf = if point.material.is_lambertian() {
                 None
             } else {
@@ -280,19 +319,12 @@ impl<'a> Integrator<'a> {
             };
             *rays += 1;
             if depth == self.bounces {
-                // Only whether it escapes matters: an occlusion ray suffices.
-                if !self.occluded(&point, w) {
-                    let le = escaped();
-                    out.radiance += path.before * le;
-                    out.specular += path.specular_before * le;
-                }
+                self.last_segment(&path, w, escaped, &mut out);
                 break;
             }
             match self.trace(&point, w) {
                 None => {
-                    let le = escaped();
-                    out.radiance += path.before * le;
-                    out.specular += path.specular_before * le;
+                    path.add(escaped(), &mut out);
                     break;
                 }
                 Some(hit) => {
@@ -309,6 +341,27 @@ impl<'a> Integrator<'a> {
             }
         }
         out
+    }
+
+    /// The path's last segment, along `w`: what it reaches counts, the environment (its
+    /// radiance `escaped()`) or an emitter. Without emitters only whether it escapes matters:
+    /// an occlusion ray suffices.
+    fn last_segment(
+        &self,
+        path: &PathVertex,
+        w: Vec3,
+        escaped: impl FnOnce() -> Rgb,
+        out: &mut PathEstimate,
+    ) {
+        if self.triangle_emissions.is_empty() {
+            if !self.occluded(&path.point, w) {
+                path.add(escaped(), out);
+            }
+        } else if let Some(hit) = self.trace(&path.point, w) {
+            out.radiance += path.before * self.emitted(&hit);
+        } else {
+            path.add(escaped(), out);
+        }
     }
 
     /// Next-event estimation toward the environment from the path's current point, with the
@@ -392,6 +445,12 @@ impl PathVertex {
     /// Draws the continuation from the point's BSDF (`bsdf`, or Lambertian) and moves the
     /// path's weights past the point; `None` where the sampled direction reflects nothing.
     #[inline]
+    /// Adds the environment's radiance `le`, seen along the path's continuation, to `out`.
+    fn add(&self, le: Rgb, out: &mut PathEstimate) {
+        out.radiance += self.before * le;
+        out.specular += self.specular_before * le;
+    }
+
     fn scatter(
         &mut self,
         bsdf: Option<&SurfaceBsdf>,

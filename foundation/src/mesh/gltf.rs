@@ -7,14 +7,14 @@
 //! else a material says is ignored, with one note per material.
 
 use super::error::MeshError;
-use super::gltf_geometry::{assemble_triangles, check_type, with_flat_normals};
+use super::gltf_geometry::{assemble_triangles, check_accessor, check_type, with_flat_normals};
 use super::gltf_material::{decode_normals, decode_srgb, ignored_properties, part_layer};
 use super::gltf_sources::Sources;
 use super::gltf_texcoords::{Textured, finish_textured, material_tex_coords};
 use super::triangle_mesh::RawMesh;
 use crate::color::Rgb;
 use crate::material::Layer;
-use crate::texture::{AlbedoTexture, NormalMap, decode_image};
+use crate::texture::{AlbedoTexture, Emission, NormalMap, decode_image};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
@@ -45,6 +45,8 @@ pub struct PartMaterial {
     pub layer: Option<Layer>,
     /// `normalTexture`, decoded linearly, with its scale.
     pub normal_map: Option<NormalMap>,
+    /// The light it emits; `None` where its emissive factor is black.
+    pub emission: Option<Emission>,
 }
 
 /// Extensions that change how geometry is stored: a file that requires one cannot be read.
@@ -197,6 +199,10 @@ impl Loader<'_> {
             let textured = Textured {
                 base_colour: material.texture.is_some(),
                 normal_map: material.normal_map.is_some(),
+                emission: material
+                    .emission
+                    .as_ref()
+                    .is_some_and(|e| e.texture.is_some()),
             };
             finish_textured(&mut raw, textured, coords)
                 .map_err(|m| self.invalid(format!("{name}: {m}")))?;
@@ -283,11 +289,12 @@ impl Loader<'_> {
     /// Checks every accessor of a primitive before the `gltf` crate's reader touches it.
     fn check_primitive(&self, name: &str, primitive: &gltf::Primitive) -> Result<(), MeshError> {
         for (semantic, accessor) in primitive.attributes() {
-            self.check_accessor(name, &format!("{semantic:?}"), &accessor)?;
+            check_accessor(self.buffers, name, &format!("{semantic:?}"), &accessor)
+                .map_err(|m| self.invalid(m))?;
             check_type(&semantic, &accessor).map_err(|m| self.invalid(format!("{name}: {m}")))?;
         }
         if let Some(indices) = primitive.indices() {
-            self.check_accessor(name, "indices", &indices)?;
+            check_accessor(self.buffers, name, "indices", &indices).map_err(|m| self.invalid(m))?;
             let index_type = matches!(
                 indices.data_type(),
                 DataType::U8 | DataType::U16 | DataType::U32
@@ -301,53 +308,6 @@ impl Loader<'_> {
                     indices.dimensions()
                 )));
             }
-        }
-        Ok(())
-    }
-
-    /// Refuses what the `gltf` crate's reader would read wrongly or panic on: sparse
-    /// accessors, and accessors reaching past their buffer view or buffer.
-    fn check_accessor(
-        &self,
-        part: &str,
-        what: &str,
-        accessor: &gltf::Accessor,
-    ) -> Result<(), MeshError> {
-        if accessor.sparse().is_some() {
-            return Err(self.invalid(format!(
-                "{part}: {what} uses a sparse accessor, which hprt does not support"
-            )));
-        }
-        let Some(view) = accessor.view() else {
-            return Err(self.invalid(format!("{part}: {what} has no buffer view")));
-        };
-        let buffer_len = self
-            .buffers
-            .get(view.buffer().index())
-            .map_or(0, |b| b.len());
-        let element = accessor.size();
-        let stride = view.stride().unwrap_or(element);
-        if stride < element {
-            return Err(self.invalid(format!(
-                "{part}: {what} (accessor {}) has a byteStride of {stride}, less than its \
-                 {element}-byte elements",
-                accessor.index()
-            )));
-        }
-        // Checked: a hostile count or offset must not wrap around to a small number.
-        let needed = match accessor.count() {
-            0 => Some(0),
-            n => stride
-                .checked_mul(n - 1)
-                .and_then(|s| s.checked_add(accessor.offset()))
-                .and_then(|s| s.checked_add(element)),
-        };
-        let view_end = view.offset().checked_add(view.length());
-        if needed.is_none_or(|n| n > view.length()) || view_end.is_none_or(|end| end > buffer_len) {
-            return Err(self.invalid(format!(
-                "{part}: {what} reaches past the end of its buffer (accessor {})",
-                accessor.index()
-            )));
         }
         Ok(())
     }
@@ -390,13 +350,42 @@ impl Loader<'_> {
             None => None,
             Some(normal) => Some(self.normal_map(&name, &normal)?),
         };
+        let emission = self.emission(&name, material)?;
         Ok(PartMaterial {
             name,
             base_color: Rgb::new(r, g, b),
             texture,
             layer,
             normal_map,
+            emission,
         })
+    }
+
+    /// A material's emission: `emissiveFactor` times `KHR_materials_emissive_strength`, times
+    /// its sRGB texture. A negative factor or strength is refused; factors above 1 (against the
+    /// specification, from exporters without the strength extension) are kept.
+    fn emission(
+        &mut self,
+        name: &str,
+        material: &gltf::Material,
+    ) -> Result<Option<Emission>, MeshError> {
+        let factor = material.emissive_factor();
+        let strength = material.emissive_strength().unwrap_or(1.0);
+        if factor.iter().any(|f| *f < 0.0) || strength < 0.0 || strength.is_nan() {
+            return Err(self.invalid(format!(
+                "{name}: emissive factor {factor:?} with strength {strength}: neither may be \
+                 negative"
+            )));
+        }
+        let factor = Rgb::from(factor) * strength;
+        if factor == Rgb::ZERO {
+            return Ok(None);
+        }
+        let texture = match material.emissive_texture() {
+            None => None,
+            Some(info) => Some(self.image(&info.texture().source(), false)?),
+        };
+        Ok(Some(Emission { factor, texture }))
     }
 
     /// A material's normal map; a non-finite scale is refused (glTF's default is 1).

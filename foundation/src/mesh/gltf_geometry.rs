@@ -62,6 +62,50 @@ pub(super) fn check_type(
     }
 }
 
+/// Refuses what the `gltf` crate's reader would read wrongly or panic on: sparse
+/// accessors, and accessors reaching past their buffer view or buffer.
+pub(super) fn check_accessor(
+    buffers: &[gltf::buffer::Data],
+    part: &str,
+    what: &str,
+    accessor: &gltf::Accessor,
+) -> Result<(), String> {
+    if accessor.sparse().is_some() {
+        return Err(format!(
+            "{part}: {what} uses a sparse accessor, which hprt does not support"
+        ));
+    }
+    let Some(view) = accessor.view() else {
+        return Err(format!("{part}: {what} has no buffer view"));
+    };
+    let buffer_len = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
+    let element = accessor.size();
+    let stride = view.stride().unwrap_or(element);
+    if stride < element {
+        return Err(format!(
+            "{part}: {what} (accessor {}) has a byteStride of {stride}, less than its \
+             {element}-byte elements",
+            accessor.index()
+        ));
+    }
+    // Checked: a hostile count or offset must not wrap around to a small number.
+    let needed = match accessor.count() {
+        0 => Some(0),
+        n => stride
+            .checked_mul(n - 1)
+            .and_then(|s| s.checked_add(accessor.offset()))
+            .and_then(|s| s.checked_add(element)),
+    };
+    let view_end = view.offset().checked_add(view.length());
+    if needed.is_none_or(|n| n > view.length()) || view_end.is_none_or(|end| end > buffer_len) {
+        return Err(format!(
+            "{part}: {what} reaches past the end of its buffer (accessor {})",
+            accessor.index()
+        ));
+    }
+    Ok(())
+}
+
 /// Triangles of a triangle list, strip or fan.
 pub(super) fn assemble_triangles(mode: Mode, indices: &[u32]) -> Vec<[u32; 3]> {
     match mode {

@@ -45,9 +45,6 @@ pub(super) fn ignored_properties(material: &gltf::Material) -> Vec<&'static str>
     if material.occlusion_texture().is_some() {
         ignored.push("occlusion texture");
     }
-    if material.emissive_texture().is_some() || material.emissive_factor() != [0.0; 3] {
-        ignored.push("emission");
-    }
     if material.alpha_mode() != gltf::material::AlphaMode::Opaque {
         ignored.push("transparency");
     }

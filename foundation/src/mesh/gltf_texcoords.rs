@@ -1,7 +1,8 @@
 //! Which texture coordinates a glTF material's textures read: the set (`TEXCOORD_n`) and the
 //! `KHR_texture_transform` each texture names, applied to the primitive's coordinates once.
 //! hprt keeps one set of coordinates per vertex, so the textures it draws (base colour, normal
-//! map) must agree on both; the metallic-roughness texture is drawn by its mean and reads none.
+//! map, emission) must agree on both; the metallic-roughness texture is drawn by its mean and
+//! reads none.
 
 use super::tangents::{TangentInput, generate_tangents};
 use super::triangle_mesh::RawMesh;
@@ -74,8 +75,8 @@ fn coords(tex_coord: u32, transform: Option<Transform>) -> TexCoords {
 }
 
 /// The coordinates of the textures `material` draws; set 0 untransformed where it draws none.
-/// An error names what disagrees when its base colour texture and normal map read different
-/// sets or transforms.
+/// An error names what disagrees where its base colour texture, normal map and emissive
+/// texture read different sets or transforms.
 pub(super) fn material_tex_coords(material: &gltf::Material) -> Result<TexCoords, String> {
     let transform_of = |info: &gltf::texture::Info| {
         info.texture_transform().map(|t| Transform {
@@ -85,37 +86,39 @@ pub(super) fn material_tex_coords(material: &gltf::Material) -> Result<TexCoords
             tex_coord: t.tex_coord(),
         })
     };
-    let base = material
-        .pbr_metallic_roughness()
-        .base_color_texture()
-        .map(|info| coords(info.tex_coord(), transform_of(&info)));
-    let normals = match material.normal_texture() {
-        None => None,
-        Some(n) => Some(coords(n.tex_coord(), normal_transform(&n)?)),
+    let info_coords = |info: gltf::texture::Info| coords(info.tex_coord(), transform_of(&info));
+    let mut drawn = Vec::new();
+    if let Some(info) = material.pbr_metallic_roughness().base_color_texture() {
+        drawn.push(("base colour texture", info_coords(info)));
+    }
+    if let Some(n) = material.normal_texture() {
+        drawn.push(("normal map", coords(n.tex_coord(), normal_transform(&n)?)));
+    }
+    if let Some(info) = material.emissive_texture() {
+        drawn.push(("emissive texture", info_coords(info)));
+    }
+    let describe = |(what, c): &(&str, TexCoords)| {
+        let moved = if c.transform.is_some() {
+            " transformed"
+        } else {
+            ""
+        };
+        format!("its {what} reads TEXCOORD_{}{moved}", c.set)
     };
-    match (base, normals) {
-        (Some(b), Some(n)) if b != n => Err(format!(
-            "its base colour texture reads TEXCOORD_{}{} and its normal map TEXCOORD_{}{}: \
-             hprt keeps one set of texture coordinates per vertex, so both must read the same",
-            b.set,
-            if b.transform.is_some() {
-                " transformed"
-            } else {
-                ""
-            },
-            n.set,
-            if n.transform.is_some() {
-                " transformed"
-            } else {
-                ""
-            },
+    match drawn.iter().find(|(_, c)| *c != drawn[0].1) {
+        Some(other) => Err(format!(
+            "{} and {}: hprt keeps one set of texture coordinates per vertex, so every texture \
+             it draws must read the same",
+            describe(&drawn[0]),
+            describe(other)
         )),
-        (Some(b), _) => Ok(b),
-        (None, Some(n)) => Ok(n),
-        (None, None) => Ok(TexCoords {
-            set: 0,
-            transform: None,
-        }),
+        None => Ok(drawn.first().map_or(
+            TexCoords {
+                set: 0,
+                transform: None,
+            },
+            |(_, c)| *c,
+        )),
     }
 }
 
@@ -134,6 +137,7 @@ fn normal_transform(normal: &gltf::material::NormalTexture) -> Result<Option<Tra
 pub(super) struct Textured {
     pub base_colour: bool,
     pub normal_map: bool,
+    pub emission: bool,
 }
 
 /// Finishes a primitive's texture coordinates and tangents for its material: the transform
@@ -148,6 +152,7 @@ pub(super) fn finish_textured(
     let textured = [
         ("a base colour texture", material.base_colour),
         ("a normal map", material.normal_map),
+        ("an emissive texture", material.emission),
     ];
     if let Some((what, _)) = textured.iter().find(|(_, has)| *has)
         && raw.uvs.is_none()

@@ -147,6 +147,7 @@ pub(super) fn parse_obj_parts(
                     texture,
                     layer: None,
                     normal_map: None,
+                    emission: None,
                 })
             }
         };

@@ -11,7 +11,7 @@ use crate::infra::names::check_file_name;
 use crate::material::{Layer, MAX_SHININESS, Material, check_energy};
 use crate::mesh::{LoadOptions, MeshError, TriangleMesh, annulus_mesh, box_mesh};
 use crate::probe::ProbeSource;
-use crate::texture::{AlbedoTexture, NormalMap};
+use crate::texture::{AlbedoTexture, Emission, NormalMap};
 use glam::Vec3;
 use std::path::Path;
 use std::sync::Arc;
@@ -254,7 +254,8 @@ fn add_object(
         let material = part_material(material, colour.is_some(), part.layer);
         // A scene file's colour replaces the model's whole material, textures included.
         let textures = colour.is_none().then_some((part.texture, part.normal_map));
-        push_part(geometry, part_name, &world, albedo, textures);
+        let emission = part.emission;
+        push_part(geometry, (part_name, &world, albedo), textures, emission);
         if let Some(o) = geometry.objects.last_mut() {
             o.material = material;
             o.role = object.role;
@@ -263,13 +264,13 @@ fn add_object(
     Ok(())
 }
 
-/// Adds one part of an object, with its model's base colour texture and normal map, if any.
+/// Adds one part of an object, with its model's base colour texture and normal map, if any,
+/// and its emission (light, not the surface's colour: a scene file's colour keeps it).
 fn push_part(
     geometry: &mut SceneMesh,
-    name: String,
-    world: &TriangleMesh,
-    albedo: Rgb,
+    (name, world, albedo): (String, &TriangleMesh, Rgb),
     textures: Option<(Option<Arc<AlbedoTexture>>, Option<NormalMap>)>,
+    emission: Option<Emission>,
 ) {
     let (texture, normal_map) = textures.unwrap_or_default();
     match texture {
@@ -278,6 +279,9 @@ fn push_part(
     }
     if let Some(map) = normal_map {
         geometry.set_normal_map(map);
+    }
+    if let Some(emission) = emission {
+        geometry.set_emission(emission);
     }
 }
 
@@ -399,6 +403,7 @@ fn load_object_parts(
             texture: None,
             layer: None,
             normal_map: None,
+            emission: None,
         }]
     };
     match (&object.mesh, &object.box_shape, &object.annulus) {

@@ -6,7 +6,7 @@ use crate::material::metallic_roughness::{MetallicRoughness, hemispherical_split
 use crate::material::{Layer, Material};
 use crate::mesh::TriangleMesh;
 use crate::scene::ObjectRole;
-use crate::texture::{AlbedoTexture, NormalMap};
+use crate::texture::{AlbedoTexture, Emission, NormalMap};
 use std::sync::Arc;
 
 /// A named part of the scene mesh.
@@ -21,6 +21,8 @@ pub struct SceneObject {
     pub texture: Option<usize>,
     /// Index into [`SceneMesh::normal_maps`] of its normal map (the mesh then has tangents).
     pub normal_map: Option<usize>,
+    /// Index into [`SceneMesh::emissions`] of the light it emits.
+    pub emission: Option<usize>,
     /// Its specular lobe, if glossy (the albedo above is its diffuse `k_d`).
     pub material: Material,
     /// A virtual object, or a proxy of a real surface.
@@ -45,6 +47,9 @@ pub struct SceneMesh {
     /// Normal maps of the normal-mapped objects. The bake does not read them (CONVENTIONS.md,
     /// "Normal maps"), so they are not in [`Self::content_hash`].
     pub normal_maps: Vec<NormalMap>,
+    /// What the emitting objects emit. The bake does not carry their light to other surfaces
+    /// (CONVENTIONS.md, "Emission"), so they are not in [`Self::content_hash`].
+    pub emissions: Vec<Emission>,
 }
 
 impl SceneMesh {
@@ -122,9 +127,24 @@ impl SceneMesh {
             triangles: t0..self.mesh.triangle_count() as u32,
             texture: None,
             normal_map: None,
+            emission: None,
             material: Material::DIFFUSE,
             role: ObjectRole::Object,
         });
+    }
+
+    /// Makes the last object pushed emit `emission`.
+    pub fn set_emission(&mut self, emission: Emission) {
+        let index = match self.emissions.iter().position(|e| *e == emission) {
+            Some(i) => i,
+            None => {
+                self.emissions.push(emission);
+                self.emissions.len() - 1
+            }
+        };
+        if let Some(object) = self.objects.last_mut() {
+            object.emission = Some(index);
+        }
     }
 
     /// Gives the last object pushed `map` (its mesh must have had tangents).
@@ -221,6 +241,9 @@ impl SceneMesh {
             }
             if let Some(map) = o.normal_map {
                 out.set_normal_map(self.normal_maps[map].clone());
+            }
+            if let Some(e) = o.emission {
+                out.set_emission(self.emissions[e].clone());
             }
             if let Some(last) = out.objects.last_mut() {
                 last.material = o.material;
@@ -323,6 +346,11 @@ impl SceneMesh {
     /// Per triangle, the index of its normal map in [`Self::normal_maps`], or [`NO_TEXTURE`].
     pub fn triangle_normal_maps(&self) -> Vec<u32> {
         self.per_triangle(|o| o.normal_map)
+    }
+
+    /// Per triangle, the index of its emission in [`Self::emissions`], or [`NO_TEXTURE`].
+    pub fn triangle_emissions(&self) -> Vec<u32> {
+        self.per_triangle(|o| o.emission)
     }
 
     fn per_triangle(&self, index: impl Fn(&SceneObject) -> Option<usize>) -> Vec<u32> {

@@ -4,7 +4,7 @@
 use crate::color::Rgb;
 use crate::material::Layer;
 use crate::mesh::{self, LoadOptions, MeshCleanup, MeshError, TriangleMesh};
-use crate::texture::{AlbedoTexture, NormalMap};
+use crate::texture::{AlbedoTexture, Emission, NormalMap};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -21,6 +21,8 @@ pub(super) struct ObjectPart {
     pub(super) layer: Option<Layer>,
     /// The normal map the model file gives (glTF materials; the mesh then has tangents).
     pub(super) normal_map: Option<NormalMap>,
+    /// The light the model file says it emits (glTF materials).
+    pub(super) emission: Option<Emission>,
 }
 
 /// The model files a scene has read, by file and the options it was read with: a scene of many
@@ -72,6 +74,7 @@ fn read_model_parts(
                 albedo: part.material.as_ref().map(|m| material_albedo(path, m)),
                 layer: part.material.as_ref().and_then(|m| m.layer),
                 normal_map: part.material.as_ref().and_then(|m| m.normal_map.clone()),
+                emission: part.material.as_ref().and_then(|m| m.emission.clone()),
                 texture: part.material.and_then(|m| m.texture),
                 name: part.name,
                 mesh,

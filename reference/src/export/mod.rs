@@ -9,11 +9,11 @@ use foundation::image_io::{RgbImageF32, write_exr};
 use foundation::infra::atomic_file::write_atomic;
 use foundation::mesh::TriangleMesh;
 use foundation::scene::{SceneMesh, SceneObject};
-use ply_rs_bw::ply::{
-    Addable, DefaultElement, ElementDef, Encoding, Ply, Property, PropertyDef, PropertyType,
-    ScalarType,
-};
+use foundation::texture::Emission;
 use std::path::{Path, PathBuf};
+
+mod ply;
+pub(crate) use ply::ply_bytes;
 
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
@@ -34,72 +34,6 @@ pub struct ExportSettings {
 /// depth 2 adds direct lighting, each further level one indirect bounce.
 pub fn mitsuba_max_depth(bounces: u32) -> u32 {
     bounces + 2
-}
-
-/// A binary little-endian PLY with positions, normals and, for a textured mesh, texture
-/// coordinates (`u`, `v`: hprt's and Mitsuba's bitmap convention agree, origin at the image's
-/// top left) and, for a normal-mapped one, tangents (`tangent_x`, `_y`, `_z`) and their
-/// bitangent signs (`handed_x`): Mitsuba reads them as the attributes `vertex_tangent` and
-/// `vertex_handed`.
-pub(crate) fn ply_bytes(mesh: &TriangleMesh) -> Vec<u8> {
-    let mut names = vec!["x", "y", "z", "nx", "ny", "nz"];
-    if !mesh.uvs.is_empty() {
-        names.extend(["u", "v"]);
-    }
-    if !mesh.tangents.is_empty() {
-        names.extend(["tangent_x", "tangent_y", "tangent_z", "handed_x"]);
-    }
-    let mut ply = Ply::<DefaultElement>::new();
-    ply.header.encoding = Encoding::BinaryLittleEndian;
-    ply.header
-        .comments
-        .push("exported by hprt (world space)".into());
-    let mut vertex = ElementDef::new("vertex".into());
-    for name in &names {
-        vertex.properties.add(PropertyDef::new(
-            (*name).into(),
-            PropertyType::Scalar(ScalarType::Float),
-        ));
-    }
-    ply.header.elements.add(vertex);
-    let mut face = ElementDef::new("face".into());
-    face.properties.add(PropertyDef::new(
-        "vertex_indices".into(),
-        PropertyType::List(ScalarType::UChar, ScalarType::UInt),
-    ));
-    ply.header.elements.add(face);
-    let vertices = (0..mesh.vertex_count())
-        .map(|v| {
-            let mut e = DefaultElement::new();
-            // Absent attributes add nothing (their names are absent too).
-            let values = mesh.positions[v]
-                .to_array()
-                .into_iter()
-                .chain(mesh.normals[v].to_array())
-                .chain(mesh.uvs.get(v).into_iter().flat_map(|t| t.to_array()))
-                .chain(mesh.tangents.get(v).into_iter().flat_map(|t| t.to_array()));
-            for (name, value) in names.iter().zip(values) {
-                e.insert((*name).into(), Property::Float(value));
-            }
-            e
-        })
-        .collect();
-    let faces = mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            let mut e = DefaultElement::new();
-            e.insert("vertex_indices".into(), Property::ListUInt(t.to_vec()));
-            e
-        })
-        .collect();
-    ply.payload.insert("vertex".into(), vertices);
-    ply.payload.insert("face".into(), faces);
-    let mut out = Vec::new();
-    ply_rs_bw::writer::Writer::new()
-        .write_ply(&mut out, &mut ply)
-        .expect("writing PLY to memory cannot fail");
-    out
 }
 
 /// The sub-mesh of one scene object (its own vertex range).
@@ -125,6 +59,11 @@ fn object_mesh(geometry: &SceneMesh, object: usize) -> TriangleMesh {
 /// The texture file of textured object `index`.
 fn texture_file_for(name: &str, index: usize) -> String {
     file_name_for(name, index).replace(".ply", ".exr")
+}
+
+/// The emission file of object `index`, whose emission is textured.
+fn emission_file_for(name: &str, index: usize) -> String {
+    file_name_for(name, index).replace(".ply", "_emission.exr")
 }
 
 /// The normal map file of normal-mapped object `index`.
@@ -202,7 +141,7 @@ pub(crate) fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> Stri
         rotation = settings.rotation_deg,
     );
     for (i, o) in geometry.objects.iter().enumerate() {
-        xml.push_str(&shape_xml(o, i));
+        xml.push_str(&shape_xml(o, i, o.emission.map(|e| &geometry.emissions[e])));
     }
     xml.push_str("</scene>\n");
     xml
@@ -210,7 +149,7 @@ pub(crate) fn scene_xml(geometry: &SceneMesh, settings: &ExportSettings) -> Stri
 
 /// One object as a Mitsuba shape: its mesh file and its BSDF (diffuse, hprt's Phong, or
 /// glTF's metallic-roughness).
-fn shape_xml(o: &SceneObject, i: usize) -> String {
+fn shape_xml(o: &SceneObject, i: usize, emission: Option<&Emission>) -> String {
     let a = o.albedo;
     let reflectance = match o.texture {
         // The texture with the object's factor folded in, linear, looked up bilinearly
@@ -274,11 +213,40 @@ fn shape_xml(o: &SceneObject, i: usize) -> String {
         <boolean name="face_normals" value="false"/>
         <bsdf type="$surface">
             {inner}
-        </bsdf>
+        </bsdf>{emitter}
     </shape>
 "#,
         id = xml_escape(&o.name),
         file = file_name_for(&o.name, i),
+        emitter = emitter_xml(o, i, emission),
+    )
+}
+
+/// An emitting object's `area` emitter: its factor, or its texture times its factor as a
+/// linear EXR. Mitsuba's area lights emit from the front only; hprt's from both sides (seen
+/// only where a back faces the viewer).
+fn emitter_xml(o: &SceneObject, i: usize, emission: Option<&Emission>) -> String {
+    let Some(e) = emission else {
+        return String::new();
+    };
+    let radiance = match e.texture {
+        Some(_) => format!(
+            r#"<texture type="bitmap" name="radiance">
+                <string name="filename" value="textures/{}"/>
+                <boolean name="raw" value="true"/>
+            </texture>"#,
+            emission_file_for(&o.name, i)
+        ),
+        None => format!(
+            r#"<rgb name="radiance" value="{}, {}, {}"/>"#,
+            e.factor.x, e.factor.y, e.factor.z
+        ),
+    };
+    format!(
+        r#"
+        <emitter type="area">
+            {radiance}
+        </emitter>"#
     )
 }
 
@@ -316,8 +284,15 @@ pub fn export_files(dir: &Path, geometry: &SceneMesh) -> Vec<PathBuf> {
         .filter(|(_, o)| o.texture.is_some())
         .map(|(i, o)| dir.join("textures").join(texture_file_for(&o.name, i)));
     let normal_maps = objects
+        .clone()
         .filter(|(_, o)| o.normal_map.is_some())
         .map(|(i, o)| dir.join("textures").join(normal_map_file_for(&o.name, i)));
+    let emissions = objects
+        .filter(|(_, o)| {
+            o.emission
+                .is_some_and(|e| geometry.emissions[e].texture.is_some())
+        })
+        .map(|(i, o)| dir.join("textures").join(emission_file_for(&o.name, i)));
     let fixed = [
         "envmap.exr",
         "thinsheet.py",
@@ -330,6 +305,7 @@ pub fn export_files(dir: &Path, geometry: &SceneMesh) -> Vec<PathBuf> {
     meshes
         .chain(textures)
         .chain(normal_maps)
+        .chain(emissions)
         .chain(fixed)
         .collect()
 }
@@ -375,6 +351,18 @@ pub fn export_mitsuba(
         };
         let texels = map.texture.texels.iter().map(|t| scaled(*t)).collect();
         let image = RgbImageF32::new(map.texture.width, map.texture.height, texels);
+        write_exr(&path, &image).map_err(|e| error(&path, e.to_string()))?;
+    }
+    for (i, o) in geometry.objects.iter().enumerate() {
+        let Some(e) = o.emission.map(|e| &geometry.emissions[e]) else {
+            continue;
+        };
+        let Some(texture) = &e.texture else { continue };
+        let folder = dir.join("textures");
+        std::fs::create_dir_all(&folder).map_err(|e| error(&folder, e.to_string()))?;
+        let path = folder.join(emission_file_for(&o.name, i));
+        let texels = texture.texels.iter().map(|t| *t * e.factor).collect();
+        let image = RgbImageF32::new(texture.width, texture.height, texels);
         write_exr(&path, &image).map_err(|e| error(&path, e.to_string()))?;
     }
     let env_path = dir.join("envmap.exr");
@@ -455,5 +443,38 @@ mod tests {
         .unwrap();
         assert!(dir.path().join("meshes/00_table_top.ply").exists());
         assert!(dir.path().join("envmap.exr").exists());
+        // An emitting object gets an area emitter of its radiance; a textured one its texture
+        // times its factor, written beside the scene.
+        assert!(!xml.contains("<emitter type=\"area\">"));
+        let texture = std::sync::Arc::new(foundation::texture::AlbedoTexture {
+            width: 1,
+            height: 1,
+            texels: vec![Rgb::new(0.5, 1.0, 0.25)],
+        });
+        for (texture, want) in [
+            (None, "value=\"2, 4, 8\""),
+            (Some(texture), "_emission.exr"),
+        ] {
+            let mut lit = geometry.clone();
+            let factor = Rgb::new(2.0, 4.0, 8.0);
+            lit.set_emission(Emission { factor, texture });
+            let xml = scene_xml(&lit, &settings);
+            assert!(
+                xml.contains("<emitter type=\"area\">") && xml.contains(want),
+                "{xml}"
+            );
+            export_mitsuba(
+                dir.path(),
+                &lit,
+                &EnvMap::uniform(8, 4, Rgb::ONE),
+                &settings,
+            )
+            .unwrap();
+            assert!(export_files(dir.path(), &lit).iter().all(|f| f.exists()));
+        }
+        let written =
+            foundation::image_io::read_exr(&dir.path().join("textures/00_table_top_emission.exr"))
+                .unwrap();
+        assert_eq!(written.pixels[0], Rgb::new(1.0, 4.0, 2.0));
     }
 }

@@ -72,6 +72,13 @@ pub enum BundleError {
 impl SceneBundle {
     /// The gzipped file.
     pub fn to_bytes(&self) -> std::io::Result<Vec<u8>> {
+        if !self.geometry.emissions.is_empty() {
+            log::warn!(
+                "{}: the web viewer does not draw emission yet; its emitting objects show their \
+                 reflected light only",
+                self.name
+            );
+        }
         let stride = 3 * num_coeffs(self.transfer.settings.order);
         let direct = quantize(self.transfer.direct.as_slice(), stride);
         let indirect = quantize(self.transfer.indirect.as_slice(), stride);
@@ -269,6 +276,8 @@ fn read_sections(
         objects: h.objects.iter().map(scene_object).collect(),
         textures,
         normal_maps,
+        // Not carried: the page draws no emission (`to_bytes` says so).
+        emissions: Vec::new(),
     };
     Ok(SceneBundle {
         name: h.name,
@@ -338,6 +347,7 @@ fn scene_object(o: &ObjectEntry) -> SceneObject {
         triangles: o.triangles[0]..o.triangles[1],
         texture: o.texture,
         normal_map: o.normal_map,
+        emission: None,
         material: match o.layer {
             Some([metallic, roughness]) => Material::metallic_roughness(metallic, roughness),
             None => Material::phong(Rgb::from_array(o.specular), o.shininess),

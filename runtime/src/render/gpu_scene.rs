@@ -12,7 +12,7 @@ use crate::lighting::{FrameLighting, ShTransfer};
 use bytemuck::{Pod, Zeroable};
 use foundation::color::Rgb;
 use foundation::scene::SceneMesh;
-use foundation::texture::{AlbedoTexture, NormalMap};
+use foundation::texture::{AlbedoTexture, Emission, NormalMap};
 use glam::Vec3;
 use precompute::bake::Transfer;
 use wgpu::util::DeviceExt;
@@ -44,8 +44,8 @@ pub(crate) struct GpuScene {
     transfer_pass: TransferPass,
     /// Layout of group 1 of the PRT pass: an object's textures ([`SURFACE_TEXTURES`]).
     pub texture_layout: wgpu::BindGroupLayout,
-    /// One per pair of albedo texture and normal map ([`surface_keys`]); the first, a white
-    /// texel and no normal map, is the untextured objects'.
+    /// One per combination of albedo texture, normal map and emission ([`surface_keys`]); the
+    /// first, a white texel and neither, is the plain objects'.
     texture_groups: Vec<wgpu::BindGroup>,
     /// Index ranges drawn with one texture group each, in scene order.
     draws: Vec<(std::ops::Range<u32>, usize)>,
@@ -153,19 +153,7 @@ impl GpuScene {
         );
         let materials = materials(device, queue, geometry, transfer)?;
         let texture_layout = SURFACE_TEXTURES.layout(device);
-        let white = AlbedoTexture {
-            width: 1,
-            height: 1,
-            texels: vec![Rgb::ONE],
-        };
-        let texture_groups = surface_keys(geometry)
-            .into_iter()
-            .map(|(albedo, normals)| {
-                let albedo = albedo.map_or(&white, |t| &*geometry.textures[t]);
-                let normals = normals.map(|m| &geometry.normal_maps[m]);
-                texture_group(device, queue, &texture_layout, albedo, normals)
-            })
-            .collect();
+        let texture_groups = texture_groups(device, queue, &texture_layout, geometry);
         Ok(Self {
             materials,
             texture_layout,
@@ -360,13 +348,19 @@ fn draws(geometry: &SceneMesh) -> Vec<(std::ops::Range<u32>, usize)> {
     draws_of(geometry, |_| true)
 }
 
-/// The objects' distinct pairs of albedo texture and normal map, in scene order after the
-/// untextured objects' `(None, None)`.
-fn surface_keys(geometry: &SceneMesh) -> Vec<(Option<usize>, Option<usize>)> {
-    let mut keys = vec![(None, None)];
+/// An object's albedo texture, normal map and emission, by index.
+type SurfaceKey = (Option<usize>, Option<usize>, Option<usize>);
+
+fn surface_key(o: &foundation::scene::SceneObject) -> SurfaceKey {
+    (o.texture, o.normal_map, o.emission)
+}
+
+/// The objects' distinct surface keys, in scene order after the plain objects'.
+fn surface_keys(geometry: &SceneMesh) -> Vec<SurfaceKey> {
+    let mut keys = vec![(None, None, None)];
     for o in &geometry.objects {
-        if !keys.contains(&(o.texture, o.normal_map)) {
-            keys.push((o.texture, o.normal_map));
+        if !keys.contains(&surface_key(o)) {
+            keys.push(surface_key(o));
         }
     }
     keys
@@ -380,10 +374,7 @@ pub(crate) fn draws_of(
     let keys = surface_keys(geometry);
     let mut draws: Vec<(std::ops::Range<u32>, usize)> = Vec::new();
     for o in geometry.objects.iter().filter(|o| keep(o)) {
-        let group = keys
-            .iter()
-            .position(|k| *k == (o.texture, o.normal_map))
-            .unwrap_or(0);
+        let group = keys.iter().position(|k| *k == surface_key(o)).unwrap_or(0);
         let range = 3 * o.triangles.start..3 * o.triangles.end;
         match draws.last_mut() {
             Some((last, g)) if *g == group && last.end == range.start => last.end = range.end,
@@ -393,31 +384,82 @@ pub(crate) fn draws_of(
     draws
 }
 
-/// An albedo texture and a normal map with their mipmaps, sampled trilinearly with repeat
-/// wrapping (the reference looks the base level up bilinearly: `AlbedoTexture::bilinear`),
-/// and the normal map's scale (x) and presence (y) in a uniform. Without a normal map, the
-/// albedo texture stands in for it, unread.
+/// One texture group per surface key ([`surface_keys`]), a white texel for the plain
+/// objects' albedo.
+fn texture_groups(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    layout: &wgpu::BindGroupLayout,
+    geometry: &SceneMesh,
+) -> Vec<wgpu::BindGroup> {
+    let white = AlbedoTexture {
+        width: 1,
+        height: 1,
+        texels: vec![Rgb::ONE],
+    };
+    surface_keys(geometry)
+        .into_iter()
+        .map(|(albedo, normals, emission)| {
+            let surface = SurfaceTextures {
+                albedo: albedo.map_or(&white, |t| &*geometry.textures[t]),
+                normal_map: normals.map(|m| &geometry.normal_maps[m]),
+                emission: emission.map(|e| &geometry.emissions[e]),
+            };
+            texture_group(device, queue, layout, surface)
+        })
+        .collect()
+}
+
+/// What one texture group holds.
+struct SurfaceTextures<'a> {
+    albedo: &'a AlbedoTexture,
+    normal_map: Option<&'a NormalMap>,
+    emission: Option<&'a Emission>,
+}
+
+/// The `Surface` uniform of `shaders/geometry.wgsl`: the normal map's scale and presence, the
+/// emission's factor and whether a texture multiplies it.
+fn surface_uniform(s: &SurfaceTextures) -> [f32; 8] {
+    let flag = |b: bool| f32::from(u8::from(b));
+    let factor = s.emission.map_or(Rgb::ZERO, |e| e.factor);
+    let emission_textured = s.emission.is_some_and(|e| e.texture.is_some());
+    [
+        s.normal_map.map_or(0.0, |m| m.scale),
+        flag(s.normal_map.is_some()),
+        0.0,
+        0.0,
+        factor.x,
+        factor.y,
+        factor.z,
+        flag(emission_textured),
+    ]
+}
+
+/// An albedo texture, a normal map and an emissive texture with their mipmaps, sampled
+/// trilinearly with repeat wrapping (the reference looks the base level up bilinearly:
+/// `AlbedoTexture::bilinear`), and their parameters in a uniform ([`surface_uniform`]). A
+/// texture the object lacks is stood in for by the albedo texture, unread.
 fn texture_group(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     layout: &wgpu::BindGroupLayout,
-    texture: &AlbedoTexture,
-    normal_map: Option<&NormalMap>,
+    surface_textures: SurfaceTextures,
 ) -> wgpu::BindGroup {
     let upload = |texture: &AlbedoTexture, label| {
         let levels = mip_chain_of(&texture.texels, texture.width, texture.height);
         upload_mip_chain(device, queue, label, &levels)
     };
-    let gpu_texture = upload(texture, "albedo texture");
-    let normal_texture = normal_map.map(|m| upload(&m.texture, "normal map"));
+    let gpu_texture = upload(surface_textures.albedo, "albedo texture");
+    let normal_texture = surface_textures
+        .normal_map
+        .map(|m| upload(&m.texture, "normal map"));
+    let emissive_texture = surface_textures
+        .emission
+        .and_then(|e| e.texture.as_ref())
+        .map(|t| upload(t, "emissive texture"));
     let surface = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("surface"),
-        contents: bytemuck::cast_slice(&[
-            normal_map.map_or(0.0, |m| m.scale),
-            f32::from(u8::from(normal_map.is_some())),
-            0.0,
-            0.0,
-        ]),
+        contents: bytemuck::cast_slice(&surface_uniform(&surface_textures)),
         usage: wgpu::BufferUsages::UNIFORM,
     });
     let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
@@ -430,9 +472,14 @@ fn texture_group(
         ..Default::default()
     });
     let view = gpu_texture.create_view(&Default::default());
-    let normal_view = normal_texture
-        .as_ref()
-        .map_or_else(|| view.clone(), |t| t.create_view(&Default::default()));
+    let view_or_albedo = |t: &Option<wgpu::Texture>| {
+        t.as_ref()
+            .map_or_else(|| view.clone(), |t| t.create_view(&Default::default()))
+    };
+    let (normal_view, emissive_view) = (
+        view_or_albedo(&normal_texture),
+        view_or_albedo(&emissive_texture),
+    );
     SURFACE_TEXTURES.bind_group(
         device,
         layout,
@@ -442,6 +489,10 @@ fn texture_group(
             (
                 "normal_texture",
                 wgpu::BindingResource::TextureView(&normal_view),
+            ),
+            (
+                "emissive_texture",
+                wgpu::BindingResource::TextureView(&emissive_view),
             ),
             ("surface", surface.as_entire_binding()),
         ],

@@ -124,8 +124,8 @@ pub(crate) const PRT_FRAME: BindGroupDecl = BindGroupDecl {
     ],
 };
 
-/// `shaders/geometry.wgsl`, group 1: an object's textures (albedo and normal map, sampled
-/// alike) and the normal map's scale.
+/// `shaders/geometry.wgsl`, group 1: an object's textures (albedo, normal map and emission,
+/// sampled alike), the normal map's scale and the emission's factor.
 pub(crate) const SURFACE_TEXTURES: BindGroupDecl = BindGroupDecl {
     label: "surface textures",
     shader: Shader::Geometry,
@@ -134,6 +134,7 @@ pub(crate) const SURFACE_TEXTURES: BindGroupDecl = BindGroupDecl {
         binding("albedo_texture", FRAGMENT, FILTERABLE_2D),
         binding("albedo_sampler", FRAGMENT, FILTERING),
         binding("normal_texture", FRAGMENT, FILTERABLE_2D),
+        binding("emissive_texture", FRAGMENT, FILTERABLE_2D),
         binding("surface", FRAGMENT, Resource::Uniform),
     ],
 };
