@@ -4,15 +4,16 @@
 use super::description::*;
 use super::geometry::SceneMesh;
 use super::model_files::{ModelFiles, ObjectPart};
+use super::shape_objects::{annulus_object, box_object, sphere_object};
+use super::spec_error::SpecError;
 use super::{Scene, SceneError};
 use crate::color::Rgb;
 use crate::infra::limits::{MAX_SCENE_TRIANGLES, ReadError, read_text_file};
 use crate::infra::names::check_file_name;
 use crate::material::{Layer, MAX_SHININESS, Material, check_energy};
-use crate::mesh::{LoadOptions, MeshError, TriangleMesh, annulus_mesh, box_mesh};
+use crate::mesh::{LoadOptions, MeshError, TriangleMesh};
 use crate::probe::ProbeSource;
 use crate::texture::{AlbedoTexture, Emission, NormalMap};
-use glam::Vec3;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -337,9 +338,6 @@ fn layer_factor(name: &str, what: &'static str, value: Option<f32>) -> Result<f3
     Ok(clamped)
 }
 
-/// Face names of `skip_faces`, in the order of `box_mesh`'s `skip` flags.
-const BOX_FACES: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
-
 enum ObjectError {
     Mesh(MeshError),
     Spec(SpecError),
@@ -349,45 +347,6 @@ impl From<SpecError> for ObjectError {
     fn from(e: SpecError) -> Self {
         ObjectError::Spec(e)
     }
-}
-
-/// What is wrong with an object's description in the scene file.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub(super) enum SpecError {
-    #[error("shininess without specular = [r, g, b]")]
-    ShininessWithoutSpecular,
-    #[error("specular needs a shininess (the Phong exponent)")]
-    SpecularWithoutShininess,
-    #[error("specular {0:?} must be in [0, 1] per channel")]
-    Specular([f32; 3]),
-    #[error("shininess {0} must be in (0, {max}]", max = MAX_SHININESS)]
-    Shininess(f32),
-    #[error(
-        "give a Phong lobe (specular, shininess) or a metallic-roughness material \
-         (base_color, metallic, roughness), not both"
-    )]
-    PhongAndLayer,
-    #[error("{what} {value} is not a number")]
-    Factor { what: &'static str, value: f32 },
-    #[error(
-        "give exactly one of `mesh = \"file\"`, `box = {{ min, max }}` or `annulus = {{ outer_radius }}`"
-    )]
-    Shape,
-    #[error("box min {min:?} must be below max {max:?} on every axis")]
-    BoxBounds { min: [f32; 3], max: [f32; 3] },
-    #[error("box segments {0:?} must be between 1 and 4096")]
-    BoxSegments([u32; 3]),
-    #[error("unknown box face {0:?} in skip_faces (use {faces:?})", faces = BOX_FACES)]
-    BoxFace(String),
-    #[error(
-        "the object would have {0} triangles, more than the {max} a scene may hold",
-        max = MAX_SCENE_TRIANGLES
-    )]
-    TooManyTriangles(u64),
-    #[error("annulus radii {inner} .. {outer} must satisfy 0 <= inner < outer")]
-    AnnulusRadii { inner: f32, outer: f32 },
-    #[error("annulus segments {0:?} must be at least [1, 3] and at most 4096")]
-    AnnulusSegments([u32; 2]),
 }
 
 fn load_object_parts(
@@ -406,8 +365,9 @@ fn load_object_parts(
             emission: None,
         }]
     };
-    match (&object.mesh, &object.box_shape, &object.annulus) {
-        (Some(file), None, None) => {
+    let shape = (&object.box_shape, &object.annulus, &object.sphere);
+    match (&object.mesh, shape) {
+        (Some(file), (None, None, None)) => {
             let options = LoadOptions {
                 patch_segments: object.patch_segments,
                 skip_patches: object.skip_patches.clone(),
@@ -417,62 +377,9 @@ fn load_object_parts(
                 .parts(path, &options, object.weld)
                 .map_err(ObjectError::Mesh)
         }
-        (None, Some(b), None) => box_object(b).map(whole),
-        (None, None, Some(a)) => annulus_object(a).map(whole),
+        (None, (Some(b), None, None)) => box_object(b).map(whole).map_err(Into::into),
+        (None, (None, Some(a), None)) => annulus_object(a).map(whole).map_err(Into::into),
+        (None, (None, None, Some(s))) => sphere_object(s).map(whole).map_err(Into::into),
         _ => Err(SpecError::Shape.into()),
     }
-}
-
-fn box_object(b: &BoxSpec) -> Result<TriangleMesh, ObjectError> {
-    let (min, max) = (Vec3::from(b.min), Vec3::from(b.max));
-    if !(min.is_finite() && max.is_finite() && min.cmplt(max).all()) {
-        return Err(SpecError::BoxBounds {
-            min: b.min,
-            max: b.max,
-        }
-        .into());
-    }
-    if b.segments.iter().any(|&s| s == 0 || s > 4096) {
-        return Err(SpecError::BoxSegments(b.segments).into());
-    }
-    let [x, y, z] = b.segments.map(u64::from);
-    let triangles = 4 * (x * y + y * z + z * x);
-    if triangles > MAX_SCENE_TRIANGLES as u64 {
-        return Err(SpecError::TooManyTriangles(triangles).into());
-    }
-    let mut skip = [false; 6];
-    for face in &b.skip_faces {
-        let index = BOX_FACES
-            .iter()
-            .position(|f| f == face)
-            .ok_or_else(|| SpecError::BoxFace(face.clone()))?;
-        skip[index] = true;
-    }
-    if skip.iter().all(|s| *s) {
-        log::warn!(
-            "the box {:?}..{:?} skips all six faces: it adds nothing to the scene",
-            b.min,
-            b.max
-        );
-    }
-    Ok(box_mesh(min, max, b.segments, skip))
-}
-
-fn annulus_object(a: &AnnulusSpec) -> Result<TriangleMesh, ObjectError> {
-    if !(a.inner_radius >= 0.0 && a.outer_radius > a.inner_radius && a.outer_radius.is_finite()) {
-        return Err(SpecError::AnnulusRadii {
-            inner: a.inner_radius,
-            outer: a.outer_radius,
-        }
-        .into());
-    }
-    if a.segments[0] == 0 || a.segments[1] < 3 || a.segments.iter().any(|&s| s > 4096) {
-        return Err(SpecError::AnnulusSegments(a.segments).into());
-    }
-    Ok(annulus_mesh(
-        Vec3::from(a.center),
-        a.inner_radius,
-        a.outer_radius,
-        a.segments,
-    ))
 }

@@ -179,6 +179,9 @@ pub struct ObjectSpec {
     /// A flat ring (or disc, with `inner_radius = 0`) in the object's XZ plane, facing +Y.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub annulus: Option<AnnulusSpec>,
+    /// A sphere (an icosphere with smooth normals).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sphere: Option<SphereSpec>,
     /// Weld coincident vertices (default: when the file has no normals).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub weld: Option<bool>,
@@ -220,6 +223,21 @@ pub struct AnnulusSpec {
 
 fn default_annulus_segments() -> [u32; 2] {
     [1, 64]
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereSpec {
+    #[serde(default)]
+    pub center: [f32; 3],
+    pub radius: f32,
+    /// Times the icosahedron's triangles are split in four (0 to 7: 20 × 4^n triangles).
+    #[serde(default = "default_sphere_subdivisions")]
+    pub subdivisions: u32,
+}
+
+fn default_sphere_subdivisions() -> u32 {
+    4
 }
 
 /// Object-to-world placement: scale, then rotations about X, Y and Z (degrees), then translate.

@@ -9,6 +9,8 @@ pub mod model;
 mod model_files;
 mod path;
 mod rotation;
+mod shape_objects;
+mod spec_error;
 
 pub use backplate::{BackplateError, load_backplate_image};
 pub use description::{
