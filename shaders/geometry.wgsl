@@ -215,11 +215,12 @@ fn shade(in: VertexOut) -> FragmentOut {
     var out: FragmentOut;
     let vertex_normal = normalize(in.normal);
     let texel = textureSample(albedo_texture, albedo_sampler, in.uv).rgb;
-    let normal_texel = textureSample(normal_texture, albedo_sampler, in.uv).rgb;
-    let emissive_texel = textureSample(emissive_texture, albedo_sampler, in.uv).rgb;
     var normal = vertex_normal;
     out.color = vec4<f32>(in.radiance * texel, 1.0);
+    // The surface's flags are uniform: the branches below sample in uniform control flow, and
+    // objects without a normal map or emissive texture read neither.
     if surface.normal_map.y > 0.5 {
+        let normal_texel = textureSample(normal_texture, albedo_sampler, in.uv).rgb;
         normal = perturbed_normal(vertex_normal, in.tangent, normal_texel, surface.normal_map.x);
         out.color = vec4<f32>(out.color.xyz * normal_map_ratio(vertex_normal, normal), 1.0);
     }
@@ -275,8 +276,11 @@ fn shade(in: VertexOut) -> FragmentOut {
         }
     }
     // Emission: added as it is, from both sides (the light pass adds the lights' on top).
-    let emitted_texel = select(vec3<f32>(1.0), emissive_texel, surface.emission.w > 0.5);
-    out.color = out.color + vec4<f32>(surface.emission.rgb * emitted_texel, 0.0);
+    var emitted = surface.emission.rgb;
+    if surface.emission.w > 0.5 {
+        emitted *= textureSample(emissive_texture, albedo_sampler, in.uv).rgb;
+    }
+    out.color = out.color + vec4<f32>(emitted, 0.0);
     // w: the material index (exact in a half float) for the light pass.
     out.normal = vec4<f32>(normal, f32(in.material));
     out.albedo = vec4<f32>(in.albedo * texel, 1.0);

@@ -144,7 +144,6 @@ impl<'a> Integrator<'a> {
     /// The surface point where a ray from `origin` along `direction` hit. Either side of a
     /// triangle shows its front (CONVENTIONS.md, "Surfaces").
     pub fn surface(&self, hit: &Hit) -> SurfacePoint {
-        let mesh = &self.geometry.mesh;
         let triangle = &self.triangles[hit.triangle as usize];
         let weights = hit.barycentrics();
         let mut position = Vec3::ZERO;
@@ -159,12 +158,7 @@ impl<'a> Integrator<'a> {
             && texture != NO_TEXTURE
         {
             // The texel's albedo (times the object's factor, interpolated above).
-            let uv: glam::Vec2 = mesh.triangles[hit.triangle as usize]
-                .iter()
-                .zip(weights)
-                .map(|(i, w)| mesh.uvs[*i as usize] * w)
-                .sum();
-            albedo *= self.geometry.textures[texture as usize].bilinear(uv);
+            albedo *= self.geometry.textures[texture as usize].bilinear(self.hit_uv(hit));
         }
         let front = triangle.front_normal;
         let mut shading_normal = normal.try_normalize().unwrap_or(front);
@@ -216,15 +210,14 @@ impl<'a> Integrator<'a> {
     fn mapped_normal(&self, hit: &Hit, n: Vec3, map: usize) -> Vec3 {
         let mesh = &self.geometry.mesh;
         let corners = mesh.triangles[hit.triangle as usize];
-        let weights = hit.barycentrics();
-        let (mut uv, mut tangent) = (glam::Vec2::ZERO, glam::Vec4::ZERO);
-        for (i, w) in corners.iter().zip(weights) {
-            uv += mesh.uvs[*i as usize] * w;
-            tangent += mesh.tangents[*i as usize] * w;
-        }
+        let mut tangent: glam::Vec4 = corners
+            .iter()
+            .zip(hit.barycentrics())
+            .map(|(i, w)| mesh.tangents[*i as usize] * w)
+            .sum();
         // The sign is the corners' (one per triangle in a well-made mesh).
         tangent.w = mesh.tangents[corners[0] as usize].w;
-        self.geometry.normal_maps[map].shading_normal(n, tangent, uv)
+        self.geometry.normal_maps[map].shading_normal(n, tangent, self.hit_uv(hit))
     }
 
     /// The point at vertex `v`, with rays leaving as in the bake.

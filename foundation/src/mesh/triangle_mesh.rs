@@ -103,28 +103,27 @@ impl TriangleMesh {
     /// vertex where either mesh has them (zero for the other's vertices).
     pub(crate) fn append(&mut self, other: &TriangleMesh) {
         let base = self.positions.len() as u32;
-        if !self.tangents.is_empty() || !other.tangents.is_empty() {
-            self.tangents.resize(self.positions.len(), Vec4::ZERO);
-            match other.tangents.is_empty() {
-                true => self
-                    .tangents
-                    .extend(std::iter::repeat_n(Vec4::ZERO, other.positions.len())),
-                false => self.tangents.extend_from_slice(&other.tangents),
-            }
-        }
-        if !self.uvs.is_empty() || !other.uvs.is_empty() {
-            self.uvs.resize(self.positions.len(), Vec2::ZERO);
-            match other.uvs.is_empty() {
-                true => self
-                    .uvs
-                    .extend(std::iter::repeat_n(Vec2::ZERO, other.positions.len())),
-                false => self.uvs.extend_from_slice(&other.uvs),
-            }
-        }
+        let counts = (self.positions.len(), other.positions.len());
+        append_optional(&mut self.uvs, &other.uvs, counts);
+        append_optional(&mut self.tangents, &other.tangents, counts);
         self.positions.extend_from_slice(&other.positions);
         self.normals.extend_from_slice(&other.normals);
         self.triangles
             .extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
+    }
+}
+
+/// Appends `other` (one per vertex of the other mesh, or empty) to `all` (one per vertex of
+/// this mesh, or empty), `counts` the two meshes' vertex counts: where either has the
+/// attribute, both keep one per vertex, zero for the vertices that lacked it.
+fn append_optional<T: Copy + Default>(all: &mut Vec<T>, other: &[T], counts: (usize, usize)) {
+    if all.is_empty() && other.is_empty() {
+        return;
+    }
+    all.resize(counts.0, T::default());
+    match other.is_empty() {
+        true => all.extend(std::iter::repeat_n(T::default(), counts.1)),
+        false => all.extend_from_slice(other),
     }
 }
 

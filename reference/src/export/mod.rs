@@ -154,17 +154,8 @@ fn shape_xml(o: &SceneObject, i: usize, emission: Option<&Emission>) -> String {
     let reflectance = match o.texture {
         // The texture with the object's factor folded in, linear, looked up bilinearly
         // with repeat wrapping (Mitsuba's defaults, and hprt's reference).
-        Some(_) => format!(
-            r#"<texture type="bitmap" name="reflectance">
-                    <string name="filename" value="textures/{}"/>
-                    <boolean name="raw" value="true"/>
-                </texture>"#,
-            texture_file_for(&o.name, i)
-        ),
-        None => format!(
-            r#"<rgb name="reflectance" value="{}, {}, {}"/>"#,
-            a.x, a.y, a.z
-        ),
+        Some(_) => bitmap_xml("reflectance", &texture_file_for(&o.name, i)),
+        None => rgb_xml("reflectance", a),
     };
     let m = &o.material;
     let surface = if let Some(layer) = m.layer {
@@ -197,13 +188,10 @@ fn shape_xml(o: &SceneObject, i: usize, emission: Option<&Emission>) -> String {
     let inner = match o.normal_map {
         Some(_) => format!(
             r#"<bsdf type="hprtnormalmap">
-                <texture type="bitmap" name="normalmap">
-                    <string name="filename" value="textures/{}"/>
-                    <boolean name="raw" value="true"/>
-                </texture>
+                {}
                 {surface}
             </bsdf>"#,
-            normal_map_file_for(&o.name, i)
+            bitmap_xml("normalmap", &normal_map_file_for(&o.name, i))
         ),
         None => surface,
     };
@@ -230,17 +218,8 @@ fn emitter_xml(o: &SceneObject, i: usize, emission: Option<&Emission>) -> String
         return String::new();
     };
     let radiance = match e.texture {
-        Some(_) => format!(
-            r#"<texture type="bitmap" name="radiance">
-                <string name="filename" value="textures/{}"/>
-                <boolean name="raw" value="true"/>
-            </texture>"#,
-            emission_file_for(&o.name, i)
-        ),
-        None => format!(
-            r#"<rgb name="radiance" value="{}, {}, {}"/>"#,
-            e.factor.x, e.factor.y, e.factor.z
-        ),
+        Some(_) => bitmap_xml("radiance", &emission_file_for(&o.name, i)),
+        None => rgb_xml("radiance", e.factor),
     };
     format!(
         r#"
@@ -248,6 +227,21 @@ fn emitter_xml(o: &SceneObject, i: usize, emission: Option<&Emission>) -> String
             {radiance}
         </emitter>"#
     )
+}
+
+/// A linear EXR of `textures/` as the texture parameter `name`, looked up bilinearly with
+/// repeat wrapping (Mitsuba's defaults, and hprt's reference).
+fn bitmap_xml(name: &str, file: &str) -> String {
+    format!(
+        r#"<texture type="bitmap" name="{name}">
+                    <string name="filename" value="textures/{file}"/>
+                    <boolean name="raw" value="true"/>
+                </texture>"#
+    )
+}
+
+fn rgb_xml(name: &str, c: Rgb) -> String {
+    format!(r#"<rgb name="{name}" value="{}, {}, {}"/>"#, c.x, c.y, c.z)
 }
 
 fn xml_escape(s: &str) -> String {
