@@ -63,6 +63,7 @@ pub(super) fn sphere_object(s: &SphereSpec) -> Result<TriangleMesh, SpecError> {
     let sane = s.radius > 0.0 && s.radius.is_finite() && centre.is_finite();
     if !sane || s.subdivisions > MAX_SPHERE_SUBDIVISIONS {
         return Err(SpecError::Sphere {
+            center: s.center,
             radius: s.radius,
             subdivisions: s.subdivisions,
         });

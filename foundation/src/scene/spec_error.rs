@@ -48,8 +48,13 @@ pub(crate) enum SpecError {
     #[error("annulus segments {0:?} must be at least [1, 3] and at most 4096")]
     AnnulusSegments([u32; 2]),
     #[error(
-        "sphere radius {radius} must be above 0 and subdivisions {subdivisions} at most {max}",
+        "sphere radius {radius} must be above 0 and finite, subdivisions {subdivisions} at most \
+         {max} and the center {center:?} finite",
         max = MAX_SPHERE_SUBDIVISIONS
     )]
-    Sphere { radius: f32, subdivisions: u32 },
+    Sphere {
+        center: [f32; 3],
+        radius: f32,
+        subdivisions: u32,
+    },
 }
